@@ -1,0 +1,4 @@
+#include <phri/core/version.hpp>
+namespace phri {
+const char* version() { return PHRI_VERSION; }
+}  // namespace phri
