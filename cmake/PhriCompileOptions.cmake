@@ -24,6 +24,11 @@ endif()
 function(phri_target_options target)
   target_compile_options(${target} PRIVATE -Wall -Wextra -Wpedantic -Werror
     $<$<CONFIG:Release,RelWithDebInfo>:-O3>)
+  # GCC 12 reports false array-bounds errors inside Eigen's AVX code paths once inlined into our
+  # functions (GCC bugs 106247 / 107852); the diagnostic is about Eigen's internals, not our code.
+  if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU")
+    target_compile_options(${target} PRIVATE -Wno-array-bounds -Wno-stringop-overflow)
+  endif()
   if(PHRI_MARCH_FLAG)
     target_compile_options(${target} PRIVATE ${PHRI_MARCH_FLAG})
   endif()

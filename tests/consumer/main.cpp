@@ -16,6 +16,6 @@ int main(int argc, char** argv) {
   const Eigen::VectorXd q = Eigen::VectorXd::Zero(model.nq());
   phri::compute_gravity(model, data, q);
   std::printf("phri %s: %s has %d joints, |g(0)| = %.6f\n", phri::version(), model.name().c_str(),
-              model.nq(), data.gravity.norm());
+              model.nq(), data.gravity_torque.norm());
   return model.nq() > 0 ? 0 : 1;
 }

@@ -1,0 +1,135 @@
+// Forward kinematics, frame placements, frame velocities and accelerations, frame Jacobians.
+// Everything is computed in the world frame (see spatial.hpp), so a chain needs no per-joint
+// change of coordinates: joint i's motion subspace S_i is expressed once, in world axes.
+#include <phri/model/algorithms.hpp>
+
+#include <cassert>
+
+namespace phri {
+namespace {
+
+// Placement of body i in the world and its motion subspace, for the joint position qi.
+void place_body(const Model& model, Data& data, int i, double qi) {
+  const Joint& joint = model.joint(i);
+  const Eigen::Isometry3d& parent = i == 0 ? model.base_placement() : data.body_placements[static_cast<std::size_t>(i - 1)];
+  Eigen::Isometry3d& body = data.body_placements[static_cast<std::size_t>(i)];
+  body = parent * joint.placement;  // the joint frame at q = 0
+  const Eigen::Vector3d axis_world = body.linear() * joint.axis;
+  if (joint.type == JointType::kPrismatic) {
+    body.translation() += axis_world * qi;
+    data.motion_subspace.col(i) << axis_world, Eigen::Vector3d::Zero();
+  } else {
+    body.linear() = body.linear() * Eigen::AngleAxisd(qi, joint.axis).toRotationMatrix();
+    // A rotation about the axis through the body origin p moves the world-origin point at p x a.
+    data.motion_subspace.col(i) << body.translation().cross(axis_world), axis_world;
+  }
+}
+
+const Eigen::Isometry3d& frame_parent_placement(const Model& model, const Data& data, int body) {
+  return body < 0 ? model.base_placement() : data.body_placements[static_cast<std::size_t>(body)];
+}
+
+}  // namespace
+
+void forward_kinematics(const Model& model, Data& data, const Eigen::VectorXd& q) {
+  assert(q.size() == model.nq());
+  for (int i = 0; i < model.nq(); ++i) place_body(model, data, i, q[i]);
+}
+
+void forward_kinematics(const Model& model, Data& data, const Eigen::VectorXd& q,
+                        const Eigen::VectorXd& qd) {
+  assert(q.size() == model.nq() && qd.size() == model.nv());
+  for (int i = 0; i < model.nq(); ++i) {
+    place_body(model, data, i, q[i]);
+    auto v = data.body_velocities.col(i);
+    v = data.motion_subspace.col(i) * qd[i];
+    if (i > 0) v += data.body_velocities.col(i - 1);
+  }
+}
+
+void forward_kinematics(const Model& model, Data& data, const Eigen::VectorXd& q,
+                        const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd) {
+  assert(qdd.size() == model.nv());
+  forward_kinematics(model, data, q, qd);
+  for (int i = 0; i < model.nq(); ++i) {
+    const Vector6d s = data.motion_subspace.col(i);
+    // d/dt (S_i qd_i) = S_i qdd_i + (v_i x S_i) qd_i: the axis moves with the parent body.
+    Vector6d a = s * qdd[i] + motion_cross(data.body_velocities.col(i), s) * qd[i];
+    if (i > 0) a += data.body_accelerations.col(i - 1);
+    data.body_accelerations.col(i) = a;
+  }
+}
+
+void update_frame_placements(const Model& model, Data& data) {
+  for (int f = 0; f < model.num_frames(); ++f) {
+    const Frame& frame = model.frame(f);
+    data.frame_placements[static_cast<std::size_t>(f)] =
+        frame_parent_placement(model, data, frame.body) * frame.placement;
+  }
+}
+
+Vector6d frame_velocity(const Model& model, const Data& data, int frame_id, ReferenceFrame rf) {
+  const Frame& frame = model.frame(frame_id);
+  if (frame.body < 0) return Vector6d::Zero();
+  const Vector6d v = data.body_velocities.col(frame.body);
+  if (rf == ReferenceFrame::kWorld) return v;
+  const Eigen::Isometry3d& oMf = data.frame_placements[static_cast<std::size_t>(frame_id)];
+  Vector6d out;
+  out.head<3>() = v.head<3>() + v.tail<3>().cross(oMf.translation());
+  out.tail<3>() = v.tail<3>();
+  if (rf == ReferenceFrame::kLocal) {
+    out.head<3>() = oMf.linear().transpose() * out.head<3>();
+    out.tail<3>() = oMf.linear().transpose() * out.tail<3>();
+  }
+  return out;
+}
+
+Vector6d frame_acceleration(const Model& model, const Data& data, int frame_id, ReferenceFrame rf) {
+  const Frame& frame = model.frame(frame_id);
+  if (frame.body < 0) return Vector6d::Zero();
+  const Vector6d a = data.body_accelerations.col(frame.body);
+  if (rf == ReferenceFrame::kWorld) return a;  // d/dt(J_world qd) is the spatial acceleration
+  const Vector6d v = data.body_velocities.col(frame.body);
+  const Eigen::Isometry3d& oMf = data.frame_placements[static_cast<std::size_t>(frame_id)];
+  const Eigen::Vector3d& p = oMf.translation();
+  const Eigen::Vector3d w = v.tail<3>();
+  const Eigen::Vector3d alpha = a.tail<3>();
+  // Acceleration of the body point at p, seen from a frame moving with the point's velocity.
+  const Eigen::Vector3d a_point = a.head<3>() + alpha.cross(p);
+  Vector6d out;
+  if (rf == ReferenceFrame::kLocalWorldAligned) {
+    // Classical acceleration: add w x (velocity of the point).
+    const Eigen::Vector3d v_point = v.head<3>() + w.cross(p);
+    out.head<3>() = a_point + w.cross(v_point);
+    out.tail<3>() = alpha;
+  } else {
+    // d/dt(R^T x) = R^T (x' - w x x): the rotating axes remove exactly that term.
+    out.head<3>() = oMf.linear().transpose() * a_point;
+    out.tail<3>() = oMf.linear().transpose() * alpha;
+  }
+  return out;
+}
+
+void frame_jacobian(const Model& model, const Data& data, int frame_id, ReferenceFrame rf,
+                    Eigen::Ref<Eigen::MatrixXd> jacobian) {
+  assert(jacobian.rows() == 6 && jacobian.cols() == model.nv());
+  jacobian.setZero();
+  const Frame& frame = model.frame(frame_id);
+  const Eigen::Isometry3d& oMf = data.frame_placements[static_cast<std::size_t>(frame_id)];
+  for (int j = 0; j <= frame.body; ++j) {
+    const auto s = data.motion_subspace.col(j);
+    if (rf == ReferenceFrame::kWorld) {
+      jacobian.col(j) = s;
+      continue;
+    }
+    Eigen::Vector3d lin = s.head<3>() + s.tail<3>().cross(oMf.translation());
+    Eigen::Vector3d ang = s.tail<3>();
+    if (rf == ReferenceFrame::kLocal) {
+      lin = oMf.linear().transpose() * lin;
+      ang = oMf.linear().transpose() * ang;
+    }
+    jacobian.col(j) << lin, ang;
+  }
+}
+
+}  // namespace phri

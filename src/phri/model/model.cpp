@@ -1,0 +1,412 @@
+// Model construction from URDF (urdfdom) with validation, and the small Model queries.
+#include <phri/model/model.hpp>
+
+#include <phri/core/config_error.hpp>
+
+#include <console_bridge/console.h>
+#include <urdf_parser/urdf_parser.h>
+
+#include <Eigen/Eigenvalues>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <mutex>
+#include <sstream>
+
+namespace phri {
+
+// ---------------------------------------------------------------------------------- Inertia
+Inertia Inertia::combined_with(const Inertia& other) const {
+  const double m = mass + other.mass;
+  if (m <= 0.0) return Inertia{};
+  Inertia out;
+  out.mass = m;
+  out.com = (mass * com + other.mass * other.com) / m;
+  auto shifted = [&](const Inertia& part) -> Eigen::Matrix3d {
+    const Eigen::Vector3d d = part.com - out.com;
+    return part.inertia_com +
+           part.mass * (d.squaredNorm() * Eigen::Matrix3d::Identity() - d * d.transpose());
+  };
+  out.inertia_com = shifted(*this) + shifted(other);
+  return out;
+}
+
+Inertia Inertia::transformed(const Eigen::Isometry3d& placement) const {
+  Inertia out;
+  out.mass = mass;
+  out.com = placement * com;
+  out.inertia_com = placement.linear() * inertia_com * placement.linear().transpose();
+  return out;
+}
+
+// ---------------------------------------------------------------------------------- builder
+namespace {
+
+// Captures urdfdom's console_bridge messages so that a parse failure can be reported with its
+// reason instead of a bare "invalid". console_bridge's handler is global: serialise loads.
+class CapturingOutput : public console_bridge::OutputHandler {
+public:
+  void log(const std::string& text, console_bridge::LogLevel level, const char*, int) override {
+    if (level >= console_bridge::CONSOLE_BRIDGE_LOG_WARN) {
+      if (!messages.empty()) messages += "; ";
+      messages += text;
+    }
+  }
+  std::string messages;
+};
+std::mutex g_parse_mutex;
+
+bool finite(double x) { return std::isfinite(x); }
+
+Eigen::Isometry3d to_isometry(const urdf::Pose& pose) {
+  Eigen::Isometry3d out = Eigen::Isometry3d::Identity();
+  Eigen::Quaterniond quat(pose.rotation.w, pose.rotation.x, pose.rotation.y, pose.rotation.z);
+  out.linear() = quat.normalized().toRotationMatrix();
+  out.translation() << pose.position.x, pose.position.y, pose.position.z;
+  return out;
+}
+
+bool pose_is_finite(const urdf::Pose& p) {
+  return finite(p.position.x) && finite(p.position.y) && finite(p.position.z) &&
+         finite(p.rotation.x) && finite(p.rotation.y) && finite(p.rotation.z) && finite(p.rotation.w);
+}
+
+std::string fmt(double x) {
+  std::ostringstream s;
+  s << x;
+  return s.str();
+}
+
+bool is_movable(const urdf::Joint& joint) { return joint.type != urdf::Joint::FIXED; }
+
+}  // namespace
+
+class UrdfModelBuilder {
+public:
+  UrdfModelBuilder(const urdf::ModelInterface& urdf, const ModelOptions& options, std::string source)
+      : urdf_(urdf), options_(options), source_(std::move(source)) {}
+
+  Model build() {
+    model_.name_ = urdf_.getName();
+    model_.gravity_ = options_.gravity;
+    model_.base_placement_ = options_.base_placement;
+    if (!options_.gravity.allFinite()) fail("ModelOptions.gravity", "must be finite");
+    if (!options_.base_placement.matrix().allFinite()) fail("ModelOptions.base_placement", "must be finite");
+
+    const urdf::Link* base = resolve_base();
+    model_.base_link_ = base->name;
+    const urdf::Link* tip = resolve_tip(base);
+    model_.tip_link_ = tip->name;
+
+    // The links on the path base -> tip (base excluded), which decides what is "the chain".
+    for (const urdf::Link* link = tip; link != base; link = link->getParent().get()) {
+      on_path_[link->name] = true;
+    }
+    visit(*base, -1, Eigen::Isometry3d::Identity());
+
+    if (model_.joints_.empty()) {
+      fail("", "no movable joint between base '" + base->name + "' and tip '" + tip->name + "'");
+    }
+    for (std::size_t i = 0; i < model_.bodies_.size(); ++i) check_body(static_cast<int>(i));
+    add_extra_frames();
+    apply_armature();
+    for (const std::string& name : options_.locked_joints) {
+      if (!urdf_.getJoint(name)) fail("ModelOptions.locked_joints", "unknown joint '" + name + "'");
+    }
+    return std::move(model_);
+  }
+
+private:
+  [[noreturn]] void fail(const std::string& element, const std::string& reason) const {
+    throw ConfigError(source_, element, reason);
+  }
+
+  const urdf::Link* resolve_base() const {
+    if (options_.base_link.empty()) {
+      auto root = urdf_.getRoot();
+      if (!root) fail("", "no root link");
+      return root.get();
+    }
+    auto link = urdf_.getLink(options_.base_link);
+    if (!link) fail("ModelOptions.base_link", "unknown link '" + options_.base_link + "'");
+    return link.get();
+  }
+
+  bool locked(const std::string& joint) const {
+    return std::find(options_.locked_joints.begin(), options_.locked_joints.end(), joint) !=
+           options_.locked_joints.end();
+  }
+  bool moves(const urdf::Joint& joint) const { return is_movable(joint) && !locked(joint.name); }
+
+  // True when the subtree below `link` contains a movable, unlocked joint.
+  bool subtree_moves(const urdf::Link& link) const {
+    for (const auto& joint : link.child_joints) {
+      if (moves(*joint)) return true;
+    }
+    for (const auto& child : link.child_links) {
+      if (subtree_moves(*child)) return true;
+    }
+    return false;
+  }
+
+  const urdf::Link* resolve_tip(const urdf::Link* base) const {
+    if (!options_.tip_link.empty()) {
+      auto tip = urdf_.getLink(options_.tip_link);
+      if (!tip) fail("ModelOptions.tip_link", "unknown link '" + options_.tip_link + "'");
+      const urdf::Link* link = tip.get();
+      while (link != nullptr && link != base) link = link->getParent().get();
+      if (link == nullptr) {
+        fail("ModelOptions.tip_link", "link '" + options_.tip_link + "' is not below base '" + base->name + "'");
+      }
+      return tip.get();
+    }
+    // Follow the only branch that still moves; a fork means the user must choose.
+    const urdf::Link* link = base;
+    for (;;) {
+      const urdf::Link* next = nullptr;
+      for (std::size_t c = 0; c < link->child_links.size(); ++c) {
+        const urdf::Link& child = *link->child_links[c];
+        if (moves(*child.parent_joint) || subtree_moves(child)) {
+          if (next != nullptr) {
+            fail("link '" + link->name + "'",
+                 "the tree branches here (toward '" + next->name + "' and '" + child.name +
+                     "'); set ModelOptions.tip_link, and lock the other branch's joints");
+          }
+          next = &child;
+        }
+      }
+      if (next == nullptr) return link;
+      link = next;
+    }
+  }
+
+  // Depth-first walk of the base subtree: assigns each link to a body and a placement in it.
+  void visit(const urdf::Link& link, int body, const Eigen::Isometry3d& placement_in_body) {
+    add_link_inertia(link, body, placement_in_body);
+    model_.frames_.push_back(Frame{link.name, FrameType::kLink, body, placement_in_body});
+
+    for (std::size_t c = 0; c < link.child_links.size(); ++c) {
+      const urdf::Link& child = *link.child_links[c];
+      const urdf::Joint& joint = *child.parent_joint;
+      const std::string where = "joint '" + joint.name + "'";
+      if (!pose_is_finite(joint.parent_to_joint_origin_transform)) fail(where, "origin is not finite");
+      const Eigen::Isometry3d joint_in_body = placement_in_body * to_isometry(joint.parent_to_joint_origin_transform);
+      if (!moves(joint)) {
+        visit(child, body, joint_in_body);
+        continue;
+      }
+      if (!on_path_.count(child.name)) {
+        fail(where, "movable joint branches off the chain '" + model_.base_link_ + "' -> '" +
+                        model_.tip_link_ + "'; add it to ModelOptions.locked_joints or choose another tip_link");
+      }
+      if (body != static_cast<int>(model_.joints_.size()) - 1) {
+        fail(where, "internal error: chain bodies out of order");
+      }
+      model_.joints_.push_back(make_joint(joint, joint_in_body));
+      model_.bodies_.push_back(Inertia{});
+      visit(child, static_cast<int>(model_.joints_.size()) - 1, Eigen::Isometry3d::Identity());
+    }
+  }
+
+  Joint make_joint(const urdf::Joint& urdf_joint, const Eigen::Isometry3d& placement) const {
+    const std::string where = "joint '" + urdf_joint.name + "'";
+    Joint joint;
+    joint.name = urdf_joint.name;
+    joint.placement = placement;
+    switch (urdf_joint.type) {
+      case urdf::Joint::REVOLUTE: joint.type = JointType::kRevolute; break;
+      case urdf::Joint::CONTINUOUS: joint.type = JointType::kContinuous; break;
+      case urdf::Joint::PRISMATIC: joint.type = JointType::kPrismatic; break;
+      case urdf::Joint::FLOATING: fail(where, "floating joints are not supported in a serial arm");
+      case urdf::Joint::PLANAR: fail(where, "planar joints are not supported in a serial arm");
+      default: fail(where, "unknown joint type");
+    }
+    if (urdf_joint.mimic) fail(where, "mimic joints are not supported on the chain");
+    const Eigen::Vector3d axis(urdf_joint.axis.x, urdf_joint.axis.y, urdf_joint.axis.z);
+    if (!axis.allFinite() || axis.norm() < 1e-9) fail(where, "<axis> must be a finite non-zero vector");
+    joint.axis = axis.normalized();
+    if (const auto& limits = urdf_joint.limits) {
+      const double values[] = {limits->lower, limits->upper, limits->velocity, limits->effort};
+      for (double v : values) {
+        if (!finite(v)) fail(where + " <limit>", "values must be finite");
+      }
+      if (limits->velocity < 0.0) fail(where + " <limit>", "velocity must be >= 0 (got " + fmt(limits->velocity) + ")");
+      if (limits->effort < 0.0) fail(where + " <limit>", "effort must be >= 0 (got " + fmt(limits->effort) + ")");
+      // URDF uses 0 for "not given" in practice; the controller configuration can set limits.
+      if (limits->velocity > 0.0) joint.velocity_limit = limits->velocity;
+      if (limits->effort > 0.0) joint.effort_limit = limits->effort;
+      if (joint.type != JointType::kContinuous) {
+        if (limits->lower > limits->upper) {
+          fail(where + " <limit>", "lower " + fmt(limits->lower) + " > upper " + fmt(limits->upper));
+        }
+        if (limits->lower < limits->upper) {
+          joint.lower = limits->lower;
+          joint.upper = limits->upper;
+        }
+      }
+    } else if (joint.type != JointType::kContinuous) {
+      fail(where, "a revolute or prismatic joint needs a <limit>");
+    }
+    return joint;
+  }
+
+  void add_link_inertia(const urdf::Link& link, int body, const Eigen::Isometry3d& placement_in_body) {
+    if (!link.inertial) return;
+    const urdf::Inertial& in = *link.inertial;
+    const std::string where = "link '" + link.name + "' <inertial>";
+    const double values[] = {in.mass, in.ixx, in.ixy, in.ixz, in.iyy, in.iyz, in.izz};
+    for (double v : values) {
+      if (!finite(v)) fail(where, "values must be finite");
+    }
+    if (!pose_is_finite(in.origin)) fail(where, "origin is not finite");
+    Eigen::Matrix3d tensor;
+    tensor << in.ixx, in.ixy, in.ixz, in.ixy, in.iyy, in.iyz, in.ixz, in.iyz, in.izz;
+    if (in.mass < 0.0 || (in.mass == 0.0 && !tensor.isZero(0.0))) {
+      fail(where, "mass must be positive (got " + fmt(in.mass) + ")");
+    }
+    if (in.mass == 0.0) {
+      if (body >= 0 && on_path_.count(link.name) && link.parent_joint && moves(*link.parent_joint)) {
+        fail(where, "mass must be positive (got 0) on a link moved by a joint");
+      }
+      return;  // a massless frame link
+    }
+    check_inertia_tensor(tensor, where);
+    if (body < 0) return;  // fixed to the base: no effect on the dynamics
+    const Eigen::Isometry3d inertial_frame = placement_in_body * to_isometry(in.origin);
+    Inertia local;
+    local.mass = in.mass;
+    local.com = Eigen::Vector3d::Zero();
+    local.inertia_com = tensor;
+    Inertia& target = model_.bodies_[static_cast<std::size_t>(body)];
+    target = target.combined_with(local.transformed(inertial_frame));
+  }
+
+  void check_inertia_tensor(const Eigen::Matrix3d& tensor, const std::string& where) const {
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(tensor, Eigen::EigenvaluesOnly);
+    const Eigen::Vector3d ev = eig.eigenvalues();  // ascending
+    const double scale = std::max(ev.cwiseAbs().maxCoeff(), 1e-300);
+    if (ev[0] <= 1e-12 * scale) {
+      fail(where, "inertia tensor is not positive definite (principal moments " + fmt(ev[0]) + ", " +
+                      fmt(ev[1]) + ", " + fmt(ev[2]) + ")");
+    }
+    // A physical body also satisfies the triangle inequality I1 + I2 >= I3.
+    if (ev[0] + ev[1] < ev[2] * (1.0 - 1e-6)) {
+      fail(where, "inertia tensor violates the triangle inequality (principal moments " + fmt(ev[0]) +
+                      " + " + fmt(ev[1]) + " < " + fmt(ev[2]) + ")");
+    }
+  }
+
+  void check_body(int i) const {
+    const Inertia& body = model_.bodies_[static_cast<std::size_t>(i)];
+    const Joint& joint = model_.joints_[static_cast<std::size_t>(i)];
+    if (body.mass <= 0.0) {
+      fail("joint '" + joint.name + "'",
+           "moves no mass: its child link and the links fixed to it have no <inertial>");
+    }
+  }
+
+  void add_extra_frames() {
+    for (const ExtraFrame& extra : options_.extra_frames) {
+      const std::string where = "ModelOptions.extra_frames '" + extra.name + "'";
+      if (extra.name.empty()) fail("ModelOptions.extra_frames", "a frame needs a name");
+      if (model_.has_frame(extra.name)) fail(where, "a frame of that name already exists");
+      if (!model_.has_frame(extra.parent_frame)) fail(where, "unknown parent frame '" + extra.parent_frame + "'");
+      if (!extra.placement.matrix().allFinite()) fail(where, "placement must be finite");
+      const Frame& parent = model_.frame(model_.frame_id(extra.parent_frame));
+      model_.frames_.push_back(Frame{extra.name, FrameType::kExtra, parent.body, parent.placement * extra.placement});
+    }
+  }
+
+  void apply_armature() {
+    if (options_.armature.empty()) return;
+    if (static_cast<int>(options_.armature.size()) != model_.nq()) {
+      fail("ModelOptions.armature", "has " + std::to_string(options_.armature.size()) + " values for " +
+                                        std::to_string(model_.nq()) + " joints");
+    }
+    for (int i = 0; i < model_.nq(); ++i) {
+      const double a = options_.armature[static_cast<std::size_t>(i)];
+      if (!finite(a) || a < 0.0) fail("ModelOptions.armature", "values must be finite and >= 0");
+      model_.joints_[static_cast<std::size_t>(i)].armature = a;
+    }
+  }
+
+  const urdf::ModelInterface& urdf_;
+  const ModelOptions& options_;
+  std::string source_;
+  Model model_;
+  std::map<std::string, bool> on_path_;
+};
+
+// ---------------------------------------------------------------------------------- Model
+Model Model::from_urdf_string(const std::string& urdf, const ModelOptions& options,
+                              const std::string& source_name) {
+  urdf::ModelInterfaceSharedPtr parsed;
+  std::string messages;
+  {
+    std::lock_guard<std::mutex> lock(g_parse_mutex);
+    CapturingOutput capture;
+    console_bridge::useOutputHandler(&capture);
+    try {
+      parsed = urdf::parseURDF(urdf);
+    } catch (const std::exception& e) {
+      capture.messages += e.what();
+      parsed.reset();
+    }
+    console_bridge::restorePreviousOutputHandler();
+    messages = capture.messages;
+  }
+  if (!parsed) {
+    throw ConfigError(source_name, "", "not a valid URDF" + (messages.empty() ? std::string() : " (" + messages + ")"));
+  }
+  return UrdfModelBuilder(*parsed, options, source_name).build();
+}
+
+Model Model::from_urdf_file(const std::string& path, const ModelOptions& options) {
+  std::ifstream file(path);
+  if (!file) throw ConfigError(path, "", "cannot open the file");
+  std::stringstream contents;
+  contents << file.rdbuf();
+  return from_urdf_string(contents.str(), options, path);
+}
+
+int Model::frame_id(const std::string& name) const {
+  for (std::size_t f = 0; f < frames_.size(); ++f) {
+    if (frames_[f].name == name) return static_cast<int>(f);
+  }
+  throw ConfigError(name_, "frame '" + name + "'", "no such frame in the model");
+}
+
+bool Model::has_frame(const std::string& name) const {
+  return std::any_of(frames_.begin(), frames_.end(), [&](const Frame& f) { return f.name == name; });
+}
+
+int Model::joint_id(const std::string& name) const {
+  for (std::size_t j = 0; j < joints_.size(); ++j) {
+    if (joints_[j].name == name) return static_cast<int>(j);
+  }
+  throw ConfigError(name_, "joint '" + name + "'", "no such joint in the chain");
+}
+
+namespace {
+template <typename Getter>
+Eigen::VectorXd collect(const std::vector<Joint>& joints, Getter get) {
+  Eigen::VectorXd out(static_cast<Eigen::Index>(joints.size()));
+  for (std::size_t i = 0; i < joints.size(); ++i) out[static_cast<Eigen::Index>(i)] = get(joints[i]);
+  return out;
+}
+}  // namespace
+
+Eigen::VectorXd Model::lower_limits() const { return collect(joints_, [](const Joint& j) { return j.lower; }); }
+Eigen::VectorXd Model::upper_limits() const { return collect(joints_, [](const Joint& j) { return j.upper; }); }
+Eigen::VectorXd Model::velocity_limits() const { return collect(joints_, [](const Joint& j) { return j.velocity_limit; }); }
+Eigen::VectorXd Model::effort_limits() const { return collect(joints_, [](const Joint& j) { return j.effort_limit; }); }
+
+double Model::total_mass() const {
+  double m = 0.0;
+  for (const Inertia& b : bodies_) m += b.mass;
+  return m;
+}
+
+}  // namespace phri
