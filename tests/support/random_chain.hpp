@@ -77,9 +77,12 @@ inline RandomChain make_random_chain(int dof, std::mt19937& rng, double armature
         << "\"/><inertia ixx=\"" << num(t(0, 0)) << "\" ixy=\"" << num(t(0, 1)) << "\" ixz=\"" << num(t(0, 2))
         << "\" iyy=\"" << num(t(1, 1)) << "\" iyz=\"" << num(t(1, 2)) << "\" izz=\"" << num(t(2, 2))
         << "\"/></inertial>\n";
-      m << indent << "<inertial pos=\"" << vec3(com) << "\" mass=\"" << num(mass) << "\" fullinertia=\""
-        << num(t(0, 0)) << " " << num(t(1, 1)) << " " << num(t(2, 2)) << " " << num(t(0, 1)) << " "
-        << num(t(0, 2)) << " " << num(t(1, 2)) << "\"/>\n";
+      // MuJoCo gets the principal frame (MuJoCo's own fullinertia diagonalisation is only ~1e-10
+      // accurate, see tools/mjcf_principal_inertia.py); the URDF gets the full tensor.
+      const Eigen::Quaterniond qr(r);
+      m << indent << "<inertial pos=\"" << vec3(com) << "\" mass=\"" << num(mass) << "\" quat=\"" << num(qr.w())
+        << " " << num(qr.x()) << " " << num(qr.y()) << " " << num(qr.z()) << "\" diaginertia=\"" << vec3(moments)
+        << "\"/>\n";
     }
   };
 
