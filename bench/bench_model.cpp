@@ -1,0 +1,103 @@
+// Rigid-body algorithms on the Kinova Gen3 (7 DoF). Run:
+//   build/release/bench/phri_bench --benchmark_filter=Model --benchmark_repetitions=10 --benchmark_report_aggregates_only=true
+#include <phri/model/algorithms.hpp>
+#include <phri/model/model.hpp>
+
+#include <benchmark/benchmark.h>
+
+#include <random>
+
+namespace {
+
+struct Gen3 {
+  phri::Model model = phri::Model::from_urdf_file(std::string(PHRI_SOURCE_DIR) + "/robots/kinova_gen3/gen3.urdf");
+  phri::Data data{model};
+  Eigen::VectorXd q = Eigen::VectorXd::Zero(7), qd = Eigen::VectorXd::Zero(7), qdd = Eigen::VectorXd::Zero(7);
+  Eigen::MatrixXd jacobian = Eigen::MatrixXd::Zero(6, 7);
+  int ee = model.frame_id("end_effector_link");
+  Gen3() {
+    std::mt19937 rng(1);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    for (int i = 0; i < 7; ++i) {
+      q[i] = 2.0 * u(rng);
+      qd[i] = u(rng);
+      qdd[i] = 5.0 * u(rng);
+    }
+    phri::compute_all_terms(model, data, q, qd);
+  }
+};
+
+void ModelForwardKinematics(benchmark::State& state) {
+  Gen3 g;
+  for (auto _ : state) {
+    phri::forward_kinematics(g.model, g.data, g.q);
+    phri::update_frame_placements(g.model, g.data);
+    benchmark::DoNotOptimize(g.data.frame_placements.data());
+  }
+}
+BENCHMARK(ModelForwardKinematics);
+
+void ModelFrameJacobian(benchmark::State& state) {
+  Gen3 g;
+  for (auto _ : state) {
+    phri::frame_jacobian(g.model, g.data, g.ee, phri::ReferenceFrame::kLocalWorldAligned, g.jacobian);
+    benchmark::DoNotOptimize(g.jacobian.data());
+  }
+}
+BENCHMARK(ModelFrameJacobian);
+
+void ModelJdotQdot(benchmark::State& state) {
+  // Velocities and drift accelerations (forward pass with qdd = 0), then the frame's bias.
+  Gen3 g;
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(7);
+  for (auto _ : state) {
+    phri::forward_kinematics(g.model, g.data, g.q, g.qd, zero);
+    g.data.frame_placements[static_cast<std::size_t>(g.ee)] =
+        g.data.body_placements[static_cast<std::size_t>(g.model.frame(g.ee).body)] * g.model.frame(g.ee).placement;
+    benchmark::DoNotOptimize(phri::frame_jdot_qdot(g.model, g.data, g.ee, phri::ReferenceFrame::kLocalWorldAligned));
+  }
+}
+BENCHMARK(ModelJdotQdot);
+
+void ModelCrba(benchmark::State& state) {
+  Gen3 g;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(phri::crba(g.model, g.data, g.q).data());
+  }
+}
+BENCHMARK(ModelCrba);
+
+void ModelRnea(benchmark::State& state) {
+  Gen3 g;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(phri::rnea(g.model, g.data, g.q, g.qd, g.qdd).data());
+  }
+}
+BENCHMARK(ModelRnea);
+
+// What the controller needs each cycle: placements, velocities, M and its Cholesky factor, h,
+// and the end effector's Jacobian and J̇q̇.
+void ModelAllTogether(benchmark::State& state) {
+  Gen3 g;
+  for (auto _ : state) {
+    phri::compute_all_terms(g.model, g.data, g.q, g.qd);
+    phri::frame_jacobian(g.model, g.data, g.ee, phri::ReferenceFrame::kLocalWorldAligned, g.jacobian);
+    benchmark::DoNotOptimize(phri::frame_jdot_qdot(g.model, g.data, g.ee, phri::ReferenceFrame::kLocalWorldAligned));
+    benchmark::DoNotOptimize(g.jacobian.data());
+  }
+}
+BENCHMARK(ModelAllTogether);
+
+// The same plus a separate RNEA with a desired acceleration (the controller's tau_d).
+void ModelAllTogetherPlusRnea(benchmark::State& state) {
+  Gen3 g;
+  for (auto _ : state) {
+    phri::compute_all_terms(g.model, g.data, g.q, g.qd);
+    phri::frame_jacobian(g.model, g.data, g.ee, phri::ReferenceFrame::kLocalWorldAligned, g.jacobian);
+    benchmark::DoNotOptimize(phri::frame_jdot_qdot(g.model, g.data, g.ee, phri::ReferenceFrame::kLocalWorldAligned));
+    benchmark::DoNotOptimize(phri::rnea(g.model, g.data, g.q, g.qd, g.qdd).data());
+  }
+}
+BENCHMARK(ModelAllTogetherPlusRnea);
+
+}  // namespace

@@ -1,0 +1,463 @@
+// ctest-labels: unit
+// phri::Model / algorithms: finite differences, identities of the equations of motion, the Gen3
+// forward-kinematics check from Kinova's numbers, URDF validation errors, zero heap allocation.
+#include <phri/core/config_error.hpp>
+#include <phri/model/algorithms.hpp>
+#include <phri/model/model.hpp>
+
+#include "allocation_counter.hpp"
+#include "random_chain.hpp"
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <random>
+#include <sstream>
+
+namespace {
+
+using phri::ReferenceFrame;
+
+const std::string kGen3Urdf = std::string(PHRI_SOURCE_DIR) + "/robots/kinova_gen3/gen3.urdf";
+
+std::string read_file(const std::string& path) {
+  std::ifstream f(path);
+  std::stringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+Eigen::VectorXd random_vector(int n, double scale, std::mt19937& rng) {
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  Eigen::VectorXd v(n);
+  for (int i = 0; i < n; ++i) v[i] = scale * unit(rng);
+  return v;
+}
+
+// Angular velocity w from dR/dt = [w]x R, by central differences of R.
+Eigen::Vector3d angular_velocity_fd(const Eigen::Matrix3d& r_minus, const Eigen::Matrix3d& r_plus,
+                                    const Eigen::Matrix3d& r, double dt) {
+  const Eigen::Matrix3d w_hat = (r_plus - r_minus) / (2.0 * dt) * r.transpose();
+  return Eigen::Vector3d(w_hat(2, 1) - w_hat(1, 2), w_hat(0, 2) - w_hat(2, 0), w_hat(1, 0) - w_hat(0, 1)) / 2.0;
+}
+
+struct Robot {
+  phri::Model model;
+  std::string name;
+};
+
+std::vector<Robot> test_robots() {
+  std::vector<Robot> robots;
+  robots.push_back({phri::Model::from_urdf_file(kGen3Urdf), "gen3"});
+  std::mt19937 rng(7);
+  for (int dof : {6, 7, 7, 6, 3}) {
+    std::vector<double> armature;
+    const auto chain = phri::test::make_random_chain(dof, rng, 0.3, &armature);
+    phri::ModelOptions options;
+    options.armature = armature;
+    robots.push_back({phri::Model::from_urdf_string(chain.urdf, options), std::to_string(dof) + "-dof random"});
+  }
+  return robots;
+}
+
+class ModelFiniteDifferences : public ::testing::Test {
+protected:
+  std::vector<Robot> robots_ = test_robots();
+  std::mt19937 rng_{11};
+};
+
+TEST_F(ModelFiniteDifferences, JacobianTimesVelocityIsTheDerivativeOfFramePlacement) {
+  const double dt = 1e-6;
+  for (const auto& [model, name] : robots_) {
+    phri::Data data(model), data_minus(model), data_plus(model);
+    Eigen::MatrixXd jacobian(6, model.nv());
+    for (int sample = 0; sample < 20; ++sample) {
+      const Eigen::VectorXd q = random_vector(model.nq(), 3.0, rng_);
+      const Eigen::VectorXd qd = random_vector(model.nv(), 1.0, rng_);
+      phri::forward_kinematics(model, data, q, qd);
+      phri::update_frame_placements(model, data);
+      phri::forward_kinematics(model, data_minus, q - dt * qd);
+      phri::update_frame_placements(model, data_minus);
+      phri::forward_kinematics(model, data_plus, q + dt * qd);
+      phri::update_frame_placements(model, data_plus);
+      for (int f = 0; f < model.num_frames(); ++f) {
+        const auto& pose = data.frame_placements[static_cast<std::size_t>(f)];
+        const auto& minus = data_minus.frame_placements[static_cast<std::size_t>(f)];
+        const auto& plus = data_plus.frame_placements[static_cast<std::size_t>(f)];
+        phri::Vector6d expected;
+        expected << (plus.translation() - minus.translation()) / (2.0 * dt),
+            angular_velocity_fd(minus.linear(), plus.linear(), pose.linear(), dt);
+        phri::frame_jacobian(model, data, f, ReferenceFrame::kLocalWorldAligned, jacobian);
+        EXPECT_LT((jacobian * qd - expected).norm(), 1e-7 * (1.0 + expected.norm())) << name << " frame " << f;
+        EXPECT_LT((phri::frame_velocity(model, data, f, ReferenceFrame::kLocalWorldAligned) - expected).norm(),
+                  1e-7 * (1.0 + expected.norm()));
+        // The other conventions are the same velocity seen differently.
+        for (ReferenceFrame rf : {ReferenceFrame::kWorld, ReferenceFrame::kLocal}) {
+          phri::frame_jacobian(model, data, f, rf, jacobian);
+          EXPECT_LT((jacobian * qd - phri::frame_velocity(model, data, f, rf)).norm(), 1e-12 * (1.0 + expected.norm()));
+        }
+        phri::Vector6d local;
+        local << pose.linear().transpose() * expected.head<3>(), pose.linear().transpose() * expected.tail<3>();
+        EXPECT_LT((phri::frame_velocity(model, data, f, ReferenceFrame::kLocal) - local).norm(), 1e-7 * (1.0 + local.norm()));
+      }
+    }
+  }
+}
+
+TEST_F(ModelFiniteDifferences, JdotQdotIsTheDerivativeOfJacobianTimesVelocity) {
+  const double dt = 1e-6;
+  for (const auto& [model, name] : robots_) {
+    phri::Data data(model), data_minus(model), data_plus(model);
+    Eigen::MatrixXd j_minus(6, model.nv()), j_plus(6, model.nv());
+    for (int sample = 0; sample < 20; ++sample) {
+      const Eigen::VectorXd q = random_vector(model.nq(), 3.0, rng_);
+      const Eigen::VectorXd qd = random_vector(model.nv(), 1.5, rng_);
+      ASSERT_TRUE(phri::compute_all_terms(model, data, q, qd));
+      phri::forward_kinematics(model, data_minus, q - dt * qd);
+      phri::update_frame_placements(model, data_minus);
+      phri::forward_kinematics(model, data_plus, q + dt * qd);
+      phri::update_frame_placements(model, data_plus);
+      for (int f = 0; f < model.num_frames(); ++f) {
+        for (ReferenceFrame rf : {ReferenceFrame::kWorld, ReferenceFrame::kLocalWorldAligned, ReferenceFrame::kLocal}) {
+          phri::frame_jacobian(model, data_minus, f, rf, j_minus);
+          phri::frame_jacobian(model, data_plus, f, rf, j_plus);
+          const phri::Vector6d expected = (j_plus - j_minus) * qd / (2.0 * dt);
+          const phri::Vector6d jdot_qdot = phri::frame_jdot_qdot(model, data, f, rf);
+          EXPECT_LT((jdot_qdot - expected).norm(), 1e-6 * (1.0 + expected.norm()))
+              << name << " frame " << model.frame(f).name << " rf " << static_cast<int>(rf);
+        }
+      }
+    }
+  }
+}
+
+TEST_F(ModelFiniteDifferences, FrameAccelerationWithJointAccelerationIsJqddPlusJdotQdot) {
+  for (const auto& [model, name] : robots_) {
+    phri::Data data(model);
+    Eigen::MatrixXd jacobian(6, model.nv());
+    const Eigen::VectorXd q = random_vector(model.nq(), 3.0, rng_);
+    const Eigen::VectorXd qd = random_vector(model.nv(), 1.5, rng_);
+    const Eigen::VectorXd qdd = random_vector(model.nv(), 5.0, rng_);
+    phri::compute_all_terms(model, data, q, qd);
+    const int f = model.num_frames() - 1;
+    for (ReferenceFrame rf : {ReferenceFrame::kWorld, ReferenceFrame::kLocalWorldAligned, ReferenceFrame::kLocal}) {
+      const phri::Vector6d bias = phri::frame_jdot_qdot(model, data, f, rf);
+      phri::frame_jacobian(model, data, f, rf, jacobian);
+      phri::Data with_qdd(model);
+      phri::forward_kinematics(model, with_qdd, q, qd, qdd);
+      phri::update_frame_placements(model, with_qdd);
+      const phri::Vector6d expected = jacobian * qdd + bias;
+      EXPECT_LT((phri::frame_acceleration(model, with_qdd, f, rf) - expected).norm(), 1e-12 * (1.0 + expected.norm())) << name;
+    }
+  }
+}
+
+TEST_F(ModelFiniteDifferences, InverseDynamicsIsMassMatrixTimesAccelerationPlusNonlinearEffects) {
+  for (const auto& [model, name] : robots_) {
+    phri::Data data(model);
+    for (int sample = 0; sample < 50; ++sample) {
+      const Eigen::VectorXd q = random_vector(model.nq(), 3.0, rng_);
+      const Eigen::VectorXd qd = random_vector(model.nv(), 2.0, rng_);
+      const Eigen::VectorXd qdd = random_vector(model.nv(), 10.0, rng_);
+      const Eigen::MatrixXd mass = phri::crba(model, data, q);
+      EXPECT_LT((mass - mass.transpose()).norm(), 1e-15 * mass.norm());
+      const Eigen::VectorXd h = phri::nonlinear_effects(model, data, q, qd);
+      const Eigen::VectorXd tau = phri::rnea(model, data, q, qd, qdd);
+      EXPECT_LT((tau - (mass * qdd + h)).norm(), 1e-12 * (1.0 + tau.norm())) << name;
+      const Eigen::VectorXd zero = Eigen::VectorXd::Zero(model.nv());
+      const Eigen::VectorXd g = phri::compute_gravity(model, data, q);
+      EXPECT_LT((g - phri::rnea(model, data, q, zero, zero)).norm(), 1e-12 * (1.0 + g.norm()));
+      // M^-1 through the Cholesky factor.
+      ASSERT_TRUE(phri::compute_all_terms(model, data, q, qd));
+      Eigen::VectorXd x = tau;
+      phri::mass_matrix_solve_in_place(data, x);
+      EXPECT_LT((mass * x - tau).norm(), 1e-10 * (1.0 + tau.norm()));
+      EXPECT_LT((data.nonlinear_effects - h).norm(), 1e-12 * (1.0 + h.norm()));
+    }
+  }
+}
+
+// Lagrangian mechanics: with C from the Christoffel symbols of M (derivatives by finite
+// differences), C qd = h - g and dM/dt - 2C is skew-symmetric; so qd'(dM/dt)qd = 2 qd'(h - g),
+// the energy balance.
+TEST_F(ModelFiniteDifferences, ChristoffelCoriolisMatchesNonlinearEffectsAndMdotMinus2CIsSkew) {
+  const double eps = 1e-6;
+  for (const auto& [model, name] : robots_) {
+    const int n = model.nv();
+    phri::Data data(model);
+    for (int sample = 0; sample < 5; ++sample) {
+      const Eigen::VectorXd q = random_vector(n, 3.0, rng_);
+      const Eigen::VectorXd qd = random_vector(n, 2.0, rng_);
+      std::vector<Eigen::MatrixXd> dmass(static_cast<std::size_t>(n));  // dM/dq_k
+      for (int k = 0; k < n; ++k) {
+        Eigen::VectorXd qp = q, qm = q;
+        qp[k] += eps;
+        qm[k] -= eps;
+        const Eigen::MatrixXd mp = phri::crba(model, data, qp);
+        const Eigen::MatrixXd mm = phri::crba(model, data, qm);
+        dmass[static_cast<std::size_t>(k)] = (mp - mm) / (2.0 * eps);
+      }
+      Eigen::MatrixXd coriolis = Eigen::MatrixXd::Zero(n, n), mdot = Eigen::MatrixXd::Zero(n, n);
+      for (int k = 0; k < n; ++k) mdot += dmass[static_cast<std::size_t>(k)] * qd[k];
+      for (int i = 0; i < n; ++i) {
+        for (int j = 0; j < n; ++j) {
+          for (int k = 0; k < n; ++k) {
+            coriolis(i, j) += 0.5 * (dmass[static_cast<std::size_t>(k)](i, j) + dmass[static_cast<std::size_t>(j)](i, k) -
+                                     dmass[static_cast<std::size_t>(i)](j, k)) * qd[k];
+          }
+        }
+      }
+      const Eigen::VectorXd h = phri::nonlinear_effects(model, data, q, qd);
+      const Eigen::VectorXd g = phri::compute_gravity(model, data, q);
+      EXPECT_LT((coriolis * qd - (h - g)).norm(), 1e-6 * (1.0 + (h - g).norm())) << name;
+      const Eigen::MatrixXd n_matrix = mdot - 2.0 * coriolis;
+      EXPECT_LT((n_matrix + n_matrix.transpose()).norm(), 1e-6 * (1.0 + mdot.norm())) << name;
+      EXPECT_NEAR(qd.dot(mdot * qd), 2.0 * qd.dot(h - g), 1e-6 * (1.0 + std::abs(qd.dot(h - g)))) << name;
+    }
+  }
+}
+
+// ------------------------------------------------------------------- Kinova's own FK figures
+TEST(Gen3Model, ForwardKinematicsMatchesKinovaTable) {
+  const phri::Model model = phri::Model::from_urdf_file(kGen3Urdf);
+  EXPECT_EQ(model.nq(), 7);
+  EXPECT_NEAR(model.total_mass(), 8.0519 - 1.697, 1e-12);  // the base link does not move
+  phri::Data data(model);
+  const int ee = model.frame_id("end_effector_link");
+  const int tool = model.frame_id("tool_frame");
+  Eigen::VectorXd q = Eigen::VectorXd::Zero(7);
+  phri::forward_kinematics(model, data, q);
+  phri::update_frame_placements(model, data);
+  // kinova_gen3.md section e, computed from Kinova's xacro: q = 0 and the home posture.
+  EXPECT_LT((data.frame_placements[static_cast<std::size_t>(ee)].translation() - Eigen::Vector3d(0.0, -0.0248596, 1.1873848)).norm(), 1e-7);
+  q << 0, 0.2618, 3.1416, -2.2689, 0, 0.9599, 1.5708;
+  phri::forward_kinematics(model, data, q);
+  phri::update_frame_placements(model, data);
+  const auto& pose = data.frame_placements[static_cast<std::size_t>(ee)];
+  EXPECT_LT((pose.translation() - Eigen::Vector3d(0.4566726, 0.0013436, 0.4337285)).norm(), 1e-7);
+  const Eigen::Quaterniond quat(pose.linear());
+  EXPECT_LT(std::abs(std::abs(quat.coeffs().dot(Eigen::Vector4d(0.5000027, 0.4999991, 0.4999965, 0.5000017))) - 1.0), 1e-6);
+  EXPECT_TRUE(data.frame_placements[static_cast<std::size_t>(tool)].isApprox(pose, 1e-15));
+  // Limits as in the URDF.
+  EXPECT_FALSE(model.joint(0).has_position_limits());
+  EXPECT_DOUBLE_EQ(model.joint(1).upper, 2.24);
+  EXPECT_DOUBLE_EQ(model.joint(3).lower, -2.57);
+  EXPECT_DOUBLE_EQ(model.joint(4).velocity_limit, 1.2218);
+  EXPECT_DOUBLE_EQ(model.joint(0).effort_limit, 39.0);
+}
+
+TEST(Gen3Model, BasePlacementMovesEveryFrameAndGravityStaysInTheWorld) {
+  phri::ModelOptions options;
+  options.base_placement = Eigen::Isometry3d::Identity();
+  options.base_placement.linear() = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  options.base_placement.translation() << 0.1, 0.2, 0.3;
+  const phri::Model moved = phri::Model::from_urdf_file(kGen3Urdf, options);
+  const phri::Model upright = phri::Model::from_urdf_file(kGen3Urdf);
+  phri::Data dm(moved), du(upright);
+  Eigen::VectorXd q(7);
+  q << 0.1, 0.5, -0.3, 1.2, 0.4, -0.7, 0.9;
+  phri::forward_kinematics(moved, dm, q);
+  phri::update_frame_placements(moved, dm);
+  phri::forward_kinematics(upright, du, q);
+  phri::update_frame_placements(upright, du);
+  for (int f = 0; f < moved.num_frames(); ++f) {
+    EXPECT_TRUE(dm.frame_placements[static_cast<std::size_t>(f)].isApprox(
+        options.base_placement * du.frame_placements[static_cast<std::size_t>(f)], 1e-14));
+  }
+  // Arm mounted on a wall (base x axis up): same M, different gravity torques; with gravity
+  // rotated along, the same as upright.
+  EXPECT_TRUE(phri::crba(moved, dm, q).isApprox(phri::crba(upright, du, q), 1e-13));
+  options.gravity = options.base_placement.linear() * Eigen::Vector3d(0, 0, -9.81);
+  const phri::Model moved_gravity = phri::Model::from_urdf_file(kGen3Urdf, options);
+  phri::Data dg(moved_gravity);
+  EXPECT_TRUE(phri::compute_gravity(moved_gravity, dg, q).isApprox(phri::compute_gravity(upright, du, q), 1e-12));
+  EXPECT_FALSE(phri::compute_gravity(moved, dm, q).isApprox(phri::compute_gravity(upright, du, q), 1e-3));
+}
+
+TEST(ModelOptionsTest, ExtraFramesAreFixedToTheirParent) {
+  phri::ModelOptions options;
+  phri::ExtraFrame tcp;
+  tcp.name = "tcp";
+  tcp.parent_frame = "end_effector_link";
+  tcp.placement.translation() << 0.0, 0.0, 0.12;
+  options.extra_frames.push_back(tcp);
+  const phri::Model model = phri::Model::from_urdf_file(kGen3Urdf, options);
+  phri::Data data(model);
+  const Eigen::VectorXd q = Eigen::VectorXd::Constant(7, 0.3);
+  phri::forward_kinematics(model, data, q);
+  phri::update_frame_placements(model, data);
+  const auto& ee = data.frame_placements[static_cast<std::size_t>(model.frame_id("end_effector_link"))];
+  const auto& frame = data.frame_placements[static_cast<std::size_t>(model.frame_id("tcp"))];
+  EXPECT_TRUE(frame.isApprox(ee * tcp.placement, 1e-14));
+}
+
+TEST(ModelOptionsTest, LockedJointBehavesAsFixedAtZero) {
+  // A gripper-like branch: a movable joint off the chain is an error unless locked.
+  std::string urdf = read_file(kGen3Urdf);
+  const std::string finger =
+      "  <link name=\"finger\"><inertial><origin xyz=\"0 0 0.02\"/><mass value=\"0.1\"/>"
+      "<inertia ixx=\"1e-4\" ixy=\"0\" ixz=\"0\" iyy=\"1e-4\" iyz=\"0\" izz=\"1e-4\"/></inertial></link>\n"
+      "  <joint name=\"finger_joint\" type=\"prismatic\"><parent link=\"bracelet_link\"/><child link=\"finger\"/>"
+      "<origin xyz=\"0 0.03 -0.07\"/><axis xyz=\"0 1 0\"/><limit lower=\"0\" upper=\"0.04\" effort=\"10\" velocity=\"0.1\"/></joint>\n";
+  urdf.insert(urdf.rfind("</robot>"), finger);
+  phri::ModelOptions options;
+  options.tip_link = "end_effector_link";
+  try {
+    phri::Model::from_urdf_string(urdf, options);
+    FAIL() << "an unlocked branch must be refused";
+  } catch (const phri::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("finger_joint"), std::string::npos) << e.what();
+  }
+  options.locked_joints = {"finger_joint"};
+  const phri::Model locked = phri::Model::from_urdf_string(urdf, options);
+  EXPECT_EQ(locked.nq(), 7);
+  EXPECT_NEAR(locked.total_mass(), 8.0519 - 1.697 + 0.1, 1e-12);
+  // Same as the finger welded: the fixed-joint version of the same file.
+  std::string welded = urdf;
+  welded.replace(welded.find("type=\"prismatic\""), 16, "type=\"fixed\"");
+  const phri::Model fixed = phri::Model::from_urdf_string(welded, {});
+  phri::Data dl(locked), df(fixed);
+  const Eigen::VectorXd q = Eigen::VectorXd::Constant(7, -0.4);
+  EXPECT_TRUE(phri::crba(locked, dl, q).isApprox(phri::crba(fixed, df, q), 1e-14));
+}
+
+// ------------------------------------------------------------------- validation of bad input
+std::string gen3_with(const std::string& from, const std::string& to) {
+  std::string urdf = read_file(kGen3Urdf);
+  const std::size_t at = urdf.find(from);
+  if (at == std::string::npos) throw std::runtime_error("test setup: '" + from + "' not in gen3.urdf");
+  urdf.replace(at, from.size(), to);
+  return urdf;
+}
+
+// Loading must throw ConfigError whose message contains every string of `mentions`.
+void expect_config_error(const std::string& urdf, const std::vector<std::string>& mentions,
+                         const phri::ModelOptions& options = {}) {
+  try {
+    phri::Model::from_urdf_string(urdf, options, "bad.urdf");
+    ADD_FAILURE() << "no ConfigError; expected one mentioning " << mentions.front();
+  } catch (const phri::ConfigError& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(e.file(), "bad.urdf");
+    for (const auto& m : mentions) EXPECT_NE(what.find(m), std::string::npos) << "message: " << what;
+  }
+}
+
+TEST(ModelValidation, MalformedXmlNamesTheProblem) {
+  expect_config_error("<robot name=\"x\"><link name=\"a\"></robot>", {"not a valid URDF"});
+  expect_config_error("this is not xml at all", {"not a valid URDF"});
+  expect_config_error("", {"not a valid URDF"});
+  // A joint that names a missing link.
+  expect_config_error(gen3_with("<child link=\"forearm_link\"/>", "<child link=\"no_such_link\"/>"), {"not a valid URDF"});
+}
+
+TEST(ModelValidation, InertialProblemsNameTheLink) {
+  const std::string urdf = read_file(kGen3Urdf);
+  // Remove the inertial of a moving link.
+  const std::size_t link = urdf.find("<link name=\"half_arm_1_link\">");
+  ASSERT_NE(link, std::string::npos);
+  const std::size_t begin = urdf.find("<inertial>", link);
+  const std::size_t end = urdf.find("</inertial>", begin) + std::string("</inertial>").size();
+  std::string missing = urdf;
+  missing.erase(begin, end - begin);
+  expect_config_error(missing, {"joint_2", "no <inertial>"});
+
+  expect_config_error(gen3_with("<mass value=\"1.1636\"", "<mass value=\"-1.1636\""), {"half_arm_1_link", "mass must be positive"});
+  expect_config_error(gen3_with("<mass value=\"0.9302\"", "<mass value=\"0\""), {"forearm_link", "mass must be positive"});
+  expect_config_error(gen3_with("ixx=\"0.011088\"", "ixx=\"-0.011088\""), {"half_arm_1_link", "not positive definite"});
+  // Positive definite but not physical: I1 + I2 < I3.
+  expect_config_error(gen3_with("ixx=\"0.011088\"", "ixx=\"0.1\""), {"half_arm_1_link", "triangle inequality"});
+  expect_config_error(gen3_with("<mass value=\"1.1636\"", "<mass value=\"nan\""), {"half_arm_1_link"});
+}
+
+TEST(ModelValidation, JointProblemsNameTheJoint) {
+  expect_config_error(gen3_with("lower=\"-2.24\" upper=\"2.24\"", "lower=\"2.24\" upper=\"-2.24\""), {"joint_2", "lower"});
+  expect_config_error(gen3_with("<joint name=\"joint_3\" type=\"continuous\"", "<joint name=\"joint_3\" type=\"floating\""),
+                      {"joint_3", "floating"});
+  std::string urdf = read_file(kGen3Urdf);
+  const std::size_t j4 = urdf.find("<joint name=\"joint_4\"");
+  const std::size_t axis = urdf.find("<axis xyz=\"0 0 1\"", j4);
+  urdf.replace(axis, std::string("<axis xyz=\"0 0 1\"").size(), "<axis xyz=\"0 0 0\"");
+  expect_config_error(urdf, {"joint_4", "axis"});
+}
+
+TEST(ModelValidation, ChainProblems) {
+  const std::string urdf = read_file(kGen3Urdf);
+  phri::ModelOptions options;
+  options.tip_link = "no_such_link";
+  expect_config_error(urdf, {"tip_link", "no_such_link"}, options);
+  options = {};
+  options.base_link = "nope";
+  expect_config_error(urdf, {"base_link", "nope"}, options);
+  options = {};
+  options.base_link = "forearm_link";
+  options.tip_link = "shoulder_link";
+  expect_config_error(urdf, {"not below base"}, options);
+  options = {};
+  options.base_link = "end_effector_link";
+  expect_config_error(urdf, {"no movable joint"}, options);
+  options = {};
+  options.armature = {0.1, 0.2};
+  expect_config_error(urdf, {"armature", "7 joints"}, options);
+  options = {};
+  options.extra_frames.push_back({"tcp", "nowhere", Eigen::Isometry3d::Identity()});
+  expect_config_error(urdf, {"tcp", "nowhere"}, options);
+  // Two movable branches and no tip named.
+  std::string branched = urdf;
+  branched.insert(branched.rfind("</robot>"),
+                  "<link name=\"side\"><inertial><mass value=\"0.1\"/><inertia ixx=\"1e-4\" ixy=\"0\" ixz=\"0\" iyy=\"1e-4\" "
+                  "iyz=\"0\" izz=\"1e-4\"/></inertial></link><joint name=\"side_joint\" type=\"continuous\">"
+                  "<parent link=\"half_arm_2_link\"/><child link=\"side\"/><axis xyz=\"1 0 0\"/></joint>");
+  expect_config_error(branched, {"half_arm_2_link", "branches"});
+  options = {};
+  options.tip_link = "side";
+  expect_config_error(branched, {"joint_4", "locked_joints"}, options);
+  options.locked_joints = {"joint_4", "joint_5", "joint_6", "joint_7"};
+  EXPECT_EQ(phri::Model::from_urdf_string(branched, options).nq(), 4);
+  // Missing file.
+  try {
+    phri::Model::from_urdf_file("/nonexistent/robot.urdf");
+    ADD_FAILURE();
+  } catch (const phri::ConfigError& e) {
+    EXPECT_EQ(e.file(), "/nonexistent/robot.urdf");
+  }
+  const phri::Model model = phri::Model::from_urdf_string(urdf);
+  EXPECT_THROW(model.frame_id("unknown"), phri::ConfigError);
+  EXPECT_THROW(model.joint_id("unknown"), phri::ConfigError);
+}
+
+// ------------------------------------------------------------------- no heap allocation
+TEST(ModelAllocation, AlgorithmsDoNotAllocate) {
+  const phri::Model model = phri::Model::from_urdf_file(kGen3Urdf);
+  phri::Data data(model);
+  std::mt19937 rng(3);
+  const Eigen::VectorXd q = random_vector(7, 2.0, rng), qd = random_vector(7, 1.0, rng), qdd = random_vector(7, 5.0, rng);
+  Eigen::MatrixXd jacobian(6, 7);
+  Eigen::VectorXd x = Eigen::VectorXd::Ones(7);
+  const int ee = model.frame_id("end_effector_link");
+  phri::Vector6d sink = phri::Vector6d::Zero();
+  phri::test::AllocationCounter count;
+  {
+    phri::test::NoMallocScope no_malloc;
+    for (int repeat = 0; repeat < 3; ++repeat) {
+      phri::compute_all_terms(model, data, q, qd);
+      phri::frame_jacobian(model, data, ee, ReferenceFrame::kLocalWorldAligned, jacobian);
+      phri::frame_jacobian(model, data, ee, ReferenceFrame::kLocal, jacobian);
+      sink += phri::frame_jdot_qdot(model, data, ee, ReferenceFrame::kLocalWorldAligned);
+      sink += phri::frame_velocity(model, data, ee, ReferenceFrame::kLocal);
+      phri::mass_matrix_solve_in_place(data, x);
+      phri::crba(model, data, q);
+      phri::compute_mass_matrix_cholesky(data);
+      phri::rnea(model, data, q, qd, qdd);
+      phri::nonlinear_effects(model, data, q, qd);
+      phri::compute_gravity(model, data, q);
+      phri::forward_kinematics(model, data, q, qd, qdd);
+      phri::update_frame_placements(model, data);
+      sink += phri::frame_acceleration(model, data, ee, ReferenceFrame::kWorld);
+    }
+  }
+  EXPECT_EQ(count.allocations(), 0u);
+  EXPECT_TRUE(sink.allFinite());
+}
+
+}  // namespace
