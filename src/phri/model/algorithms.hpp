@@ -40,6 +40,16 @@ inline Vector6d frame_jdot_qdot(const Model& model, const Data& data, int frame_
 void frame_jacobian(const Model& model, const Data& data, int frame_id, ReferenceFrame rf,
                     Eigen::Ref<Eigen::MatrixXd> jacobian);
 
+/// 3 x nv linear Jacobian of the point of `body` (-1: the base) now at world position `point`:
+/// its velocity in world axes is jacobian * qd (after forward_kinematics).
+void body_point_linear_jacobian(const Model& model, const Data& data, int body, const Eigen::Vector3d& point,
+                                Eigen::Ref<Eigen::MatrixXd> jacobian);
+/// Velocity of that body point (after forward_kinematics with qd).
+Eigen::Vector3d body_point_velocity(const Model& model, const Data& data, int body, const Eigen::Vector3d& point);
+/// Classical acceleration of that body point with the accelerations in data; with qdd = 0 (after
+/// compute_all_terms) it is the point's J̇ q̇.
+Eigen::Vector3d body_point_jdot_qdot(const Model& model, const Data& data, int body, const Eigen::Vector3d& point);
+
 // ---- dynamics --------------------------------------------------------------------------
 /// Joint-space inertia matrix M(q) (composite rigid-body algorithm), into data.mass_matrix.
 const Eigen::MatrixXd& crba(const Model& model, Data& data, const Eigen::VectorXd& q);
