@@ -64,11 +64,16 @@ const Eigen::VectorXd& rnea(const Model& model, Data& data, const Eigen::VectorX
 /// h(q, qd) = C(q, qd) qd + g(q), into data.nonlinear_effects.
 const Eigen::VectorXd& nonlinear_effects(const Model& model, Data& data, const Eigen::VectorXd& q,
                                          const Eigen::VectorXd& qd);
-/// g(q), into data.gravity_torque.
+/// g(q), into data.gravity_torque (body velocities and accelerations in data are kept).
 const Eigen::VectorXd& compute_gravity(const Model& model, Data& data, const Eigen::VectorXd& q);
 
+/// C(q, qd)^T qd, which equals dT/dq (T the kinetic energy): the term the generalized-momentum
+/// observer needs, since dp/dt = tau + C^T qd - g for p = M qd. Uses the velocities and body
+/// inertias in data (after compute_all_terms or nonlinear_effects); writes data.coriolis_transpose_qd.
+const Eigen::VectorXd& coriolis_transpose_times_velocity(const Model& model, Data& data);
+
 /// One pass for the controller: placements of bodies and frames, velocities, drift accelerations
-/// (so frame_jdot_qdot works), M(q) and its Cholesky factor, h(q, qd). Returns false if M is
+/// (so frame_jdot_qdot works), M(q) and its Cholesky factor, h(q, qd), g(q). Returns false if M is
 /// not positive definite (which a valid model never gives).
 bool compute_all_terms(const Model& model, Data& data, const Eigen::VectorXd& q,
                        const Eigen::VectorXd& qd);
