@@ -635,6 +635,30 @@ TEST(QpSolver, IllConditionedHessian) {
             << worst.complementarity << "\n";
 }
 
+// Found by the random tests: after a step of ~1e11 along a nearly dependent normal, the active
+// row 1 drifted by 2e-9 and its parallel copy, row 2, looked violated with no way to enter.
+TEST(QpSolver, ParallelEqualityRowsAfterLongSteps) {
+  QpProblem p;
+  p.resize(3, 0, 4);
+  p.H << 1648301937.8725543, -3117171828.3207688, -614270635.10438871,  //
+      -3117171828.3207688, 5897082465.2622461, 1161158634.0490916,      //
+      -614270635.10438871, 1161158634.0490916, 229047192.35992178;
+  p.g << -9566855784.5464382, 23213318880.847328, -1427490321.8666673;
+  p.A << 2.3593383488663657, 1.4509423458378123, 0.023909919427844806,  //
+      0.29906776081359876, 0.99016352872371283, 2.4916684990632887,     //
+      0.30639003669083692, 1.0144063641974219, 2.5526736842933233,      //
+      -1.7577429676467424, 0.33699697937164419, 1.5095036671134838;
+  p.l << 2.6063273440042232, 5.2039226364559283, 5.3313337525330109, 1.2230310849598096;
+  p.u << 2.6063273440042232, 5.2039226364559283, 5.3313337525330109, 3.0514473610116752;
+  QpSolver s(3, 0, 4);
+  ASSERT_EQ(s.solve(p), QpStatus::kOptimal);
+  const Kkt r = kkt_residuals(p, s);
+  EXPECT_LE(r.primal, 1e-12);
+  EXPECT_LE(r.stationarity, 1e-7);
+  const double f_ref = brute_force_optimum(p);
+  EXPECT_NEAR(s.objective(), f_ref, 1e-8 * std::abs(f_ref));
+}
+
 // ------------------------------------------------------------------------------------ warm start
 
 std::vector<QpActiveSide> random_sides(Rng& rng, Index size) {

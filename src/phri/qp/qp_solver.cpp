@@ -288,10 +288,11 @@ QpStatus QpSolver::solve(const QpProblem& problem, const QpSolveOptions& options
 
   // Equalities skipped as dependent must hold at the point that satisfies the independent ones.
   bool consistent = !null_row_infeasible_;
+  const double base = 1.0 + x_.cwiseAbs().maxCoeff();
   for (Index k = 0; k < m_eq_ && consistent; ++k) {
     if (sign_[static_cast<std::size_t>(k)] != 0) continue;
     const double target = lower_(k);
-    consistent = std::abs(rows_.col(k).dot(x_) - target) <= settings_.feasibility_tolerance * (1.0 + std::abs(target));
+    consistent = std::abs(rows_.col(k).dot(x_) - target) <= settings_.feasibility_tolerance * (base + std::abs(target));
   }
 
   QpStatus status = QpStatus::kInfeasible;
@@ -300,7 +301,6 @@ QpStatus QpSolver::solve(const QpProblem& problem, const QpSolveOptions& options
                                    ? settings_.max_iterations
                                    : static_cast<int>(10 * (n_ + m_eq_ + m_in_) + 10);
     status = iterate(max_iterations);
-    if (status == QpStatus::kOptimal) polish_active_constraints();
   }
 
   publish();
@@ -399,9 +399,10 @@ void QpSolver::solve_working_set() {
 }
 
 void QpSolver::polish_active_constraints() {
-  // Each primal step moves x along directions orthogonal to the active normals only up to
-  // roundoff, so on ill-conditioned H the active constraints drift. The minimum H-norm
-  // correction dx = J1 R^-T (b - N'x) restores them exactly (N'J1 = R'); H dx is negligible.
+  // A primal step moves x orthogonally to the active normals only up to roundoff, and long
+  // steps (ill-conditioned H, nearly dependent normals) make the active constraints drift, enough
+  // to make a parallel copy of one look violated. The minimum H-norm correction
+  // dx = J1 R^-T (b - N'x) restores them (N'J1 = R'); H dx is negligible.
   const Index q = q_;
   for (Index i = 0; i < q; ++i) {
     const Index k = active_[static_cast<std::size_t>(i)];
@@ -418,7 +419,9 @@ double QpSolver::active_target(Index j) const {
 }
 
 bool QpSolver::most_violated(Index& best_k, int& best_sign) {
+  // Relative to |x| too: the roundoff of a'x grows with it.
   const double tol = settings_.feasibility_tolerance;
+  const double base = 1.0 + x_.cwiseAbs().maxCoeff();
   double best = 0.0;
   best_k = -1;
   if (m_in_ > 0) row_values_.noalias() = rows_.middleCols(m_eq_, m_in_).transpose() * x_;
@@ -427,13 +430,13 @@ bool QpSolver::most_violated(Index& best_k, int& best_sign) {
     if (sign_[static_cast<std::size_t>(k)] != 0) continue;
     const double v = row_values_(i);
     const double below = lower_(k) - v;
-    if (below > best && below > tol * (1.0 + std::abs(lower_(k)))) {
+    if (below > best && below > tol * (base + std::abs(lower_(k)))) {
       best = below;
       best_k = k;
       best_sign = +1;
     }
     const double above = v - upper_(k);
-    if (above > best && above > tol * (1.0 + std::abs(upper_(k)))) {
+    if (above > best && above > tol * (base + std::abs(upper_(k)))) {
       best = above;
       best_k = k;
       best_sign = -1;
@@ -444,13 +447,13 @@ bool QpSolver::most_violated(Index& best_k, int& best_sign) {
     if (sign_[static_cast<std::size_t>(k)] != 0) continue;
     const double v = x_(j);
     const double below = lower_(k) - v;
-    if (below > best && below > tol * (1.0 + std::abs(lower_(k)))) {
+    if (below > best && below > tol * (base + std::abs(lower_(k)))) {
       best = below;
       best_k = k;
       best_sign = +1;
     }
     const double above = v - upper_(k);
-    if (above > best && above > tol * (1.0 + std::abs(upper_(k)))) {
+    if (above > best && above > tol * (base + std::abs(upper_(k)))) {
       best = above;
       best_k = k;
       best_sign = -1;
@@ -514,6 +517,7 @@ QpStatus QpSolver::iterate(int max_iterations) {
       u_p += t;
       if (full_step) {
         add_constraint(p, sign, u_p);  // d_ is still J'n for the current J
+        polish_active_constraints();
         break;
       }
       drop_constraint(blocking);
