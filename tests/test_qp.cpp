@@ -125,7 +125,7 @@ Kkt kkt_residuals(const QpProblem& p, const QpSolver& s) {
   const VectorXd& y_eq = s.equality_multipliers();
   const VectorXd& y_row = s.row_multipliers();
   const VectorXd& y_b = s.bound_multipliers();
-  const MatrixXd h = p.H.selfadjointView<Eigen::Upper>();
+  const MatrixXd h = p.H.selfadjointView<Eigen::Lower>();
   const VectorXd hx = h * x;
   const VectorXd eq_term = p.A_eq.transpose() * y_eq;
   const VectorXd row_term = p.A.transpose() * y_row;
@@ -170,7 +170,7 @@ Kkt kkt_residuals(const QpProblem& p, const QpSolver& s) {
 }
 
 double objective(const QpProblem& p, const VectorXd& x) {
-  const MatrixXd h = p.H.selfadjointView<Eigen::Upper>();
+  const MatrixXd h = p.H.selfadjointView<Eigen::Lower>();
   return 0.5 * x.dot(h * x) + p.g.dot(x);
 }
 
@@ -218,7 +218,7 @@ double brute_force_optimum(const QpProblem& p, VectorXd* best_x = nullptr) {
   const Index n = p.g.size();
   const DenseRows d = dense_rows(p);
   const Index m = d.a.rows();
-  const MatrixXd h = p.H.selfadjointView<Eigen::Upper>();
+  const MatrixXd h = p.H.selfadjointView<Eigen::Lower>();
   std::vector<int> choice(static_cast<std::size_t>(m), 0);  // 0 inactive, 1 lower, 2 upper
   double best = kInf;
   const auto feasible = [&](const VectorXd& x) {
@@ -799,8 +799,8 @@ TEST(QpSolver, InvalidInputIsReported) {
   p.H(1, 2) = kInf;
   expect_invalid(p, QpInvalidReason::kNonFiniteHessian, 1, "Inf in H");
   p = good;
-  p.H(4, 0) = nan;  // the lower triangle is not used, but NaN anywhere is invalid
-  expect_invalid(p, QpInvalidReason::kNonFiniteHessian, 4, "NaN in lower H");
+  p.H(0, 4) = nan;  // the upper triangle is not used, but NaN anywhere is invalid
+  expect_invalid(p, QpInvalidReason::kNonFiniteHessian, 0, "NaN in upper H");
   p = good;
   p.H(2, 2) = -1.0;
   expect_invalid(p, QpInvalidReason::kHessianNotPositiveDefinite, 2, "indefinite H");

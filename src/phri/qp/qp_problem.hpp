@@ -3,7 +3,7 @@
 //
 //   minimize 1/2 x'Hx + g'x   s.t.   A_eq x = b_eq,   l <= A x <= u,   lb <= x <= ub
 //
-// with H symmetric positive definite (only its upper triangle is read). A side at or beyond
+// with H symmetric positive definite (only its lower triangle is read). A side at or beyond
 // +-QpSettings::infinity (1e20 by default), or an empty l, u, lb or ub, is absent.
 #include <Eigen/Core>
 

@@ -1,8 +1,8 @@
 // Goldfarb-Idnani dual active-set method. Notation of the paper: H = L L', the active normals N
 // (q columns), J = L^-T Q and R upper triangular with Q' L^-1 N = [R; 0]; J1 = first q columns of
 // J, J2 = the rest. For a constraint n'x >= b entering the active set, d = J'n, the primal step
-// direction is z = J2 d2 and the dual one r = R^-1 d1 (Section 3 of the paper). Here L' is stored
-// as the upper-triangular chol_, so the initial J is chol_^-1.
+// direction is z = J2 d2 and the dual one r = R^-1 d1 (Section 3 of the paper). L is chol_ and
+// the initial J = L^-T is inv_chol_, both computed once per factorisation.
 //
 // Each row is scaled to unit length once per solve, which makes the violation test a distance and
 // keeps R well balanced. A constraint k enters with sign +1 (normal a_k, active at its lower side)
@@ -16,22 +16,86 @@
 namespace phri {
 namespace {
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
+using Index = Eigen::Index;
 
-// v.head(q) <- R^-1 v.head(q) for the leading q x q block of upper-triangular r.
-void back_substitute(const Eigen::MatrixXd& r, Eigen::Index q, Eigen::VectorXd& v) {
-  for (Eigen::Index i = q - 1; i >= 0; --i) {
-    v(i) /= r(i, i);
-    v.head(i) -= v(i) * r.col(i).head(i);
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kMax = std::numeric_limits<double>::max();
+
+// Small dense kernels on raw columns. The sizes change at run time and are mostly tiny (the
+// controller's n = 7), where plain inlined loops beat the dispatch of Eigen's general products;
+// from kLargeRows rows on, Eigen's blocked matrix-vector products win.
+constexpr Index kLargeRows = 16;
+
+// Four partial sums: no loop-carried dependence on a single accumulator.
+[[gnu::always_inline]] inline double dot(const double* __restrict a, const double* __restrict b, Index n) {
+  double s0 = 0.0;
+  double s1 = 0.0;
+  double s2 = 0.0;
+  double s3 = 0.0;
+  Index i = 0;
+  for (; i + 4 <= n; i += 4) {
+    s0 += a[i] * b[i];
+    s1 += a[i + 1] * b[i + 1];
+    s2 += a[i + 2] * b[i + 2];
+    s3 += a[i + 3] * b[i + 3];
+  }
+  for (; i < n; ++i) s0 += a[i] * b[i];
+  return (s0 + s1) + (s2 + s3);
+}
+
+// y += alpha x
+[[gnu::always_inline]] inline void axpy(double alpha, const double* __restrict x, double* __restrict y, Index n) {
+  for (Index i = 0; i < n; ++i) y[i] += alpha * x[i];
+}
+
+using ConstColumns = Eigen::Map<const Eigen::MatrixXd, 0, Eigen::OuterStride<>>;
+
+// out[c] = M(:, c)' v, M with `rows` rows, `cols` columns, leading dimension ld.
+void columns_dot(const double* m, Index ld, Index rows, Index cols, const double* v, double* out) {
+  if (rows >= kLargeRows) {
+    Eigen::Map<Eigen::VectorXd>(out, cols).noalias() =
+        ConstColumns(m, rows, cols, Eigen::OuterStride<>(ld)).transpose() * Eigen::Map<const Eigen::VectorXd>(v, rows);
+    return;
+  }
+  for (Index c = 0; c < cols; ++c) out[c] = dot(m + c * ld, v, rows);
+}
+
+// y += M coef
+void columns_axpy(const double* m, Index ld, Index rows, Index cols, const double* coef, double* y) {
+  if (rows >= kLargeRows) {
+    Eigen::Map<Eigen::VectorXd>(y, rows).noalias() +=
+        ConstColumns(m, rows, cols, Eigen::OuterStride<>(ld)) * Eigen::Map<const Eigen::VectorXd>(coef, cols);
+    return;
+  }
+  for (Index c = 0; c < cols; ++c) axpy(coef[c], m + c * ld, y, rows);
+}
+
+bool all_finite(const double* p, Index n) {
+  bool ok = true;
+  for (Index i = 0; i < n; ++i) ok &= std::abs(p[i]) <= kMax;
+  return ok;
+}
+
+// v[0..q) <- R^-1 v[0..q), R the leading q x q block of an upper-triangular matrix (leading
+// dimension ld), column by column.
+void back_substitute(const double* r, Index ld, Index q, double* v) {
+  for (Index i = q - 1; i >= 0; --i) {
+    v[i] /= r[i + i * ld];
+    axpy(-v[i], r + i * ld, v, i);
   }
 }
 
-// Columns a <- c a + s b and b <- -s a + c b.
-void rotate_columns(Eigen::MatrixXd& m, Eigen::Index ia, Eigen::Index ib, double c, double s) {
+// y[0..q) <- R^-T b[0..q); y may alias b.
+void forward_substitute_transposed(const double* r, Index ld, Index q, const double* b, double* y) {
+  for (Index i = 0; i < q; ++i) y[i] = (b[i] - dot(r + i * ld, y, i)) / r[i + i * ld];
+}
+
+// Columns a <- c a + s b and b <- c b - s a.
+void rotate_columns(Eigen::MatrixXd& m, Index ia, Index ib, double c, double s) {
   double* __restrict a = m.col(ia).data();
   double* __restrict b = m.col(ib).data();
-  const Eigen::Index rows = m.rows();
-  for (Eigen::Index t = 0; t < rows; ++t) {
+  const Index rows = m.rows();
+  for (Index t = 0; t < rows; ++t) {
     const double va = a[t];
     const double vb = b[t];
     a[t] = c * va + s * vb;
@@ -40,8 +104,8 @@ void rotate_columns(Eigen::MatrixXd& m, Eigen::Index ia, Eigen::Index ib, double
 }
 
 template <typename Matrix>
-Eigen::Index first_non_finite_row(const Matrix& m) {
-  for (Eigen::Index i = 0; i < m.rows(); ++i) {
+Index first_non_finite_row(const Matrix& m) {
+  for (Index i = 0; i < m.rows(); ++i) {
     if (!m.row(i).allFinite()) return i;
   }
   return -1;
@@ -66,6 +130,7 @@ void QpSolver::resize(Index n, Index m_eq, Index m_in) {
 
   rows_.setZero(n_, m_rows_);
   row_scale_.setZero(m_rows_);
+  row_values_.setZero(m_in_);
   lower_.setZero(m_all);
   upper_.setZero(m_all);
   g_.setZero(n_);
@@ -80,7 +145,6 @@ void QpSolver::resize(Index n, Index m_eq, Index m_in) {
   d_.setZero(n_);
   dir_.setZero(n_);
   work_.setZero(n_);
-  row_values_.setZero(m_in_);
 
   status_ = QpStatus::kInvalidInput;
   invalid_reason_ = QpInvalidReason::kNone;
@@ -107,11 +171,11 @@ QpInvalidReason QpSolver::set_hessian_factor(const Eigen::Ref<const Eigen::Matri
   has_factor_ = false;
   if (n_ == 0 || factor_l.rows() != n_ || factor_l.cols() != n_) return QpInvalidReason::kDimensionMismatch;
   for (Index c = 0; c < n_; ++c) {
-    if (!factor_l.col(c).tail(n_ - c).allFinite() || !(factor_l(c, c) > 0.0)) {
+    if (!all_finite(factor_l.col(c).data() + c, n_ - c) || !(factor_l(c, c) > 0.0)) {
       return QpInvalidReason::kInvalidHessianFactor;
     }
   }
-  chol_.triangularView<Eigen::Upper>() = factor_l.transpose();
+  chol_.triangularView<Eigen::Lower>() = factor_l;
   invert_factor();
   has_factor_ = true;
   return QpInvalidReason::kNone;
@@ -120,27 +184,34 @@ QpInvalidReason QpSolver::set_hessian_factor(const Eigen::Ref<const Eigen::Matri
 QpInvalidReason QpSolver::factorize(const Eigen::Ref<const Eigen::MatrixXd>& h, Index& bad_index) {
   has_factor_ = false;
   const Index n = n_;
+  bool finite = true;
+  double max_diagonal = 0.0;
+  double* l = chol_.data();
   for (Index c = 0; c < n; ++c) {
-    if (!h.col(c).allFinite()) {
-      bad_index = first_non_finite_row(h);
-      return QpInvalidReason::kNonFiniteHessian;
-    }
+    const double* hc = h.col(c).data();
+    finite &= all_finite(hc, n);
+    max_diagonal = std::max(max_diagonal, std::abs(hc[c]));
+    for (Index i = c; i < n; ++i) l[i + c * n] = hc[i];
   }
-  // Up-looking Cholesky H = U'U on the upper triangle: every inner product runs down two
-  // contiguous columns. A pivot below n eps max|H_ii| means H is not (numerically) definite.
-  const double pivot_min =
-      static_cast<double>(n) * std::numeric_limits<double>::epsilon() * h.diagonal().cwiseAbs().maxCoeff();
-  for (Index j = 0; j < n; ++j) {
-    auto col = chol_.col(j);
-    for (Index i = 0; i < j; ++i) {
-      col(i) = (h(i, j) - chol_.col(i).head(i).dot(col.head(i))) / chol_(i, i);
-    }
-    const double pivot = h(j, j) - col.head(j).squaredNorm();
+  if (!finite) {
+    bad_index = first_non_finite_row(h);
+    return QpInvalidReason::kNonFiniteHessian;
+  }
+  // Right-looking Cholesky H = L L' on the lower triangle: each step scales a column and updates
+  // the trailing columns with contiguous axpys. A pivot below n eps max|H_ii| means H is not
+  // (numerically) positive definite.
+  const double pivot_min = static_cast<double>(n) * std::numeric_limits<double>::epsilon() * max_diagonal;
+  for (Index k = 0; k < n; ++k) {
+    double* lk = l + k * n;
+    const double pivot = lk[k];
     if (!(pivot > pivot_min)) {
-      bad_index = j;
+      bad_index = k;
       return QpInvalidReason::kHessianNotPositiveDefinite;
     }
-    col(j) = std::sqrt(pivot);
+    lk[k] = std::sqrt(pivot);
+    const double inv = 1.0 / lk[k];
+    for (Index i = k + 1; i < n; ++i) lk[i] *= inv;
+    for (Index j = k + 1; j < n; ++j) axpy(-lk[j], lk + j, l + j * n + j, n - j);
   }
   invert_factor();
   has_factor_ = true;
@@ -148,19 +219,46 @@ QpInvalidReason QpSolver::factorize(const Eigen::Ref<const Eigen::MatrixXd>& h, 
 }
 
 void QpSolver::invert_factor() {
-  // Column c of U^-1 by back substitution against e_c; the strict lower part stays zero.
-  for (Index c = 0; c < n_; ++c) {
-    auto col = inv_chol_.col(c);
-    col.head(c).setZero();
-    col(c) = 1.0;
-    for (Index k = c; k >= 0; --k) {
-      col(k) /= chol_(k, k);
-      col.head(k) -= col(k) * chol_.col(k).head(k);
+  // Column c of L^-1 by forward substitution against e_c, written transposed as row c of
+  // J = L^-T; the strict lower part of J stays zero.
+  const Index n = n_;
+  const double* l = chol_.data();
+  double* j = inv_chol_.data();
+  double* inv_diag = work_.data();
+  double* col = d_.data();
+  for (Index k = 0; k < n; ++k) inv_diag[k] = 1.0 / l[k + k * n];
+  for (Index c = 0; c < n; ++c) {
+    for (Index k = c; k < n; ++k) col[k] = 0.0;
+    col[c] = 1.0;
+    for (Index k = c; k < n; ++k) {
+      col[k] *= inv_diag[k];
+      axpy(-col[k], l + k * n + k + 1, col + k + 1, n - k - 1);
     }
+    for (Index k = c; k < n; ++k) j[c + k * n] = col[k];
   }
 }
 
 // ------------------------------------------------------------------------------------ input
+
+// Scales row k (a column of rows_) to unit length. Returns false when it holds NaN or Inf.
+bool QpSolver::normalize_row(Index k) {
+  double* a = rows_.col(k).data();
+  double squared = dot(a, a, n_);
+  if (!(squared >= std::numeric_limits<double>::min() && squared <= kMax)) {
+    // Rare: non-finite, zero, or so large or small that the squares leave the double range.
+    if (!all_finite(a, n_)) return false;
+    squared = rows_.col(k).stableNorm();
+    squared *= squared;
+  }
+  if (squared > 0.0 && std::isfinite(squared)) {
+    const double scale = 1.0 / std::sqrt(squared);
+    for (Index i = 0; i < n_; ++i) a[i] *= scale;
+    row_scale_(k) = scale;
+  } else {
+    row_scale_(k) = 0.0;  // an all-zero row (or one beyond 1e154 that cannot be scaled)
+  }
+  return true;
+}
 
 QpInvalidReason QpSolver::load(const QpProblem& p, bool reuse_factor) {
   const Index n = n_;
@@ -182,7 +280,7 @@ QpInvalidReason QpSolver::load(const QpProblem& p, bool reuse_factor) {
     return QpInvalidReason::kMissingHessianFactor;
   }
 
-  if (!p.g.allFinite()) {
+  if (!all_finite(p.g.data(), n)) {
     invalid_index_ = first_non_finite_row(p.g);
     return QpInvalidReason::kNonFiniteGradient;
   }
@@ -190,46 +288,34 @@ QpInvalidReason QpSolver::load(const QpProblem& p, bool reuse_factor) {
 
   const double big = settings_.infinity;
   const double tol = settings_.feasibility_tolerance;
-  constexpr double kTiny = std::numeric_limits<double>::min();
   null_row_infeasible_ = false;
 
   if (m_eq_ > 0) {
-    if (!p.A_eq.allFinite()) {
-      invalid_index_ = first_non_finite_row(p.A_eq);
-      return QpInvalidReason::kNonFiniteEqualityRows;
-    }
-    if (!p.b_eq.allFinite()) {
+    if (!all_finite(p.b_eq.data(), m_eq_)) {
       invalid_index_ = first_non_finite_row(p.b_eq);
       return QpInvalidReason::kNonFiniteEqualityTarget;
     }
     rows_.leftCols(m_eq_) = p.A_eq.transpose();
   }
   for (Index k = 0; k < m_eq_; ++k) {
-    const double norm = rows_.col(k).norm();
-    if (norm > kTiny) {
-      const double scale = 1.0 / norm;
-      rows_.col(k) *= scale;
-      row_scale_(k) = scale;
-      lower_(k) = upper_(k) = p.b_eq(k) * scale;
-    } else {
-      // 0 = b: skipped as linearly dependent, its consistency decided here.
-      row_scale_(k) = 0.0;
-      lower_(k) = upper_(k) = 0.0;
-      null_row_infeasible_ |= std::abs(p.b_eq(k)) > tol;
+    if (!normalize_row(k)) {
+      invalid_index_ = k;
+      return QpInvalidReason::kNonFiniteEqualityRows;
     }
+    // An all-zero row reads 0 = b: skipped as dependent, its consistency decided here.
+    lower_(k) = upper_(k) = p.b_eq(k) * row_scale_(k);
+    null_row_infeasible_ |= row_scale_(k) == 0.0 && std::abs(p.b_eq(k)) > tol;
   }
 
-  if (m_in_ > 0) {
-    if (!p.A.allFinite()) {
-      invalid_index_ = first_non_finite_row(p.A);
-      return QpInvalidReason::kNonFiniteInequalityRows;
-    }
-    rows_.middleCols(m_eq_, m_in_) = p.A.transpose();
-  }
+  if (m_in_ > 0) rows_.middleCols(m_eq_, m_in_) = p.A.transpose();
   const bool has_l = p.l.size() > 0;
   const bool has_u = p.u.size() > 0;
   for (Index i = 0; i < m_in_; ++i) {
     const Index k = m_eq_ + i;
+    if (!normalize_row(k)) {
+      invalid_index_ = i;
+      return QpInvalidReason::kNonFiniteInequalityRows;
+    }
     const double lo = has_l ? p.l(i) : -kInf;
     const double hi = has_u ? p.u(i) : kInf;
     if (std::isnan(lo) || std::isnan(hi) || lo == kInf || hi == -kInf) {
@@ -240,16 +326,12 @@ QpInvalidReason QpSolver::load(const QpProblem& p, bool reuse_factor) {
       invalid_index_ = i;
       return QpInvalidReason::kRowBoundsInverted;
     }
-    const double norm = rows_.col(k).norm();
-    if (norm > kTiny) {
-      const double scale = 1.0 / norm;
-      rows_.col(k) *= scale;
-      row_scale_(k) = scale;
+    const double scale = row_scale_(k);
+    if (scale > 0.0) {
       lower_(k) = lo <= -big ? -kInf : lo * scale;
       upper_(k) = hi >= big ? kInf : hi * scale;
     } else {
-      // l <= 0 <= u: never active.
-      row_scale_(k) = 0.0;
+      // An all-zero row: l <= 0 <= u or nothing, never active.
       lower_(k) = -kInf;
       upper_(k) = kInf;
       null_row_infeasible_ |= (lo > -big && lo > tol) || (hi < big && hi < -tol);
@@ -292,7 +374,8 @@ QpStatus QpSolver::solve(const QpProblem& problem, const QpSolveOptions& options
   for (Index k = 0; k < m_eq_ && consistent; ++k) {
     if (sign_[static_cast<std::size_t>(k)] != 0) continue;
     const double target = lower_(k);
-    consistent = std::abs(rows_.col(k).dot(x_) - target) <= settings_.feasibility_tolerance * (base + std::abs(target));
+    const double value = dot(rows_.col(k).data(), x_.data(), n_);
+    consistent = std::abs(value - target) <= settings_.feasibility_tolerance * (base + std::abs(target));
   }
 
   QpStatus status = QpStatus::kInfeasible;
@@ -304,7 +387,7 @@ QpStatus QpSolver::solve(const QpProblem& problem, const QpSolveOptions& options
   }
 
   publish();
-  if (!x_.allFinite() || !std::isfinite(objective_) || !y_eq_.allFinite() || !y_row_.allFinite() ||
+  if (!all_finite(x_.data(), n_) || !std::isfinite(objective_) || !y_eq_.allFinite() || !y_row_.allFinite() ||
       !y_bound_.allFinite()) {
     status = QpStatus::kNumericalError;
     x_.setZero();
@@ -378,9 +461,9 @@ void QpSolver::start_working_set(bool warm) {
 void QpSolver::add_warm_constraint(Index k, int sign) {
   if (q_ == n_) return;
   compute_normal_product(k, sign);
-  const double outside = d_.tail(n_ - q_).squaredNorm();
+  const double outside = dot(d_.data() + q_, d_.data() + q_, n_ - q_);
   const double tol = settings_.dependence_tolerance;
-  if (outside > tol * tol * d_.squaredNorm()) add_constraint(k, sign, 0.0);
+  if (outside > tol * tol * dot(d_.data(), d_.data(), n_)) add_constraint(k, sign, 0.0);
 }
 
 void QpSolver::solve_working_set() {
@@ -388,14 +471,17 @@ void QpSolver::solve_working_set() {
   // so y1 = R^-T b, y2 = -J2'g, and the multipliers solve R u = y1 + J1'g.
   const Index n = n_;
   const Index q = q_;
-  work_.noalias() = j_.transpose() * g_;
-  for (Index i = 0; i < q; ++i) {
-    dir_(i) = (active_target(i) - r_.col(i).head(i).dot(dir_.head(i))) / r_(i, i);
-  }
-  x_.noalias() = j_.leftCols(q) * dir_.head(q);
-  x_.noalias() -= j_.rightCols(n - q) * work_.tail(n - q);
-  u_.head(q) = dir_.head(q) + work_.head(q);
-  back_substitute(r_, q, u_);
+  const double* j = j_.data();
+  double* c = work_.data();
+  double* y = dir_.data();
+  columns_dot(j, n, n, n, g_.data(), c);
+  for (Index i = 0; i < q; ++i) y[i] = active_target(i);
+  forward_substitute_transposed(r_.data(), n, q, y, y);
+  for (Index i = q; i < n; ++i) y[i] = -c[i];
+  x_.setZero();
+  columns_axpy(j, n, n, n, y, x_.data());
+  for (Index i = 0; i < q; ++i) u_(i) = y[i] + c[i];
+  back_substitute(r_.data(), n, q, u_.data());
 }
 
 void QpSolver::polish_active_constraints() {
@@ -403,14 +489,16 @@ void QpSolver::polish_active_constraints() {
   // steps (ill-conditioned H, nearly dependent normals) make the active constraints drift, enough
   // to make a parallel copy of one look violated. The minimum H-norm correction
   // dx = J1 R^-T (b - N'x) restores them (N'J1 = R'); H dx is negligible.
+  const Index n = n_;
   const Index q = q_;
+  double* y = dir_.data();
   for (Index i = 0; i < q; ++i) {
     const Index k = active_[static_cast<std::size_t>(i)];
-    const double value = k < m_rows_ ? rows_.col(k).dot(x_) : x_(k - m_rows_);
-    const double residual = active_target(i) - sign_[static_cast<std::size_t>(k)] * value;
-    dir_(i) = (residual - r_.col(i).head(i).dot(dir_.head(i))) / r_(i, i);
+    const double value = k < m_rows_ ? dot(rows_.col(k).data(), x_.data(), n) : x_(k - m_rows_);
+    y[i] = active_target(i) - sign_[static_cast<std::size_t>(k)] * value;
   }
-  x_.noalias() += j_.leftCols(q) * dir_.head(q);
+  forward_substitute_transposed(r_.data(), n, q, y, y);
+  columns_axpy(j_.data(), n, n, q, y, x_.data());
 }
 
 double QpSolver::active_target(Index j) const {
@@ -424,40 +512,32 @@ bool QpSolver::most_violated(Index& best_k, int& best_sign) {
   const double base = 1.0 + x_.cwiseAbs().maxCoeff();
   double best = 0.0;
   best_k = -1;
-  if (m_in_ > 0) row_values_.noalias() = rows_.middleCols(m_eq_, m_in_).transpose() * x_;
-  for (Index i = 0; i < m_in_; ++i) {
-    const Index k = m_eq_ + i;
-    if (sign_[static_cast<std::size_t>(k)] != 0) continue;
-    const double v = row_values_(i);
-    const double below = lower_(k) - v;
+  const auto consider = [&](Index k, double value) {
+    const double below = lower_(k) - value;
     if (below > best && below > tol * (base + std::abs(lower_(k)))) {
       best = below;
       best_k = k;
       best_sign = +1;
     }
-    const double above = v - upper_(k);
+    const double above = value - upper_(k);
     if (above > best && above > tol * (base + std::abs(upper_(k)))) {
       best = above;
       best_k = k;
       best_sign = -1;
+    }
+  };
+  if (n_ >= kLargeRows) {
+    columns_dot(rows_.col(m_eq_).data(), n_, n_, m_in_, x_.data(), row_values_.data());
+    for (Index i = 0; i < m_in_; ++i) {
+      if (sign_[static_cast<std::size_t>(m_eq_ + i)] == 0) consider(m_eq_ + i, row_values_(i));
+    }
+  } else {
+    for (Index k = m_eq_; k < m_rows_; ++k) {
+      if (sign_[static_cast<std::size_t>(k)] == 0) consider(k, dot(rows_.col(k).data(), x_.data(), n_));
     }
   }
   for (Index j = 0; j < n_; ++j) {
-    const Index k = m_rows_ + j;
-    if (sign_[static_cast<std::size_t>(k)] != 0) continue;
-    const double v = x_(j);
-    const double below = lower_(k) - v;
-    if (below > best && below > tol * (base + std::abs(lower_(k)))) {
-      best = below;
-      best_k = k;
-      best_sign = +1;
-    }
-    const double above = v - upper_(k);
-    if (above > best && above > tol * (base + std::abs(upper_(k)))) {
-      best = above;
-      best_k = k;
-      best_sign = -1;
-    }
+    if (sign_[static_cast<std::size_t>(m_rows_ + j)] == 0) consider(m_rows_ + j, x_(j));
   }
   return best_k >= 0;
 }
@@ -465,6 +545,8 @@ bool QpSolver::most_violated(Index& best_k, int& best_sign) {
 QpStatus QpSolver::iterate(int max_iterations) {
   const Index n = n_;
   const double dependence2 = settings_.dependence_tolerance * settings_.dependence_tolerance;
+  double* d = d_.data();
+  double* r = dir_.data();
   while (true) {
     // Step 1: the most violated constraint p, or optimal.
     Index p = -1;
@@ -478,19 +560,21 @@ QpStatus QpSolver::iterate(int max_iterations) {
       if (iterations_ >= max_iterations) return QpStatus::kIterationLimit;
       const Index q = q_;
       compute_normal_product(p, sign);
-      const double outside = d_.tail(n - q).squaredNorm();  // = z'n, z = J2 d2
-      const bool primal_step = outside > dependence2 * d_.squaredNorm();
+      const double outside = dot(d + q, d + q, n - q);  // = z'n, z = J2 d2
+      const bool primal_step = outside > dependence2 * (outside + dot(d, d, q));
 
-      dir_.head(q) = d_.head(q);
-      back_substitute(r_, q, dir_);
       // t1: largest dual step keeping the inequality multipliers >= 0. Entries of r that are
       // roundoff next to the largest one do not block.
-      const double r_floor = q > 0 ? 1e-12 * dir_.head(q).cwiseAbs().maxCoeff() : 0.0;
+      for (Index j = 0; j < q; ++j) r[j] = d[j];
+      back_substitute(r_.data(), n, q, r);
+      double r_max = 0.0;
+      for (Index j = 0; j < q; ++j) r_max = std::max(r_max, std::abs(r[j]));
+      const double r_floor = 1e-12 * r_max;
       double t1 = kInf;
       Index blocking = -1;
       for (Index j = 0; j < q; ++j) {
-        if (active_[static_cast<std::size_t>(j)] < m_eq_ || !(dir_(j) > r_floor)) continue;
-        const double ratio = u_(j) / dir_(j);
+        if (active_[static_cast<std::size_t>(j)] < m_eq_ || !(r[j] > r_floor)) continue;
+        const double ratio = u_(j) / r[j];
         if (ratio < t1) {
           t1 = ratio;
           blocking = j;
@@ -508,10 +592,12 @@ QpStatus QpSolver::iterate(int max_iterations) {
           t = t2;
           full_step = true;
         }
-        x_.noalias() += j_.rightCols(n - q) * (t * d_.tail(n - q));
+        double* step = work_.data();
+        for (Index j = q; j < n; ++j) step[j] = t * d[j];
+        columns_axpy(j_.col(q).data(), n, n, n - q, step + q, x_.data());
       }
-      u_.head(q) -= t * dir_.head(q);
       for (Index j = 0; j < q; ++j) {
+        u_(j) -= t * r[j];
         if (active_[static_cast<std::size_t>(j)] >= m_eq_ && u_(j) < 0.0) u_(j) = 0.0;
       }
       u_p += t;
@@ -526,35 +612,54 @@ QpStatus QpSolver::iterate(int max_iterations) {
 }
 
 void QpSolver::compute_normal_product(Index k, int sign) {
+  const Index n = n_;
+  double* d = d_.data();
+  const double* j = j_.data();
   if (k < m_rows_) {
-    d_.noalias() = j_.transpose() * rows_.col(k);
-    if (sign < 0) d_ = -d_;
-  } else if (sign > 0) {
-    d_ = j_.row(k - m_rows_).transpose();  // a bound's normal is a unit vector
+    columns_dot(j, n, n, n, rows_.col(k).data(), d);
+    if (sign < 0) {
+      for (Index i = 0; i < n; ++i) d[i] = -d[i];
+    }
   } else {
-    d_ = -j_.row(k - m_rows_).transpose();
+    // A bound's normal is a unit vector: d is a row of J.
+    const Index b = k - m_rows_;
+    for (Index i = 0; i < n; ++i) d[i] = sign * j[b + i * n];
   }
 }
 
 double QpSolver::slack(Index k, int sign) const {
-  const double v = k < m_rows_ ? rows_.col(k).dot(x_) : x_(k - m_rows_);
+  const double v = k < m_rows_ ? dot(rows_.col(k).data(), x_.data(), n_) : x_(k - m_rows_);
   return sign > 0 ? v - lower_(k) : upper_(k) - v;
 }
 
 void QpSolver::add_constraint(Index k, int sign, double multiplier) {
   // Rotate d2 onto its first entry (bottom up), applying each rotation to J: the columns of J2
   // beyond q stay orthogonal to every active normal, and [d1; |d2|] becomes column q of R.
+  // The rotated values are the norms of the trailing parts of d, so all square roots are taken
+  // up front instead of one after the other along the chain of rotations.
+  const Index n = n_;
   const Index q = q_;
-  for (Index i = n_ - 1; i > q; --i) {
-    const double b = d_(i);
-    if (b == 0.0) continue;
-    const double a = d_(i - 1);
-    const double h = std::sqrt(a * a + b * b);
-    d_(i - 1) = h;
-    d_(i) = 0.0;
-    rotate_columns(j_, i - 1, i, a / h, b / h);
+  double* d = d_.data();
+  double* norms = work_.data();
+  double sum = 0.0;
+  for (Index i = n - 1; i >= q; --i) {
+    sum += d[i] * d[i];
+    norms[i] = sum;
   }
-  r_.col(q).head(q + 1) = d_.head(q + 1);
+  for (Index i = q; i < n; ++i) norms[i] = std::sqrt(norms[i]);
+  double current = n > q ? d[n - 1] : 0.0;  // value at position i after the rotations below it
+  for (Index i = n - 1; i > q; --i) {
+    if (current == 0.0) {
+      current = d[i - 1];
+      continue;
+    }
+    const double inv = 1.0 / norms[i - 1];
+    rotate_columns(j_, i - 1, i, d[i - 1] * inv, current * inv);
+    current = norms[i - 1];
+  }
+  double* r_col = r_.col(q).data();
+  for (Index i = 0; i < q; ++i) r_col[i] = d[i];
+  r_col[q] = current;
   active_[static_cast<std::size_t>(q)] = k;
   u_(q) = multiplier;
   sign_[static_cast<std::size_t>(k)] = static_cast<std::int8_t>(sign);
@@ -613,10 +718,13 @@ void QpSolver::publish() {
   for (Index j = 0; j < n_; ++j) {
     bound_sides_[static_cast<std::size_t>(j)] = side_of(sign_[static_cast<std::size_t>(m_rows_ + j)]);
   }
-  // 1/2 |U x|^2 + g'x with H = U'U.
-  work_.setZero();
-  for (Index c = 0; c < n_; ++c) work_.head(c + 1) += x_(c) * chol_.col(c).head(c + 1);
-  objective_ = 0.5 * work_.squaredNorm() + g_.dot(x_);
+  // 1/2 |L'x|^2 + g'x with H = L L'.
+  double half_xhx = 0.0;
+  for (Index c = 0; c < n_; ++c) {
+    const double w = dot(chol_.col(c).data() + c, x_.data() + c, n_ - c);
+    half_xhx += w * w;
+  }
+  objective_ = 0.5 * half_xhx + dot(g_.data(), x_.data(), n_);
 }
 
 bool QpSolver::set_active_set(std::span<const QpActiveSide> rows, std::span<const QpActiveSide> bounds) {

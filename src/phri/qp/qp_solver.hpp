@@ -61,11 +61,11 @@ public:
   QpSettings& settings() { return settings_; }
   const QpSettings& settings() const { return settings_; }
 
-  // Factorises H (upper triangle read) for later solves with reuse_hessian_factor.
+  // Factorises H (lower triangle read) for later solves with reuse_hessian_factor.
   // Returns kNone, or the failed check (kNonFiniteHessian, kHessianNotPositiveDefinite, ...).
   QpInvalidReason set_hessian(const Eigen::Ref<const Eigen::MatrixXd>& hessian);
   // Takes the caller's Cholesky factor: lower-triangular L with H = L L' (strict upper part not
-  // read), e.g. Eigen::LLT::matrixL(). Returns kNone, or kInvalidHessianFactor.
+  // read), e.g. Eigen::LLT<Eigen::MatrixXd>::matrixL(). Returns kNone, or kInvalidHessianFactor.
   QpInvalidReason set_hessian_factor(const Eigen::Ref<const Eigen::MatrixXd>& factor_l);
 
   // Replaces the active set the next warm start begins from (sizes m_in and n, else false and
@@ -94,6 +94,7 @@ public:
 
 private:
   QpInvalidReason load(const QpProblem& problem, bool reuse_factor);
+  bool normalize_row(Index k);
   QpInvalidReason factorize(const Eigen::Ref<const Eigen::MatrixXd>& hessian, Index& bad_index);
   void invert_factor();
   void start_working_set(bool warm);
@@ -116,7 +117,7 @@ private:
   Index m_in_ = 0;
   Index m_rows_ = 0;  // m_eq + m_in; constraint k: equality < m_eq <= row < m_rows <= bound
 
-  // Hessian factor: H = chol_' chol_ with chol_ upper; inv_chol_ = chol_^-1 is the initial J.
+  // Hessian factor: H = L L' with L = chol_ (lower); inv_chol_ = L^-T is the initial J.
   Eigen::MatrixXd chol_;
   Eigen::MatrixXd inv_chol_;
   bool has_factor_ = false;
@@ -139,7 +140,7 @@ private:
   Eigen::VectorXd d_;               // J' n for the constraint being added
   Eigen::VectorXd dir_;             // R^-1 d1: dual step direction
   Eigen::VectorXd work_;
-  Eigen::VectorXd row_values_;      // A x, scaled
+  Eigen::VectorXd row_values_;      // A x (scaled rows), for the large-n scan
 
   // Published results.
   QpStatus status_ = QpStatus::kInvalidInput;
