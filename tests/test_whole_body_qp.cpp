@@ -63,9 +63,12 @@ TEST_F(WholeBodyQpTest, UnconstrainedOptimumIsTheWeightedLeastSquaresSolution) {
   EXPECT_LT((qp.desired_acceleration() - expected).norm(), 1e-9 * (1.0 + expected.norm()));
   // tau_d = M qdd_d + h - tau_ext.
   EXPECT_LT((qp.desired_torque() - (data_.mass_matrix * expected + data_.nonlinear_effects)).norm(), 1e-8);
-  // The task reference is ë* - J̇ qd: K e + D (0 - v) - bias.
+  // The task reference is ë* - J̇ qd: K e + D (v_target - v) - bias, where the target jumped by a
+  // few cm, so the governor moves the tracked target toward it (first step: speed a dt).
   const phri::Vector6d bias = phri::frame_jdot_qdot(model_, data_, ee.frame_id(), phri::ReferenceFrame::kLocalWorldAligned);
-  EXPECT_LT((ee.reference() - (100.0 * ee.error() - 20.0 * ee.velocity() - bias)).norm(), 1e-12);
+  EXPECT_LT((ee.reference() - (100.0 * ee.error() + 20.0 * (ee.target_velocity() - ee.velocity()) - bias)).norm(), 1e-12);
+  EXPECT_NEAR(ee.target_velocity().head<3>().norm(), 0.5 * 1e-3, 1e-12);
+  EXPECT_FALSE(ee.target_reached());
 }
 
 TEST_F(WholeBodyQpTest, GammaOneLetsThePushThroughAndGammaZeroNegatesIt) {
@@ -183,6 +186,37 @@ TEST_F(WholeBodyQpTest, OneFullCycleDoesNotAllocate) {
   EXPECT_EQ(count.allocations(), 0u);
   EXPECT_EQ(compliance.touch_count(), 1);
   EXPECT_FALSE(compliance.touched());
+}
+
+TEST_F(WholeBodyQpTest, TargetGovernorReachesAJumpedTargetWithBoundedSpeedAndTracksStreams) {
+  phri::EndEffectorTask task(model_, model_.frame_id("end_effector_link"));
+  task.hold_current_pose(data_);
+  const Eigen::Isometry3d start = task.target_pose();
+  Eigen::Isometry3d goal = start;
+  goal.translation() += Eigen::Vector3d(0.1, 0.0, 0.0);
+  task.set_target(goal);
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(7);
+  double max_speed = 0.0, time = 0.0;
+  while (!task.target_reached() && time < 5.0) {
+    task.update(model_, data_, zero, 1e-3);
+    max_speed = std::max(max_speed, task.target_velocity().head<3>().norm());
+    time += 1e-3;
+  }
+  // Triangular profile at 0.5 m/s^2 over 0.1 m: 2 sqrt(d / a) = 0.894 s, peak 0.224 m/s.
+  EXPECT_NEAR(time, 2.0 * std::sqrt(0.1 / 0.5), 0.01);
+  EXPECT_LE(max_speed, 0.25);
+  EXPECT_LT((task.target_pose().translation() - goal.translation()).norm(), 1e-9);
+  // A streamed trajectory at 0.1 m/s is tracked as given, feed-forward included.
+  for (int k = 1; k <= 100; ++k) {
+    Eigen::Isometry3d point = goal;
+    point.translation().z() += 1e-4 * k;
+    phri::Vector6d velocity = phri::Vector6d::Zero();
+    velocity[2] = 0.1;
+    task.set_target(point, velocity);
+    task.update(model_, data_, zero, 1e-3);
+    EXPECT_LT((task.target_pose().translation() - point.translation()).norm(), 1e-12);
+    EXPECT_NEAR(task.target_velocity()[2], 0.1, 1e-12);
+  }
 }
 
 TEST(ComplianceControllerTest, SchmittTriggerAndValidation) {

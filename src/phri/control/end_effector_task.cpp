@@ -22,8 +22,10 @@ Eigen::Vector3d rotation_log(const Eigen::Matrix3d& r) {
   return angle * axis.normalized();
 }
 
-EndEffectorTask::EndEffectorTask(const Model& model, int frame_id, double smoothing_time_constant)
+EndEffectorTask::EndEffectorTask(const Model& model, int frame_id, double smoothing_time_constant,
+                                 const TargetLimits& limits)
     : frame_id_(frame_id),
+      limits_(limits),
       stiffness_(Eigen::VectorXd::Zero(6), smoothing_time_constant),
       damping_(Eigen::VectorXd::Zero(6), smoothing_time_constant),
       weight_(Eigen::VectorXd::Zero(1), smoothing_time_constant),
@@ -45,15 +47,74 @@ void EndEffectorTask::reset_gains(const Vector6d& stiffness, const Vector6d& dam
 }
 
 void EndEffectorTask::set_target(const Eigen::Isometry3d& pose, const Vector6d& velocity, const Vector6d& acceleration) {
-  target_pose_ = pose;
-  target_velocity_ = velocity;
-  target_acceleration_ = acceleration;
+  commanded_pose_ = pose;
+  commanded_velocity_ = velocity;
+  commanded_acceleration_ = acceleration;
 }
 
 void EndEffectorTask::hold_current_pose(const Data& data) {
-  target_pose_ = data.frame_placements[static_cast<std::size_t>(frame_id_)];
+  commanded_pose_ = data.frame_placements[static_cast<std::size_t>(frame_id_)];
+  commanded_velocity_.setZero();
+  commanded_acceleration_.setZero();
+  target_pose_ = commanded_pose_;
   target_velocity_.setZero();
   target_acceleration_.setZero();
+  tracking_position_ = tracking_rotation_ = true;
+  governor_linear_speed_ = governor_angular_speed_ = 0.0;
+}
+
+bool EndEffectorTask::target_reached() const {
+  return (commanded_pose_.translation() - target_pose_.translation()).norm() < 1e-9 &&
+         (commanded_pose_.linear() - target_pose_.linear()).cwiseAbs().maxCoeff() < 1e-9;
+}
+
+// A target that moves by about its own velocity per period is a trajectory: tracked as given.
+// Otherwise the tracked target runs toward it at bounded speed and acceleration, braking so as to
+// stop on it (speed <= sqrt(2 a d)), with its velocity as feed-forward: continuous references,
+// hence no torque step.
+void EndEffectorTask::govern_target(double dt) {
+  // Position.
+  const Eigen::Vector3d gap = commanded_pose_.translation() - target_pose_.translation();
+  const double distance = gap.norm();
+  const double streamed = 1.5 * dt * std::max(limits_.linear_speed, commanded_velocity_.head<3>().norm()) + 1e-9;
+  if (tracking_position_ && distance <= streamed) {
+    target_pose_.translation() = commanded_pose_.translation();
+    target_velocity_.head<3>() = commanded_velocity_.head<3>();
+    target_acceleration_.head<3>() = commanded_acceleration_.head<3>();
+    governor_linear_speed_ = commanded_velocity_.head<3>().norm();
+  } else {
+    tracking_position_ = false;
+    const double speed = std::min({governor_linear_speed_ + limits_.linear_acceleration * dt, limits_.linear_speed,
+                                   std::sqrt(2.0 * limits_.linear_acceleration * distance)});
+    const double step = std::min(speed * dt, distance);
+    const Eigen::Vector3d direction = distance > 0.0 ? Eigen::Vector3d(gap / distance) : Eigen::Vector3d::Zero();
+    target_pose_.translation() += direction * step;
+    target_velocity_.head<3>() = direction * speed;
+    target_acceleration_.head<3>().setZero();
+    governor_linear_speed_ = speed;
+    if (distance - step < 1e-7) tracking_position_ = true;
+  }
+  // Orientation: the same along the geodesic from the tracked to the set orientation.
+  const Eigen::Vector3d rotation = rotation_log(commanded_pose_.linear() * target_pose_.linear().transpose());
+  const double angle = rotation.norm();
+  const double streamed_angle = 1.5 * dt * std::max(limits_.angular_speed, commanded_velocity_.tail<3>().norm()) + 1e-9;
+  if (tracking_rotation_ && angle <= streamed_angle) {
+    target_pose_.linear() = commanded_pose_.linear();
+    target_velocity_.tail<3>() = commanded_velocity_.tail<3>();
+    target_acceleration_.tail<3>() = commanded_acceleration_.tail<3>();
+    governor_angular_speed_ = commanded_velocity_.tail<3>().norm();
+  } else {
+    tracking_rotation_ = false;
+    const double speed = std::min({governor_angular_speed_ + limits_.angular_acceleration * dt, limits_.angular_speed,
+                                   std::sqrt(2.0 * limits_.angular_acceleration * angle)});
+    const double step = std::min(speed * dt, angle);
+    const Eigen::Vector3d axis = angle > 0.0 ? Eigen::Vector3d(rotation / angle) : Eigen::Vector3d::UnitZ();
+    target_pose_.linear() = Eigen::AngleAxisd(step, axis).toRotationMatrix() * target_pose_.linear();
+    target_velocity_.tail<3>() = axis * speed;
+    target_acceleration_.tail<3>().setZero();
+    governor_angular_speed_ = speed;
+    if (angle - step < 1e-7) tracking_rotation_ = true;
+  }
 }
 
 void EndEffectorTask::update(const Model& model, const Data& data, const Eigen::VectorXd& qdd_external, double dt) {
@@ -61,6 +122,7 @@ void EndEffectorTask::update(const Model& model, const Data& data, const Eigen::
   damping_.step(dt);
   weight_.step(dt);
   gamma_.step(dt);
+  govern_target(dt);
   pose_ = data.frame_placements[static_cast<std::size_t>(frame_id_)];
   frame_jacobian(model, data, frame_id_, ReferenceFrame::kLocalWorldAligned, jacobian_);
   velocity_ = frame_velocity(model, data, frame_id_, ReferenceFrame::kLocalWorldAligned);
