@@ -70,10 +70,22 @@ void columns_axpy(const double* m, Index ld, Index rows, Index cols, const doubl
   for (Index c = 0; c < cols; ++c) axpy(coef[c], m + c * ld, y, rows);
 }
 
-bool all_finite(const double* p, Index n) {
-  bool ok = true;
-  for (Index i = 0; i < n; ++i) ok &= std::abs(p[i]) <= kMax;
-  return ok;
+// x * 0 is 0 for finite x and NaN otherwise, and a sum of zeros and NaNs is NaN in any order:
+// four partial sums let the compiler vectorise the check.
+[[gnu::always_inline]] inline bool all_finite(const double* p, Index n) {
+  double s0 = 0.0;
+  double s1 = 0.0;
+  double s2 = 0.0;
+  double s3 = 0.0;
+  Index i = 0;
+  for (; i + 4 <= n; i += 4) {
+    s0 += p[i] * 0.0;
+    s1 += p[i + 1] * 0.0;
+    s2 += p[i + 2] * 0.0;
+    s3 += p[i + 3] * 0.0;
+  }
+  for (; i < n; ++i) s0 += p[i] * 0.0;
+  return (s0 + s1) + (s2 + s3) == 0.0;
 }
 
 // v[0..q) <- R^-1 v[0..q), R the leading q x q block of an upper-triangular matrix (leading
@@ -113,6 +125,64 @@ Index first_non_finite_row(const Matrix& m) {
 
 QpActiveSide side_of(std::int8_t sign) {
   return sign > 0 ? QpActiveSide::kLower : (sign < 0 ? QpActiveSide::kUpper : QpActiveSide::kInactive);
+}
+
+// Cholesky factor L and J = L^-T of an n x n matrix, n <= kSmall: H is padded with the identity
+// to kSmall x kSmall (the padding factors to itself) so that the compile-time loop bounds let
+// the compiler unroll everything. It runs as L D L' (W = L D column by column), which leaves
+// one division per column on the critical path instead of a square root and a division; the
+// square roots of D are taken afterwards, all at once. Returns the first pivot at or below
+// pivot_min, or -1.
+constexpr Index kSmall = 8;
+
+Index factor_small(const double* h, Index ld, Index n, double pivot_min, double* l_out, double* j_out) {
+  constexpr int N = kSmall;
+  double w[N][N];  // w[column][row]
+  double inv_d[N];
+#pragma GCC unroll 8
+  for (int c = 0; c < N; ++c) {
+#pragma GCC unroll 8
+    for (int r = 0; r < N; ++r) w[c][r] = (c < n && r < n) ? h[r + c * ld] : (r == c ? 1.0 : 0.0);
+  }
+  // Column j: H(:, j) - sum_{k<j} L(j, k) W(:, k), L(j, k) = W(j, k) / D_k; rows above the
+  // diagonal are not needed and cleared.
+#pragma GCC unroll 8
+  for (int j = 0; j < N; ++j) {
+#pragma GCC unroll 8
+    for (int k = 0; k < j; ++k) {
+      const double f = w[k][j] * inv_d[k];
+#pragma GCC unroll 8
+      for (int r = 0; r < N; ++r) w[j][r] -= f * w[k][r];
+    }
+#pragma GCC unroll 8
+    for (int r = 0; r < j; ++r) w[j][r] = 0.0;
+    if (!(w[j][j] > pivot_min)) return j;
+    inv_d[j] = 1.0 / w[j][j];
+  }
+  double scale[N];  // D^-1/2
+#pragma GCC unroll 8
+  for (int k = 0; k < N; ++k) scale[k] = std::sqrt(inv_d[k]);
+  // Unit-diagonal part first, J~(:, k) = e_k - sum_{i<k} L~(k, i) J~(:, i) with L~ = W D^-1; then
+  // J = J~ D^-1/2 and L = W D^-1/2.
+  double b[N][N];
+#pragma GCC unroll 8
+  for (int k = 0; k < N; ++k) {
+#pragma GCC unroll 8
+    for (int r = 0; r < N; ++r) b[k][r] = r == k ? 1.0 : 0.0;
+#pragma GCC unroll 8
+    for (int i = 0; i < k; ++i) {
+      const double f = w[i][k] * inv_d[i];
+#pragma GCC unroll 8
+      for (int r = 0; r < N; ++r) b[k][r] -= f * b[i][r];
+    }
+  }
+  for (Index c = 0; c < n; ++c) {
+    for (Index r = 0; r < n; ++r) {
+      l_out[r + c * n] = w[c][r] * scale[c];
+      j_out[r + c * n] = b[c][r] * scale[c];
+    }
+  }
+  return -1;
 }
 
 }  // namespace
@@ -188,30 +258,37 @@ QpInvalidReason QpSolver::factorize(const Eigen::Ref<const Eigen::MatrixXd>& h, 
   double max_diagonal = 0.0;
   double* l = chol_.data();
   for (Index c = 0; c < n; ++c) {
-    const double* hc = h.col(c).data();
-    finite &= all_finite(hc, n);
-    max_diagonal = std::max(max_diagonal, std::abs(hc[c]));
-    for (Index i = c; i < n; ++i) l[i + c * n] = hc[i];
+    finite &= all_finite(h.col(c).data(), n);
+    max_diagonal = std::max(max_diagonal, std::abs(h(c, c)));
   }
   if (!finite) {
     bad_index = first_non_finite_row(h);
     return QpInvalidReason::kNonFiniteHessian;
   }
-  // Right-looking Cholesky H = L L' on the lower triangle: each step scales a column and updates
-  // the trailing columns with contiguous axpys. A pivot below n eps max|H_ii| means H is not
-  // (numerically) positive definite.
+  // Left-looking Cholesky H = L L' on the lower triangle: column j is H(j:n, j) minus
+  // L(j, k) L(j:n, k) for the columns k < j, then scaled. Each column is updated by axpys of one
+  // length (no store-to-load stalls on partly rewritten vectors). A pivot below n eps max|H_ii|
+  // means H is not (numerically) positive definite.
   const double pivot_min = static_cast<double>(n) * std::numeric_limits<double>::epsilon() * max_diagonal;
-  for (Index k = 0; k < n; ++k) {
-    double* lk = l + k * n;
-    const double pivot = lk[k];
+  if (n <= kSmall) {
+    bad_index = factor_small(h.data(), h.outerStride(), n, pivot_min, l, inv_chol_.data());
+    if (bad_index >= 0) return QpInvalidReason::kHessianNotPositiveDefinite;
+    has_factor_ = true;
+    return QpInvalidReason::kNone;
+  }
+  for (Index c = 0; c < n; ++c) {
+    for (Index i = c; i < n; ++i) l[i + c * n] = h(i, c);
+  }
+  for (Index j = 0; j < n; ++j) {
+    double* lj = l + j * n;
+    for (Index k = 0; k < j; ++k) axpy(-l[j + k * n], l + k * n + j, lj + j, n - j);
+    const double pivot = lj[j];
     if (!(pivot > pivot_min)) {
-      bad_index = k;
+      bad_index = j;
       return QpInvalidReason::kHessianNotPositiveDefinite;
     }
-    lk[k] = std::sqrt(pivot);
-    const double inv = 1.0 / lk[k];
-    for (Index i = k + 1; i < n; ++i) lk[i] *= inv;
-    for (Index j = k + 1; j < n; ++j) axpy(-lk[j], lk + j, l + j * n + j, n - j);
+    const double inv = 1.0 / std::sqrt(pivot);
+    for (Index i = j; i < n; ++i) lj[i] *= inv;
   }
   invert_factor();
   has_factor_ = true;
@@ -219,45 +296,50 @@ QpInvalidReason QpSolver::factorize(const Eigen::Ref<const Eigen::MatrixXd>& h, 
 }
 
 void QpSolver::invert_factor() {
-  // Column c of L^-1 by forward substitution against e_c, written transposed as row c of
-  // J = L^-T; the strict lower part of J stays zero.
+  // From L L^-1 = I, row k of L^-1, i.e. column k of J = L^-T, is
+  // (e_k - sum_{i<k} L(k, i) J(:, i)) / L(k, k). J is upper triangular, so every axpy may run over
+  // rows 0..k (one length per column, no store-to-load stalls); the strict lower part stays zero.
   const Index n = n_;
   const double* l = chol_.data();
   double* j = inv_chol_.data();
-  double* inv_diag = work_.data();
-  double* col = d_.data();
-  for (Index k = 0; k < n; ++k) inv_diag[k] = 1.0 / l[k + k * n];
-  for (Index c = 0; c < n; ++c) {
-    for (Index k = c; k < n; ++k) col[k] = 0.0;
-    col[c] = 1.0;
-    for (Index k = c; k < n; ++k) {
-      col[k] *= inv_diag[k];
-      axpy(-col[k], l + k * n + k + 1, col + k + 1, n - k - 1);
-    }
-    for (Index k = c; k < n; ++k) j[c + k * n] = col[k];
+  for (Index k = 0; k < n; ++k) {
+    double* col = j + k * n;
+    for (Index r = 0; r < k; ++r) col[r] = 0.0;
+    col[k] = 1.0;
+    for (Index i = 0; i < k; ++i) axpy(-l[k + i * n], j + i * n, col, k + 1);
+    const double inv = 1.0 / l[k + k * n];
+    for (Index r = 0; r <= k; ++r) col[r] *= inv;
   }
 }
 
 // ------------------------------------------------------------------------------------ input
 
-// Scales row k (a column of rows_) to unit length. Returns false when it holds NaN or Inf.
-bool QpSolver::normalize_row(Index k) {
-  double* a = rows_.col(k).data();
-  double squared = dot(a, a, n_);
-  if (!(squared >= std::numeric_limits<double>::min() && squared <= kMax)) {
-    // Rare: non-finite, zero, or so large or small that the squares leave the double range.
-    if (!all_finite(a, n_)) return false;
-    squared = rows_.col(k).stableNorm();
-    squared *= squared;
+// Scales every row (a column of rows_) to unit length; row_scale_ = 1 / |row|, 0 for an all-zero
+// row. Returns the first row holding NaN or Inf, or -1. The square roots and divisions go
+// through Eigen's vectorised array functions in one batch: one at a time their latency dominated.
+Index QpSolver::normalize_rows() {
+  const Index n = n_;
+  const Index m = m_rows_;
+  if (m == 0) return -1;
+  double* scale = row_scale_.data();
+  for (Index k = 0; k < m; ++k) {
+    const double* a = rows_.col(k).data();
+    scale[k] = dot(a, a, n);
   }
-  if (squared > 0.0 && std::isfinite(squared)) {
-    const double scale = 1.0 / std::sqrt(squared);
-    for (Index i = 0; i < n_; ++i) a[i] *= scale;
-    row_scale_(k) = scale;
-  } else {
-    row_scale_(k) = 0.0;  // an all-zero row (or one beyond 1e154 that cannot be scaled)
+  row_scale_ = row_scale_.array().sqrt().inverse();
+  const double min_scale = 1.0 / std::sqrt(kMax);
+  const double max_scale = 1.0 / std::sqrt(std::numeric_limits<double>::min());
+  for (Index k = 0; k < m; ++k) {
+    double* a = rows_.col(k).data();
+    if (!(scale[k] >= min_scale && scale[k] <= max_scale)) {
+      // Rare: non-finite, zero, or so large or small that the squares leave the double range.
+      if (!all_finite(a, n)) return k;
+      const double norm = rows_.col(k).stableNorm();
+      scale[k] = norm > 0.0 && norm <= kMax ? 1.0 / norm : 0.0;
+    }
+    for (Index i = 0; i < n; ++i) a[i] *= scale[k];
   }
-  return true;
+  return -1;
 }
 
 QpInvalidReason QpSolver::load(const QpProblem& p, bool reuse_factor) {
@@ -297,25 +379,22 @@ QpInvalidReason QpSolver::load(const QpProblem& p, bool reuse_factor) {
     }
     rows_.leftCols(m_eq_) = p.A_eq.transpose();
   }
+  if (m_in_ > 0) rows_.middleCols(m_eq_, m_in_) = p.A.transpose();
+  const Index bad_row = normalize_rows();
+  if (bad_row >= 0) {
+    invalid_index_ = bad_row < m_eq_ ? bad_row : bad_row - m_eq_;
+    return bad_row < m_eq_ ? QpInvalidReason::kNonFiniteEqualityRows : QpInvalidReason::kNonFiniteInequalityRows;
+  }
   for (Index k = 0; k < m_eq_; ++k) {
-    if (!normalize_row(k)) {
-      invalid_index_ = k;
-      return QpInvalidReason::kNonFiniteEqualityRows;
-    }
     // An all-zero row reads 0 = b: skipped as dependent, its consistency decided here.
     lower_(k) = upper_(k) = p.b_eq(k) * row_scale_(k);
     null_row_infeasible_ |= row_scale_(k) == 0.0 && std::abs(p.b_eq(k)) > tol;
   }
 
-  if (m_in_ > 0) rows_.middleCols(m_eq_, m_in_) = p.A.transpose();
   const bool has_l = p.l.size() > 0;
   const bool has_u = p.u.size() > 0;
   for (Index i = 0; i < m_in_; ++i) {
     const Index k = m_eq_ + i;
-    if (!normalize_row(k)) {
-      invalid_index_ = i;
-      return QpInvalidReason::kNonFiniteInequalityRows;
-    }
     const double lo = has_l ? p.l(i) : -kInf;
     const double hi = has_u ? p.u(i) : kInf;
     if (std::isnan(lo) || std::isnan(hi) || lo == kInf || hi == -kInf) {

@@ -94,7 +94,7 @@ public:
 
 private:
   QpInvalidReason load(const QpProblem& problem, bool reuse_factor);
-  bool normalize_row(Index k);
+  Index normalize_rows();
   QpInvalidReason factorize(const Eigen::Ref<const Eigen::MatrixXd>& hessian, Index& bad_index);
   void invert_factor();
   void start_working_set(bool warm);
