@@ -314,33 +314,88 @@ void QpSolver::invert_factor() {
 
 // ------------------------------------------------------------------------------------ input
 
-// Scales every row (a column of rows_) to unit length; row_scale_ = 1 / |row|, 0 for an all-zero
-// row. Returns the first row holding NaN or Inf, or -1. The square roots and divisions go
-// through Eigen's vectorised array functions in one batch: one at a time their latency dominated.
-Index QpSolver::normalize_rows() {
+// Copies the rows of `a` (m x n) into rows_ from column `first` on, scaled to unit length, with
+// row_scale_ = 1 / |row| (0 for an all-zero row). Returns the first row holding NaN or Inf, or -1.
+// The squared norms accumulate down the contiguous columns of `a` and the square roots and
+// divisions go through Eigen's vectorised array functions in one batch; one row at a time,
+// their latency dominated the whole load.
+Index QpSolver::load_rows(const Eigen::MatrixXd& a, Index first) {
   const Index n = n_;
-  const Index m = m_rows_;
+  const Index m = a.rows();
   if (m == 0) return -1;
-  double* scale = row_scale_.data();
-  for (Index k = 0; k < m; ++k) {
-    const double* a = rows_.col(k).data();
-    scale[k] = dot(a, a, n);
+  double* scale = row_scale_.data() + first;
+  for (Index i = 0; i < m; ++i) scale[i] = 0.0;
+  for (Index j = 0; j < n; ++j) {
+    const double* col = a.col(j).data();
+    for (Index i = 0; i < m; ++i) scale[i] += col[i] * col[i];
   }
-  row_scale_ = row_scale_.array().sqrt().inverse();
+  auto scales = row_scale_.segment(first, m).array();
+  scales = scales.sqrt().inverse();
   const double min_scale = 1.0 / std::sqrt(kMax);
   const double max_scale = 1.0 / std::sqrt(std::numeric_limits<double>::min());
-  for (Index k = 0; k < m; ++k) {
-    double* a = rows_.col(k).data();
-    if (!(scale[k] >= min_scale && scale[k] <= max_scale)) {
-      // Rare: non-finite, zero, or so large or small that the squares leave the double range.
-      if (!all_finite(a, n)) return k;
-      const double norm = rows_.col(k).stableNorm();
-      scale[k] = norm > 0.0 && norm <= kMax ? 1.0 / norm : 0.0;
+  bool in_range = true;
+  for (Index i = 0; i < m; ++i) in_range &= scale[i] >= min_scale && scale[i] <= max_scale;
+  if (!in_range) {
+    // Rare: non-finite, zero, or so large or small that the squares leave the double range.
+    for (Index i = 0; i < m; ++i) {
+      if (scale[i] >= min_scale && scale[i] <= max_scale) continue;
+      if (!a.row(i).allFinite()) return i;
+      const double norm = a.row(i).stableNorm();
+      scale[i] = norm > 0.0 && norm <= kMax ? 1.0 / norm : 0.0;
+      has_null_rows_ |= scale[i] == 0.0;
     }
-    for (Index i = 0; i < n; ++i) a[i] *= scale[k];
+  }
+  for (Index j = 0; j < n; ++j) {
+    const double* col = a.col(j).data();
+    double* dst = rows_.data() + j + first * n;
+    for (Index i = 0; i < m; ++i) dst[i * n] = col[i] * scale[i];
   }
   return -1;
 }
+
+namespace {
+
+// Checks l <= u (either may be empty, i.e. absent) and that neither is NaN, l = +inf or u = -inf.
+// One branch-free pass; the offending index is searched only on failure.
+Index check_sides(const Eigen::VectorXd& lo, const Eigen::VectorXd& hi, Index m, bool& inverted) {
+  const bool has_lo = lo.size() > 0;
+  const bool has_hi = hi.size() > 0;
+  bool bad = false;
+  if (has_lo && has_hi) {
+    for (Index i = 0; i < m; ++i) bad |= !(lo(i) <= hi(i)) | (lo(i) == kInf) | (hi(i) == -kInf);
+  } else if (has_lo) {
+    for (Index i = 0; i < m; ++i) bad |= !(lo(i) < kInf);
+  } else if (has_hi) {
+    for (Index i = 0; i < m; ++i) bad |= !(hi(i) > -kInf);
+  }
+  if (!bad) return -1;
+  for (Index i = 0; i < m; ++i) {
+    const double l = has_lo ? lo(i) : -kInf;
+    const double u = has_hi ? hi(i) : kInf;
+    inverted = false;
+    if (std::isnan(l) || std::isnan(u) || l == kInf || u == -kInf) return i;
+    inverted = true;
+    if (l > u) return i;
+  }
+  return -1;
+}
+
+// lower/upper in the scaled units, -inf/+inf for absent sides.
+void convert_sides(const Eigen::VectorXd& lo, const Eigen::VectorXd& hi, const double* scale, Index m, double big,
+                   double* lower, double* upper) {
+  if (lo.size() > 0) {
+    for (Index i = 0; i < m; ++i) lower[i] = lo(i) <= -big ? -kInf : lo(i) * scale[i];
+  } else {
+    for (Index i = 0; i < m; ++i) lower[i] = -kInf;
+  }
+  if (hi.size() > 0) {
+    for (Index i = 0; i < m; ++i) upper[i] = hi(i) >= big ? kInf : hi(i) * scale[i];
+  } else {
+    for (Index i = 0; i < m; ++i) upper[i] = kInf;
+  }
+}
+
+}  // namespace
 
 QpInvalidReason QpSolver::load(const QpProblem& p, bool reuse_factor) {
   const Index n = n_;
@@ -371,67 +426,51 @@ QpInvalidReason QpSolver::load(const QpProblem& p, bool reuse_factor) {
   const double big = settings_.infinity;
   const double tol = settings_.feasibility_tolerance;
   null_row_infeasible_ = false;
+  has_null_rows_ = false;
 
-  if (m_eq_ > 0) {
-    if (!all_finite(p.b_eq.data(), m_eq_)) {
-      invalid_index_ = first_non_finite_row(p.b_eq);
-      return QpInvalidReason::kNonFiniteEqualityTarget;
-    }
-    rows_.leftCols(m_eq_) = p.A_eq.transpose();
+  if (!all_finite(p.b_eq.data(), m_eq_)) {
+    invalid_index_ = first_non_finite_row(p.b_eq);
+    return QpInvalidReason::kNonFiniteEqualityTarget;
   }
-  if (m_in_ > 0) rows_.middleCols(m_eq_, m_in_) = p.A.transpose();
-  const Index bad_row = normalize_rows();
-  if (bad_row >= 0) {
-    invalid_index_ = bad_row < m_eq_ ? bad_row : bad_row - m_eq_;
-    return bad_row < m_eq_ ? QpInvalidReason::kNonFiniteEqualityRows : QpInvalidReason::kNonFiniteInequalityRows;
+  if ((invalid_index_ = load_rows(p.A_eq, 0)) >= 0) return QpInvalidReason::kNonFiniteEqualityRows;
+  if ((invalid_index_ = load_rows(p.A, m_eq_)) >= 0) return QpInvalidReason::kNonFiniteInequalityRows;
+
+  bool inverted = false;
+  if ((invalid_index_ = check_sides(p.l, p.u, m_in_, inverted)) >= 0) {
+    return inverted ? QpInvalidReason::kRowBoundsInverted : QpInvalidReason::kInvalidRowBound;
   }
-  for (Index k = 0; k < m_eq_; ++k) {
-    // An all-zero row reads 0 = b: skipped as dependent, its consistency decided here.
-    lower_(k) = upper_(k) = p.b_eq(k) * row_scale_(k);
-    null_row_infeasible_ |= row_scale_(k) == 0.0 && std::abs(p.b_eq(k)) > tol;
+  if ((invalid_index_ = check_sides(p.lb, p.ub, n, inverted)) >= 0) {
+    return inverted ? QpInvalidReason::kVariableBoundsInverted : QpInvalidReason::kInvalidVariableBound;
   }
 
-  const bool has_l = p.l.size() > 0;
-  const bool has_u = p.u.size() > 0;
-  for (Index i = 0; i < m_in_; ++i) {
-    const Index k = m_eq_ + i;
-    const double lo = has_l ? p.l(i) : -kInf;
-    const double hi = has_u ? p.u(i) : kInf;
-    if (std::isnan(lo) || std::isnan(hi) || lo == kInf || hi == -kInf) {
-      invalid_index_ = i;
-      return QpInvalidReason::kInvalidRowBound;
+  for (Index k = 0; k < m_eq_; ++k) lower_(k) = upper_(k) = p.b_eq(k) * row_scale_(k);
+  convert_sides(p.l, p.u, row_scale_.data() + m_eq_, m_in_, big, lower_.data() + m_eq_, upper_.data() + m_eq_);
+  if (p.lb.size() > 0) {
+    for (Index j = 0; j < n; ++j) lower_(m_rows_ + j) = p.lb(j) <= -big ? -kInf : p.lb(j);
+  } else {
+    lower_.tail(n).setConstant(-kInf);
+  }
+  if (p.ub.size() > 0) {
+    for (Index j = 0; j < n; ++j) upper_(m_rows_ + j) = p.ub(j) >= big ? kInf : p.ub(j);
+  } else {
+    upper_.tail(n).setConstant(kInf);
+  }
+
+  if (has_null_rows_) {
+    // An all-zero equality row reads 0 = b: skipped as dependent, its consistency decided here.
+    // An all-zero inequality row is l <= 0 <= u or nothing, and never active.
+    for (Index k = 0; k < m_eq_; ++k) {
+      null_row_infeasible_ |= row_scale_(k) == 0.0 && std::abs(p.b_eq(k)) > tol;
     }
-    if (lo > hi) {
-      invalid_index_ = i;
-      return QpInvalidReason::kRowBoundsInverted;
-    }
-    const double scale = row_scale_(k);
-    if (scale > 0.0) {
-      lower_(k) = lo <= -big ? -kInf : lo * scale;
-      upper_(k) = hi >= big ? kInf : hi * scale;
-    } else {
-      // An all-zero row: l <= 0 <= u or nothing, never active.
+    for (Index i = 0; i < m_in_; ++i) {
+      const Index k = m_eq_ + i;
+      if (row_scale_(k) != 0.0) continue;
+      const double lo = p.l.size() > 0 ? p.l(i) : -kInf;
+      const double hi = p.u.size() > 0 ? p.u(i) : kInf;
+      null_row_infeasible_ |= (lo > -big && lo > tol) || (hi < big && hi < -tol);
       lower_(k) = -kInf;
       upper_(k) = kInf;
-      null_row_infeasible_ |= (lo > -big && lo > tol) || (hi < big && hi < -tol);
     }
-  }
-
-  const bool has_lb = p.lb.size() > 0;
-  const bool has_ub = p.ub.size() > 0;
-  for (Index j = 0; j < n; ++j) {
-    const double lo = has_lb ? p.lb(j) : -kInf;
-    const double hi = has_ub ? p.ub(j) : kInf;
-    if (std::isnan(lo) || std::isnan(hi) || lo == kInf || hi == -kInf) {
-      invalid_index_ = j;
-      return QpInvalidReason::kInvalidVariableBound;
-    }
-    if (lo > hi) {
-      invalid_index_ = j;
-      return QpInvalidReason::kVariableBoundsInverted;
-    }
-    lower_(m_rows_ + j) = lo <= -big ? -kInf : lo;
-    upper_(m_rows_ + j) = hi >= big ? kInf : hi;
   }
   return QpInvalidReason::kNone;
 }

@@ -94,7 +94,7 @@ public:
 
 private:
   QpInvalidReason load(const QpProblem& problem, bool reuse_factor);
-  Index normalize_rows();
+  Index load_rows(const Eigen::MatrixXd& a, Index first);
   QpInvalidReason factorize(const Eigen::Ref<const Eigen::MatrixXd>& hessian, Index& bad_index);
   void invert_factor();
   void start_working_set(bool warm);
@@ -128,6 +128,7 @@ private:
   Eigen::VectorXd lower_;      // per constraint, in the scaled units; -inf when absent
   Eigen::VectorXd upper_;      // +inf when absent
   Eigen::VectorXd g_;
+  bool has_null_rows_ = false;
   bool null_row_infeasible_ = false;
 
   // Goldfarb-Idnani state: J = L^-T Q and R with Q' L^-1 N = [R; 0] for the q active normals N.
