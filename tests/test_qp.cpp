@@ -450,8 +450,8 @@ TEST(QpSolver, BoundsOnlyMatchClamp) {
 
 TEST(QpSolver, RedundantAndParallelConstraints) {
   Rng rng(4);
-  for (int t = 0; t < 200; ++t) {
-    const Index n = rng.integer(2, 6);
+  for (int t = 0; t < 200 / kScale; ++t) {
+    const Index n = rng.integer(2, 5);  // with up to 3 rows: at most 8 constraints to enumerate
     const Index m_base = rng.integer(1, 3);
     const QpProblem base = random_problem(rng, {n, 0, m_base}, 1.0, true, 10.0);
     // Each base row again, scaled (with scaled sides), and every bound again as a dense row.
@@ -601,10 +601,11 @@ TEST(QpSolver, IllConditionedHessian) {
   Rng rng(8);
   double worst_gap = 0.0;
   Kkt worst;
-  for (int t = 0; t < 400; ++t) {
+  for (int t = 0; t < 400 / kScale; ++t) {
     const Index n = rng.integer(2, 6);
-    const Index m_in = rng.integer(1, 5);
-    QpProblem p = random_problem(rng, {n, 0, m_in}, 8.0, rng.chance(0.5), 5.0);
+    const bool bounds = rng.chance(0.5) && n <= 4;  // at most 8 constraints to enumerate
+    const Index m_in = rng.integer(1, static_cast<int>(bounds ? 8 - n : 5));
+    QpProblem p = random_problem(rng, {n, 0, m_in}, 8.0, bounds, 5.0);
     const bool controller_like = t % 2 == 0;
     // Controller-like: the gradient pulls towards a target (g = -H x_t), as a weighted task does.
     // Otherwise a gradient of the size of H's largest eigenvalue in every direction, which puts

@@ -645,7 +645,7 @@ bool QpSolver::most_violated(Index& best_k, int& best_sign) {
     }
   };
   if (n_ >= kLargeRows) {
-    columns_dot(rows_.col(m_eq_).data(), n_, n_, m_in_, x_.data(), row_values_.data());
+    columns_dot(rows_.data() + m_eq_ * n_, n_, n_, m_in_, x_.data(), row_values_.data());
     for (Index i = 0; i < m_in_; ++i) {
       if (sign_[static_cast<std::size_t>(m_eq_ + i)] == 0) consider(m_eq_ + i, row_values_(i));
     }
@@ -712,7 +712,7 @@ QpStatus QpSolver::iterate(int max_iterations) {
         }
         double* step = work_.data();
         for (Index j = q; j < n; ++j) step[j] = t * d[j];
-        columns_axpy(j_.col(q).data(), n, n, n - q, step + q, x_.data());
+        columns_axpy(j_.data() + q * n, n, n, n - q, step + q, x_.data());
       }
       for (Index j = 0; j < q; ++j) {
         u_(j) -= t * r[j];
