@@ -399,6 +399,25 @@ TEST(QpSolver, NoConstraints) {
   }
 }
 
+// Tolerances are relative: scaling the whole objective changes nothing but the multipliers.
+TEST(QpSolver, ObjectiveScaleDoesNotMatter) {
+  Rng rng(16);
+  for (Index n : {3, 7, 12}) {
+    const QpProblem base = random_problem(rng, {n, 1, 2 * n}, 2.0, true, 10.0);
+    QpSolver reference = solver_for(base);
+    ASSERT_EQ(reference.solve(base), QpStatus::kOptimal);
+    for (double scale : {1e-20, 1e-8, 1e8, 1e20}) {
+      QpProblem p = base;
+      p.H *= scale;
+      p.g *= scale;
+      QpSolver s = solver_for(p);
+      ASSERT_EQ(s.solve(p), QpStatus::kOptimal) << n << " " << scale;
+      EXPECT_LE((s.x() - reference.x()).norm(), 1e-9 * (1.0 + reference.x().norm())) << n << " " << scale;
+      expect_kkt(p, s, 1e-9, "scaled objective");
+    }
+  }
+}
+
 TEST(QpSolver, EqualityOnly) {
   Rng rng(2);
   for (Index n : {1, 3, 7, 20}) {

@@ -156,7 +156,7 @@ Index factor_small(const double* h, Index ld, Index n, double pivot_min, double*
     }
 #pragma GCC unroll 8
     for (int r = 0; r < j; ++r) w[j][r] = 0.0;
-    if (!(w[j][j] > pivot_min)) return j;
+    if (j < n && !(w[j][j] > pivot_min)) return j;  // the padding's unit pivots are not H's
     inv_d[j] = 1.0 / w[j][j];
   }
   double scale[N];  // D^-1/2
@@ -265,10 +265,7 @@ QpInvalidReason QpSolver::factorize(const Eigen::Ref<const Eigen::MatrixXd>& h, 
     bad_index = first_non_finite_row(h);
     return QpInvalidReason::kNonFiniteHessian;
   }
-  // Left-looking Cholesky H = L L' on the lower triangle: column j is H(j:n, j) minus
-  // L(j, k) L(j:n, k) for the columns k < j, then scaled. Each column is updated by axpys of one
-  // length (no store-to-load stalls on partly rewritten vectors). A pivot below n eps max|H_ii|
-  // means H is not (numerically) positive definite.
+  // A pivot below n eps max|H_ii| means H is not (numerically) positive definite.
   const double pivot_min = static_cast<double>(n) * std::numeric_limits<double>::epsilon() * max_diagonal;
   if (n <= kSmall) {
     bad_index = factor_small(h.data(), h.outerStride(), n, pivot_min, l, inv_chol_.data());
@@ -276,6 +273,9 @@ QpInvalidReason QpSolver::factorize(const Eigen::Ref<const Eigen::MatrixXd>& h, 
     has_factor_ = true;
     return QpInvalidReason::kNone;
   }
+  // Left-looking Cholesky H = L L' on the lower triangle: column j is H(j:n, j) minus
+  // L(j, k) L(j:n, k) for the columns k < j, then scaled. Each column is updated by axpys of one
+  // length (no store-to-load stalls on partly rewritten vectors).
   for (Index c = 0; c < n; ++c) {
     for (Index i = c; i < n; ++i) l[i + c * n] = h(i, c);
   }

@@ -56,7 +56,7 @@ public:
 
   Index num_variables() const { return n_; }
   Index num_equalities() const { return m_eq_; }
-  Index num_rows() const { return m_in_; }
+  Index num_inequalities() const { return m_in_; }
 
   QpSettings& settings() { return settings_; }
   const QpSettings& settings() const { return settings_; }
