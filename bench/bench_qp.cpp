@@ -196,3 +196,17 @@ void BM_QpRandom30x60Warm(benchmark::State& state) {
 BENCHMARK(BM_QpRandom30x60Warm);
 
 }  // namespace
+
+namespace {
+
+// The part of every solve that depends on H only: Cholesky factor and J = L^-T.
+void BM_QpControllerFactorize(benchmark::State& state) {
+  const ControllerQp c = make_controller_qp();
+  phri::QpSolver solver(7, 0, 17);
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(solver.set_hessian(c.problem.H));
+  }
+}
+BENCHMARK(BM_QpControllerFactorize);
+
+}  // namespace

@@ -12,11 +12,40 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
+#include <cstdlib>
 #include <iostream>
 #include <limits>
 #include <random>
 #include <string>
 #include <vector>
+
+// Eigen allocates with std::malloc, which the operator-new counter of tests/support does not see,
+// and EIGEN_RUNTIME_NO_MALLOC applies to the test code only, not to the Eigen code compiled into
+// libphri. So this program also interposes malloc, calloc and realloc (forwarding to glibc) and
+// counts them, to catch heap use anywhere in a solve. Not under AddressSanitizer, which owns
+// malloc.
+#if defined(__GLIBC__) && !defined(__SANITIZE_ADDRESS__)
+#define PHRI_TEST_COUNTS_MALLOC 1
+extern "C" void* __libc_malloc(std::size_t size);
+extern "C" void* __libc_calloc(std::size_t count, std::size_t size);
+extern "C" void* __libc_realloc(void* pointer, std::size_t size);
+namespace {
+std::size_t g_malloc_calls = 0;  // the tests run on one thread
+}  // namespace
+extern "C" void* malloc(std::size_t size) noexcept {
+  ++g_malloc_calls;
+  return __libc_malloc(size);
+}
+extern "C" void* calloc(std::size_t count, std::size_t size) noexcept {
+  ++g_malloc_calls;
+  return __libc_calloc(count, size);
+}
+extern "C" void* realloc(void* pointer, std::size_t size) noexcept {
+  ++g_malloc_calls;
+  return __libc_realloc(pointer, size);
+}
+#endif
 
 namespace phri {
 namespace {
@@ -399,6 +428,25 @@ TEST(QpSolver, NoConstraints) {
   }
 }
 
+// Tolerances are relative: scaling the whole objective changes nothing but the multipliers.
+TEST(QpSolver, ObjectiveScaleDoesNotMatter) {
+  Rng rng(16);
+  for (Index n : {3, 7, 12}) {
+    const QpProblem base = random_problem(rng, {n, 1, 2 * n}, 2.0, true, 10.0);
+    QpSolver reference = solver_for(base);
+    ASSERT_EQ(reference.solve(base), QpStatus::kOptimal);
+    for (double scale : {1e-20, 1e-8, 1e8, 1e20}) {
+      QpProblem p = base;
+      p.H *= scale;
+      p.g *= scale;
+      QpSolver s = solver_for(p);
+      ASSERT_EQ(s.solve(p), QpStatus::kOptimal) << n << " " << scale;
+      EXPECT_LE((s.x() - reference.x()).norm(), 1e-9 * (1.0 + reference.x().norm())) << n << " " << scale;
+      expect_kkt(p, s, 1e-9, "scaled objective");
+    }
+  }
+}
+
 TEST(QpSolver, EqualityOnly) {
   Rng rng(2);
   for (Index n : {1, 3, 7, 20}) {
@@ -450,8 +498,8 @@ TEST(QpSolver, BoundsOnlyMatchClamp) {
 
 TEST(QpSolver, RedundantAndParallelConstraints) {
   Rng rng(4);
-  for (int t = 0; t < 200; ++t) {
-    const Index n = rng.integer(2, 6);
+  for (int t = 0; t < 200 / kScale; ++t) {
+    const Index n = rng.integer(2, 5);  // with up to 3 rows: at most 8 constraints to enumerate
     const Index m_base = rng.integer(1, 3);
     const QpProblem base = random_problem(rng, {n, 0, m_base}, 1.0, true, 10.0);
     // Each base row again, scaled (with scaled sides), and every bound again as a dense row.
@@ -601,10 +649,11 @@ TEST(QpSolver, IllConditionedHessian) {
   Rng rng(8);
   double worst_gap = 0.0;
   Kkt worst;
-  for (int t = 0; t < 400; ++t) {
+  for (int t = 0; t < 400 / kScale; ++t) {
     const Index n = rng.integer(2, 6);
-    const Index m_in = rng.integer(1, 5);
-    QpProblem p = random_problem(rng, {n, 0, m_in}, 8.0, rng.chance(0.5), 5.0);
+    const bool bounds = rng.chance(0.5) && n <= 4;  // at most 8 constraints to enumerate
+    const Index m_in = rng.integer(1, static_cast<int>(bounds ? 8 - n : 5));
+    QpProblem p = random_problem(rng, {n, 0, m_in}, 8.0, bounds, 5.0);
     const bool controller_like = t % 2 == 0;
     // Controller-like: the gradient pulls towards a target (g = -H x_t), as a weighted task does.
     // Otherwise a gradient of the size of H's largest eigenvalue in every direction, which puts
@@ -880,53 +929,78 @@ TEST(QpSolver, IterationLimitKeepsAFiniteIterate) {
 
 // ------------------------------------------------------------------------------------ allocation
 
+std::size_t malloc_calls() {
+#ifdef PHRI_TEST_COUNTS_MALLOC
+  return g_malloc_calls;
+#else
+  return 0;
+#endif
+}
+
+#ifdef PHRI_TEST_COUNTS_MALLOC
+// The interposed malloc must see Eigen's heap use, or the zero counts below would prove nothing.
+TEST(QpSolver, MallocCounterSeesEigenAllocations) {
+  const std::size_t before = malloc_calls();
+  VectorXd v = VectorXd::Ones(100);
+  EXPECT_GT(malloc_calls(), before);
+  EXPECT_EQ(v.sum(), 100.0);
+}
+#endif
+
 TEST(QpSolver, SolveNeverAllocatesAfterResize) {
   Rng rng(14);
-  const QpProblem p = random_problem(rng, {20, 2, 40}, 3.0, true, 10.0);
-  QpProblem infeasible = p;
-  infeasible.A.row(0).setZero();
-  infeasible.A(0, 0) = 1.0;
-  infeasible.l(0) = infeasible.ub(0) + 1.0;
-  infeasible.u(0) = kInf;
-  QpProblem invalid = p;
-  invalid.g(0) = std::numeric_limits<double>::quiet_NaN();
-  QpProblem not_definite = p;
-  not_definite.H(3, 3) = -1.0;
-  const MatrixXd factor = p.H.llt().matrixL();
-  const std::vector<QpActiveSide> rows(40, QpActiveSide::kLower);
-  const std::vector<QpActiveSide> bounds(20, QpActiveSide::kUpper);
+  // n = 7 runs the small kernels, n = 20 Eigen's products.
+  for (const Shape shape : {Shape{7, 0, 17}, Shape{7, 2, 10}, Shape{20, 2, 40}}) {
+    const QpProblem p = random_problem(rng, shape, 3.0, true, 10.0);
+    QpProblem infeasible = p;
+    infeasible.A.row(0).setZero();
+    infeasible.A(0, 0) = 1.0;
+    infeasible.l(0) = infeasible.ub(0) + 1.0;
+    infeasible.u(0) = kInf;
+    QpProblem invalid = p;
+    invalid.g(0) = std::numeric_limits<double>::quiet_NaN();
+    QpProblem not_definite = p;
+    not_definite.H(3, 3) = -1.0;
+    const MatrixXd factor = p.H.llt().matrixL();
+    const std::vector<QpActiveSide> rows(static_cast<std::size_t>(shape.m_in), QpActiveSide::kLower);
+    const std::vector<QpActiveSide> bounds(static_cast<std::size_t>(shape.n), QpActiveSide::kUpper);
 
-  QpSolver s;
-  s.resize(20, 2, 40);
-  QpStatus statuses[9];
-  std::size_t allocations = 0;
-  {
-    test::AllocationCounter count;
-    test::NoMallocScope no_malloc;
-    statuses[0] = s.solve(p);
-    statuses[1] = s.solve(p, {.warm_start = true});
-    statuses[2] = s.solve(p, {.warm_start = true, .reuse_hessian_factor = true});
-    statuses[3] = s.solve(infeasible, {.warm_start = true});
-    statuses[4] = s.solve(invalid);
-    statuses[5] = s.solve(not_definite);
-    s.set_active_set(rows, bounds);
-    statuses[6] = s.solve(p, {.warm_start = true});
-    s.set_hessian(p.H);
-    statuses[7] = s.solve(p, {.reuse_hessian_factor = true});
-    s.set_hessian_factor(factor);
-    statuses[8] = s.solve(p, {.warm_start = true, .reuse_hessian_factor = true});
-    allocations = count.allocations();
+    QpSolver s;
+    s.resize(shape.n, shape.m_eq, shape.m_in);
+    QpStatus statuses[9];
+    std::size_t allocations = 0;
+    std::size_t mallocs = 0;
+    {
+      const std::size_t malloc_start = malloc_calls();
+      test::AllocationCounter count;
+      test::NoMallocScope no_malloc;
+      statuses[0] = s.solve(p);
+      statuses[1] = s.solve(p, {.warm_start = true});
+      statuses[2] = s.solve(p, {.warm_start = true, .reuse_hessian_factor = true});
+      statuses[3] = s.solve(infeasible, {.warm_start = true});
+      statuses[4] = s.solve(invalid);
+      statuses[5] = s.solve(not_definite);
+      s.set_active_set(rows, bounds);
+      statuses[6] = s.solve(p, {.warm_start = true});
+      s.set_hessian(p.H);
+      statuses[7] = s.solve(p, {.reuse_hessian_factor = true});
+      s.set_hessian_factor(factor);
+      statuses[8] = s.solve(p, {.warm_start = true, .reuse_hessian_factor = true});
+      allocations = count.allocations();
+      mallocs = malloc_calls() - malloc_start;
+    }
+    EXPECT_EQ(allocations, 0u) << shape.n;
+    EXPECT_EQ(mallocs, 0u) << shape.n;
+    EXPECT_EQ(statuses[0], QpStatus::kOptimal);
+    EXPECT_EQ(statuses[1], QpStatus::kOptimal);
+    EXPECT_EQ(statuses[2], QpStatus::kOptimal);
+    EXPECT_EQ(statuses[3], QpStatus::kInfeasible);
+    EXPECT_EQ(statuses[4], QpStatus::kInvalidInput);
+    EXPECT_EQ(statuses[5], QpStatus::kInvalidInput);
+    EXPECT_EQ(statuses[6], QpStatus::kOptimal);
+    EXPECT_EQ(statuses[7], QpStatus::kOptimal);
+    EXPECT_EQ(statuses[8], QpStatus::kOptimal);
   }
-  EXPECT_EQ(allocations, 0u);
-  EXPECT_EQ(statuses[0], QpStatus::kOptimal);
-  EXPECT_EQ(statuses[1], QpStatus::kOptimal);
-  EXPECT_EQ(statuses[2], QpStatus::kOptimal);
-  EXPECT_EQ(statuses[3], QpStatus::kInfeasible);
-  EXPECT_EQ(statuses[4], QpStatus::kInvalidInput);
-  EXPECT_EQ(statuses[5], QpStatus::kInvalidInput);
-  EXPECT_EQ(statuses[6], QpStatus::kOptimal);
-  EXPECT_EQ(statuses[7], QpStatus::kOptimal);
-  EXPECT_EQ(statuses[8], QpStatus::kOptimal);
 }
 
 TEST(QpSolver, LargestSizeSolves) {
@@ -934,14 +1008,18 @@ TEST(QpSolver, LargestSizeSolves) {
   const QpProblem p = random_problem(rng, {60, 5, 300}, 3.0, true, 10.0);
   QpSolver s = solver_for(p);
   std::size_t allocations = 0;
+  std::size_t mallocs = 0;
   QpStatus status{};
   {
+    const std::size_t malloc_start = malloc_calls();
     test::AllocationCounter count;
     status = s.solve(p);
     allocations = count.allocations();
+    mallocs = malloc_calls() - malloc_start;
   }
   ASSERT_EQ(status, QpStatus::kOptimal);
   EXPECT_EQ(allocations, 0u);
+  EXPECT_EQ(mallocs, 0u);
   expect_kkt(p, s, 1e-9, "n 60 m 300");
   ASSERT_EQ(s.solve(p, {.warm_start = true}), QpStatus::kOptimal);
   EXPECT_EQ(s.iterations(), 0);

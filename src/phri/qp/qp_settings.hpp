@@ -6,8 +6,8 @@ namespace phri {
 struct QpSettings {
   // Maximum active-set changes per solve; <= 0 means 10 * (n + m_eq + m_in) + 10.
   int max_iterations = 0;
-  // A row is violated when its distance to the feasible side (rows are normalised to unit
-  // length) exceeds feasibility_tolerance * (1 + |x|_inf + |bound|).
+  // A row a'x >= b is violated when its distance to the feasible side, (b - a'x) / |a|, exceeds
+  // feasibility_tolerance * (1 + |x|_inf + |b| / |a|).
   double feasibility_tolerance = 1e-10;
   // A new constraint normal n is taken as linearly dependent on the active ones when the part of
   // J'n outside the active span is below this fraction of |J'n|.

@@ -70,10 +70,22 @@ void columns_axpy(const double* m, Index ld, Index rows, Index cols, const doubl
   for (Index c = 0; c < cols; ++c) axpy(coef[c], m + c * ld, y, rows);
 }
 
-bool all_finite(const double* p, Index n) {
-  bool ok = true;
-  for (Index i = 0; i < n; ++i) ok &= std::abs(p[i]) <= kMax;
-  return ok;
+// x * 0 is 0 for finite x and NaN otherwise, and a sum of zeros and NaNs is NaN in any order:
+// four partial sums let the compiler vectorise the check.
+[[gnu::always_inline]] inline bool all_finite(const double* p, Index n) {
+  double s0 = 0.0;
+  double s1 = 0.0;
+  double s2 = 0.0;
+  double s3 = 0.0;
+  Index i = 0;
+  for (; i + 4 <= n; i += 4) {
+    s0 += p[i] * 0.0;
+    s1 += p[i + 1] * 0.0;
+    s2 += p[i + 2] * 0.0;
+    s3 += p[i + 3] * 0.0;
+  }
+  for (; i < n; ++i) s0 += p[i] * 0.0;
+  return (s0 + s1) + (s2 + s3) == 0.0;
 }
 
 // v[0..q) <- R^-1 v[0..q), R the leading q x q block of an upper-triangular matrix (leading
@@ -113,6 +125,64 @@ Index first_non_finite_row(const Matrix& m) {
 
 QpActiveSide side_of(std::int8_t sign) {
   return sign > 0 ? QpActiveSide::kLower : (sign < 0 ? QpActiveSide::kUpper : QpActiveSide::kInactive);
+}
+
+// Cholesky factor L and J = L^-T of an n x n matrix, n <= kSmall: H is padded with the identity
+// to kSmall x kSmall (the padding factors to itself) so that the compile-time loop bounds let
+// the compiler unroll everything. It runs as L D L' (W = L D column by column), which leaves
+// one division per column on the critical path instead of a square root and a division; the
+// square roots of D are taken afterwards, all at once. Returns the first pivot at or below
+// pivot_min, or -1.
+constexpr Index kSmall = 8;
+
+Index factor_small(const double* h, Index ld, Index n, double pivot_min, double* l_out, double* j_out) {
+  constexpr int N = kSmall;
+  double w[N][N];  // w[column][row]
+  double inv_d[N];
+#pragma GCC unroll 8
+  for (int c = 0; c < N; ++c) {
+#pragma GCC unroll 8
+    for (int r = 0; r < N; ++r) w[c][r] = (c < n && r < n) ? h[r + c * ld] : (r == c ? 1.0 : 0.0);
+  }
+  // Column j: H(:, j) - sum_{k<j} L(j, k) W(:, k), L(j, k) = W(j, k) / D_k; rows above the
+  // diagonal are not needed and cleared.
+#pragma GCC unroll 8
+  for (int j = 0; j < N; ++j) {
+#pragma GCC unroll 8
+    for (int k = 0; k < j; ++k) {
+      const double f = w[k][j] * inv_d[k];
+#pragma GCC unroll 8
+      for (int r = 0; r < N; ++r) w[j][r] -= f * w[k][r];
+    }
+#pragma GCC unroll 8
+    for (int r = 0; r < j; ++r) w[j][r] = 0.0;
+    if (j < n && !(w[j][j] > pivot_min)) return j;  // the padding's unit pivots are not H's
+    inv_d[j] = 1.0 / w[j][j];
+  }
+  double scale[N];  // D^-1/2
+#pragma GCC unroll 8
+  for (int k = 0; k < N; ++k) scale[k] = std::sqrt(inv_d[k]);
+  // Unit-diagonal part first, J~(:, k) = e_k - sum_{i<k} L~(k, i) J~(:, i) with L~ = W D^-1; then
+  // J = J~ D^-1/2 and L = W D^-1/2.
+  double b[N][N];
+#pragma GCC unroll 8
+  for (int k = 0; k < N; ++k) {
+#pragma GCC unroll 8
+    for (int r = 0; r < N; ++r) b[k][r] = r == k ? 1.0 : 0.0;
+#pragma GCC unroll 8
+    for (int i = 0; i < k; ++i) {
+      const double f = w[i][k] * inv_d[i];
+#pragma GCC unroll 8
+      for (int r = 0; r < N; ++r) b[k][r] -= f * b[i][r];
+    }
+  }
+  for (Index c = 0; c < n; ++c) {
+    for (Index r = 0; r < n; ++r) {
+      l_out[r + c * n] = w[c][r] * scale[c];
+      j_out[r + c * n] = b[c][r] * scale[c];
+    }
+  }
+  return -1;
 }
 
 }  // namespace
@@ -188,30 +258,37 @@ QpInvalidReason QpSolver::factorize(const Eigen::Ref<const Eigen::MatrixXd>& h, 
   double max_diagonal = 0.0;
   double* l = chol_.data();
   for (Index c = 0; c < n; ++c) {
-    const double* hc = h.col(c).data();
-    finite &= all_finite(hc, n);
-    max_diagonal = std::max(max_diagonal, std::abs(hc[c]));
-    for (Index i = c; i < n; ++i) l[i + c * n] = hc[i];
+    finite &= all_finite(h.col(c).data(), n);
+    max_diagonal = std::max(max_diagonal, std::abs(h(c, c)));
   }
   if (!finite) {
     bad_index = first_non_finite_row(h);
     return QpInvalidReason::kNonFiniteHessian;
   }
-  // Right-looking Cholesky H = L L' on the lower triangle: each step scales a column and updates
-  // the trailing columns with contiguous axpys. A pivot below n eps max|H_ii| means H is not
-  // (numerically) positive definite.
+  // A pivot below n eps max|H_ii| means H is not (numerically) positive definite.
   const double pivot_min = static_cast<double>(n) * std::numeric_limits<double>::epsilon() * max_diagonal;
-  for (Index k = 0; k < n; ++k) {
-    double* lk = l + k * n;
-    const double pivot = lk[k];
+  if (n <= kSmall) {
+    bad_index = factor_small(h.data(), h.outerStride(), n, pivot_min, l, inv_chol_.data());
+    if (bad_index >= 0) return QpInvalidReason::kHessianNotPositiveDefinite;
+    has_factor_ = true;
+    return QpInvalidReason::kNone;
+  }
+  // Left-looking Cholesky H = L L' on the lower triangle: column j is H(j:n, j) minus
+  // L(j, k) L(j:n, k) for the columns k < j, then scaled. Each column is updated by axpys of one
+  // length (no store-to-load stalls on partly rewritten vectors).
+  for (Index c = 0; c < n; ++c) {
+    for (Index i = c; i < n; ++i) l[i + c * n] = h(i, c);
+  }
+  for (Index j = 0; j < n; ++j) {
+    double* lj = l + j * n;
+    for (Index k = 0; k < j; ++k) axpy(-l[j + k * n], l + k * n + j, lj + j, n - j);
+    const double pivot = lj[j];
     if (!(pivot > pivot_min)) {
-      bad_index = k;
+      bad_index = j;
       return QpInvalidReason::kHessianNotPositiveDefinite;
     }
-    lk[k] = std::sqrt(pivot);
-    const double inv = 1.0 / lk[k];
-    for (Index i = k + 1; i < n; ++i) lk[i] *= inv;
-    for (Index j = k + 1; j < n; ++j) axpy(-lk[j], lk + j, l + j * n + j, n - j);
+    const double inv = 1.0 / std::sqrt(pivot);
+    for (Index i = j; i < n; ++i) lj[i] *= inv;
   }
   invert_factor();
   has_factor_ = true;
@@ -219,46 +296,106 @@ QpInvalidReason QpSolver::factorize(const Eigen::Ref<const Eigen::MatrixXd>& h, 
 }
 
 void QpSolver::invert_factor() {
-  // Column c of L^-1 by forward substitution against e_c, written transposed as row c of
-  // J = L^-T; the strict lower part of J stays zero.
+  // From L L^-1 = I, row k of L^-1, i.e. column k of J = L^-T, is
+  // (e_k - sum_{i<k} L(k, i) J(:, i)) / L(k, k). J is upper triangular, so every axpy may run over
+  // rows 0..k (one length per column, no store-to-load stalls); the strict lower part stays zero.
   const Index n = n_;
   const double* l = chol_.data();
   double* j = inv_chol_.data();
-  double* inv_diag = work_.data();
-  double* col = d_.data();
-  for (Index k = 0; k < n; ++k) inv_diag[k] = 1.0 / l[k + k * n];
-  for (Index c = 0; c < n; ++c) {
-    for (Index k = c; k < n; ++k) col[k] = 0.0;
-    col[c] = 1.0;
-    for (Index k = c; k < n; ++k) {
-      col[k] *= inv_diag[k];
-      axpy(-col[k], l + k * n + k + 1, col + k + 1, n - k - 1);
-    }
-    for (Index k = c; k < n; ++k) j[c + k * n] = col[k];
+  for (Index k = 0; k < n; ++k) {
+    double* col = j + k * n;
+    for (Index r = 0; r < k; ++r) col[r] = 0.0;
+    col[k] = 1.0;
+    for (Index i = 0; i < k; ++i) axpy(-l[k + i * n], j + i * n, col, k + 1);
+    const double inv = 1.0 / l[k + k * n];
+    for (Index r = 0; r <= k; ++r) col[r] *= inv;
   }
 }
 
 // ------------------------------------------------------------------------------------ input
 
-// Scales row k (a column of rows_) to unit length. Returns false when it holds NaN or Inf.
-bool QpSolver::normalize_row(Index k) {
-  double* a = rows_.col(k).data();
-  double squared = dot(a, a, n_);
-  if (!(squared >= std::numeric_limits<double>::min() && squared <= kMax)) {
+// Copies the rows of `a` (m x n) into rows_ from column `first` on, scaled to unit length, with
+// row_scale_ = 1 / |row| (0 for an all-zero row). Returns the first row holding NaN or Inf, or -1.
+// The squared norms accumulate down the contiguous columns of `a` and the square roots and
+// divisions go through Eigen's vectorised array functions in one batch; one row at a time,
+// their latency dominated the whole load.
+Index QpSolver::load_rows(const Eigen::MatrixXd& a, Index first) {
+  const Index n = n_;
+  const Index m = a.rows();
+  if (m == 0) return -1;
+  double* scale = row_scale_.data() + first;
+  for (Index i = 0; i < m; ++i) scale[i] = 0.0;
+  for (Index j = 0; j < n; ++j) {
+    const double* col = a.col(j).data();
+    for (Index i = 0; i < m; ++i) scale[i] += col[i] * col[i];
+  }
+  auto scales = row_scale_.segment(first, m).array();
+  scales = scales.sqrt().inverse();
+  const double min_scale = 1.0 / std::sqrt(kMax);
+  const double max_scale = 1.0 / std::sqrt(std::numeric_limits<double>::min());
+  bool in_range = true;
+  for (Index i = 0; i < m; ++i) in_range &= scale[i] >= min_scale && scale[i] <= max_scale;
+  if (!in_range) {
     // Rare: non-finite, zero, or so large or small that the squares leave the double range.
-    if (!all_finite(a, n_)) return false;
-    squared = rows_.col(k).stableNorm();
-    squared *= squared;
+    for (Index i = 0; i < m; ++i) {
+      if (scale[i] >= min_scale && scale[i] <= max_scale) continue;
+      if (!a.row(i).allFinite()) return i;
+      const double norm = a.row(i).stableNorm();
+      scale[i] = norm > 0.0 && norm <= kMax ? 1.0 / norm : 0.0;
+      has_null_rows_ |= scale[i] == 0.0;
+    }
   }
-  if (squared > 0.0 && std::isfinite(squared)) {
-    const double scale = 1.0 / std::sqrt(squared);
-    for (Index i = 0; i < n_; ++i) a[i] *= scale;
-    row_scale_(k) = scale;
-  } else {
-    row_scale_(k) = 0.0;  // an all-zero row (or one beyond 1e154 that cannot be scaled)
+  for (Index j = 0; j < n; ++j) {
+    const double* col = a.col(j).data();
+    double* dst = rows_.data() + j + first * n;
+    for (Index i = 0; i < m; ++i) dst[i * n] = col[i] * scale[i];
   }
-  return true;
+  return -1;
 }
+
+namespace {
+
+// Checks l <= u (either may be empty, i.e. absent) and that neither is NaN, l = +inf or u = -inf.
+// One branch-free pass; the offending index is searched only on failure.
+Index check_sides(const Eigen::VectorXd& lo, const Eigen::VectorXd& hi, Index m, bool& inverted) {
+  const bool has_lo = lo.size() > 0;
+  const bool has_hi = hi.size() > 0;
+  bool bad = false;
+  if (has_lo && has_hi) {
+    for (Index i = 0; i < m; ++i) bad |= !(lo(i) <= hi(i)) | (lo(i) == kInf) | (hi(i) == -kInf);
+  } else if (has_lo) {
+    for (Index i = 0; i < m; ++i) bad |= !(lo(i) < kInf);
+  } else if (has_hi) {
+    for (Index i = 0; i < m; ++i) bad |= !(hi(i) > -kInf);
+  }
+  if (!bad) return -1;
+  for (Index i = 0; i < m; ++i) {
+    const double l = has_lo ? lo(i) : -kInf;
+    const double u = has_hi ? hi(i) : kInf;
+    inverted = false;
+    if (std::isnan(l) || std::isnan(u) || l == kInf || u == -kInf) return i;
+    inverted = true;
+    if (l > u) return i;
+  }
+  return -1;
+}
+
+// lower/upper in the scaled units, -inf/+inf for absent sides.
+void convert_sides(const Eigen::VectorXd& lo, const Eigen::VectorXd& hi, const double* scale, Index m, double big,
+                   double* lower, double* upper) {
+  if (lo.size() > 0) {
+    for (Index i = 0; i < m; ++i) lower[i] = lo(i) <= -big ? -kInf : lo(i) * scale[i];
+  } else {
+    for (Index i = 0; i < m; ++i) lower[i] = -kInf;
+  }
+  if (hi.size() > 0) {
+    for (Index i = 0; i < m; ++i) upper[i] = hi(i) >= big ? kInf : hi(i) * scale[i];
+  } else {
+    for (Index i = 0; i < m; ++i) upper[i] = kInf;
+  }
+}
+
+}  // namespace
 
 QpInvalidReason QpSolver::load(const QpProblem& p, bool reuse_factor) {
   const Index n = n_;
@@ -289,70 +426,51 @@ QpInvalidReason QpSolver::load(const QpProblem& p, bool reuse_factor) {
   const double big = settings_.infinity;
   const double tol = settings_.feasibility_tolerance;
   null_row_infeasible_ = false;
+  has_null_rows_ = false;
 
-  if (m_eq_ > 0) {
-    if (!all_finite(p.b_eq.data(), m_eq_)) {
-      invalid_index_ = first_non_finite_row(p.b_eq);
-      return QpInvalidReason::kNonFiniteEqualityTarget;
-    }
-    rows_.leftCols(m_eq_) = p.A_eq.transpose();
+  if (!all_finite(p.b_eq.data(), m_eq_)) {
+    invalid_index_ = first_non_finite_row(p.b_eq);
+    return QpInvalidReason::kNonFiniteEqualityTarget;
   }
-  for (Index k = 0; k < m_eq_; ++k) {
-    if (!normalize_row(k)) {
-      invalid_index_ = k;
-      return QpInvalidReason::kNonFiniteEqualityRows;
-    }
-    // An all-zero row reads 0 = b: skipped as dependent, its consistency decided here.
-    lower_(k) = upper_(k) = p.b_eq(k) * row_scale_(k);
-    null_row_infeasible_ |= row_scale_(k) == 0.0 && std::abs(p.b_eq(k)) > tol;
+  if ((invalid_index_ = load_rows(p.A_eq, 0)) >= 0) return QpInvalidReason::kNonFiniteEqualityRows;
+  if ((invalid_index_ = load_rows(p.A, m_eq_)) >= 0) return QpInvalidReason::kNonFiniteInequalityRows;
+
+  bool inverted = false;
+  if ((invalid_index_ = check_sides(p.l, p.u, m_in_, inverted)) >= 0) {
+    return inverted ? QpInvalidReason::kRowBoundsInverted : QpInvalidReason::kInvalidRowBound;
+  }
+  if ((invalid_index_ = check_sides(p.lb, p.ub, n, inverted)) >= 0) {
+    return inverted ? QpInvalidReason::kVariableBoundsInverted : QpInvalidReason::kInvalidVariableBound;
   }
 
-  if (m_in_ > 0) rows_.middleCols(m_eq_, m_in_) = p.A.transpose();
-  const bool has_l = p.l.size() > 0;
-  const bool has_u = p.u.size() > 0;
-  for (Index i = 0; i < m_in_; ++i) {
-    const Index k = m_eq_ + i;
-    if (!normalize_row(k)) {
-      invalid_index_ = i;
-      return QpInvalidReason::kNonFiniteInequalityRows;
+  for (Index k = 0; k < m_eq_; ++k) lower_(k) = upper_(k) = p.b_eq(k) * row_scale_(k);
+  convert_sides(p.l, p.u, row_scale_.data() + m_eq_, m_in_, big, lower_.data() + m_eq_, upper_.data() + m_eq_);
+  if (p.lb.size() > 0) {
+    for (Index j = 0; j < n; ++j) lower_(m_rows_ + j) = p.lb(j) <= -big ? -kInf : p.lb(j);
+  } else {
+    lower_.tail(n).setConstant(-kInf);
+  }
+  if (p.ub.size() > 0) {
+    for (Index j = 0; j < n; ++j) upper_(m_rows_ + j) = p.ub(j) >= big ? kInf : p.ub(j);
+  } else {
+    upper_.tail(n).setConstant(kInf);
+  }
+
+  if (has_null_rows_) {
+    // An all-zero equality row reads 0 = b: skipped as dependent, its consistency decided here.
+    // An all-zero inequality row is l <= 0 <= u or nothing, and never active.
+    for (Index k = 0; k < m_eq_; ++k) {
+      null_row_infeasible_ |= row_scale_(k) == 0.0 && std::abs(p.b_eq(k)) > tol;
     }
-    const double lo = has_l ? p.l(i) : -kInf;
-    const double hi = has_u ? p.u(i) : kInf;
-    if (std::isnan(lo) || std::isnan(hi) || lo == kInf || hi == -kInf) {
-      invalid_index_ = i;
-      return QpInvalidReason::kInvalidRowBound;
-    }
-    if (lo > hi) {
-      invalid_index_ = i;
-      return QpInvalidReason::kRowBoundsInverted;
-    }
-    const double scale = row_scale_(k);
-    if (scale > 0.0) {
-      lower_(k) = lo <= -big ? -kInf : lo * scale;
-      upper_(k) = hi >= big ? kInf : hi * scale;
-    } else {
-      // An all-zero row: l <= 0 <= u or nothing, never active.
+    for (Index i = 0; i < m_in_; ++i) {
+      const Index k = m_eq_ + i;
+      if (row_scale_(k) != 0.0) continue;
+      const double lo = p.l.size() > 0 ? p.l(i) : -kInf;
+      const double hi = p.u.size() > 0 ? p.u(i) : kInf;
+      null_row_infeasible_ |= (lo > -big && lo > tol) || (hi < big && hi < -tol);
       lower_(k) = -kInf;
       upper_(k) = kInf;
-      null_row_infeasible_ |= (lo > -big && lo > tol) || (hi < big && hi < -tol);
     }
-  }
-
-  const bool has_lb = p.lb.size() > 0;
-  const bool has_ub = p.ub.size() > 0;
-  for (Index j = 0; j < n; ++j) {
-    const double lo = has_lb ? p.lb(j) : -kInf;
-    const double hi = has_ub ? p.ub(j) : kInf;
-    if (std::isnan(lo) || std::isnan(hi) || lo == kInf || hi == -kInf) {
-      invalid_index_ = j;
-      return QpInvalidReason::kInvalidVariableBound;
-    }
-    if (lo > hi) {
-      invalid_index_ = j;
-      return QpInvalidReason::kVariableBoundsInverted;
-    }
-    lower_(m_rows_ + j) = lo <= -big ? -kInf : lo;
-    upper_(m_rows_ + j) = hi >= big ? kInf : hi;
   }
   return QpInvalidReason::kNone;
 }
@@ -527,7 +645,7 @@ bool QpSolver::most_violated(Index& best_k, int& best_sign) {
     }
   };
   if (n_ >= kLargeRows) {
-    columns_dot(rows_.col(m_eq_).data(), n_, n_, m_in_, x_.data(), row_values_.data());
+    columns_dot(rows_.data() + m_eq_ * n_, n_, n_, m_in_, x_.data(), row_values_.data());
     for (Index i = 0; i < m_in_; ++i) {
       if (sign_[static_cast<std::size_t>(m_eq_ + i)] == 0) consider(m_eq_ + i, row_values_(i));
     }
@@ -594,7 +712,7 @@ QpStatus QpSolver::iterate(int max_iterations) {
         }
         double* step = work_.data();
         for (Index j = q; j < n; ++j) step[j] = t * d[j];
-        columns_axpy(j_.col(q).data(), n, n, n - q, step + q, x_.data());
+        columns_axpy(j_.data() + q * n, n, n, n - q, step + q, x_.data());
       }
       for (Index j = 0; j < q; ++j) {
         u_(j) -= t * r[j];

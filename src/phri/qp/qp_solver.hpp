@@ -28,6 +28,14 @@
 // the last solve's active set or what set_active_set() wrote. The guess is made consistent first
 // (linearly dependent constraints skipped, constraints with negative multipliers dropped), so a
 // wrong guess costs iterations, never correctness.
+//
+// Hessian factor: every solve factorises H and keeps the factor, unless reuse_hessian_factor is
+// set, which uses the kept factor (from the last solve, set_hessian or set_hessian_factor) and
+// does not read problem.H. A failed factorisation keeps no factor.
+//
+// Status: kOptimal; kInfeasible and kIterationLimit with the last primal iterate in x();
+// kInvalidInput with x() = 0 and invalid_reason()/invalid_index() naming the failed check;
+// kNumericalError (finite data whose iterates overflowed) with x() = 0. x() is never NaN.
 #include <phri/qp/qp_active_side.hpp>
 #include <phri/qp/qp_invalid_reason.hpp>
 #include <phri/qp/qp_problem.hpp>
@@ -56,13 +64,13 @@ public:
 
   Index num_variables() const { return n_; }
   Index num_equalities() const { return m_eq_; }
-  Index num_rows() const { return m_in_; }
+  Index num_inequalities() const { return m_in_; }
 
   QpSettings& settings() { return settings_; }
   const QpSettings& settings() const { return settings_; }
 
-  // Factorises H (lower triangle read) for later solves with reuse_hessian_factor.
-  // Returns kNone, or the failed check (kNonFiniteHessian, kHessianNotPositiveDefinite, ...).
+  // Factorises H (lower triangle read) for later solves with reuse_hessian_factor. Returns kNone,
+  // or the failed check (kDimensionMismatch, kNonFiniteHessian, kHessianNotPositiveDefinite).
   QpInvalidReason set_hessian(const Eigen::Ref<const Eigen::MatrixXd>& hessian);
   // Takes the caller's Cholesky factor: lower-triangular L with H = L L' (strict upper part not
   // read), e.g. Eigen::LLT<Eigen::MatrixXd>::matrixL(). Returns kNone, or kInvalidHessianFactor.
@@ -74,7 +82,7 @@ public:
 
   QpStatus solve(const QpProblem& problem, const QpSolveOptions& options = {});
 
-  // ---- results of the last solve
+  // ---- results of the last solve (before the first one: kInvalidInput, x() = 0)
   QpStatus status() const { return status_; }
   QpInvalidReason invalid_reason() const { return invalid_reason_; }
   Index invalid_index() const { return invalid_index_; }  // -1 when not applicable
@@ -94,7 +102,7 @@ public:
 
 private:
   QpInvalidReason load(const QpProblem& problem, bool reuse_factor);
-  bool normalize_row(Index k);
+  Index load_rows(const Eigen::MatrixXd& a, Index first);
   QpInvalidReason factorize(const Eigen::Ref<const Eigen::MatrixXd>& hessian, Index& bad_index);
   void invert_factor();
   void start_working_set(bool warm);
@@ -128,6 +136,7 @@ private:
   Eigen::VectorXd lower_;      // per constraint, in the scaled units; -inf when absent
   Eigen::VectorXd upper_;      // +inf when absent
   Eigen::VectorXd g_;
+  bool has_null_rows_ = false;
   bool null_row_infeasible_ = false;
 
   // Goldfarb-Idnani state: J = L^-T Q and R with Q' L^-1 N = [R; 0] for the q active normals N.
