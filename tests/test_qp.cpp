@@ -20,32 +20,6 @@
 #include <string>
 #include <vector>
 
-// Eigen allocates with std::malloc, which the operator-new counter of tests/support does not see,
-// and EIGEN_RUNTIME_NO_MALLOC applies to the test code only, not to the Eigen code compiled into
-// libphri. So this program also interposes malloc, calloc and realloc (forwarding to glibc) and
-// counts them, to catch heap use anywhere in a solve. Not under AddressSanitizer, which owns
-// malloc.
-#if defined(__GLIBC__) && !defined(__SANITIZE_ADDRESS__)
-#define PHRI_TEST_COUNTS_MALLOC 1
-extern "C" void* __libc_malloc(std::size_t size);
-extern "C" void* __libc_calloc(std::size_t count, std::size_t size);
-extern "C" void* __libc_realloc(void* pointer, std::size_t size);
-namespace {
-std::size_t g_malloc_calls = 0;  // the tests run on one thread
-}  // namespace
-extern "C" void* malloc(std::size_t size) noexcept {
-  ++g_malloc_calls;
-  return __libc_malloc(size);
-}
-extern "C" void* calloc(std::size_t count, std::size_t size) noexcept {
-  ++g_malloc_calls;
-  return __libc_calloc(count, size);
-}
-extern "C" void* realloc(void* pointer, std::size_t size) noexcept {
-  ++g_malloc_calls;
-  return __libc_realloc(pointer, size);
-}
-#endif
 
 namespace phri {
 namespace {
@@ -929,23 +903,17 @@ TEST(QpSolver, IterationLimitKeepsAFiniteIterate) {
 
 // ------------------------------------------------------------------------------------ allocation
 
-std::size_t malloc_calls() {
-#ifdef PHRI_TEST_COUNTS_MALLOC
-  return g_malloc_calls;
-#else
-  return 0;
-#endif
-}
+// tests/support counts malloc as well as operator new (glibc, no ASan).
+std::size_t malloc_calls() { return test::thread_allocation_count(); }
 
-#ifdef PHRI_TEST_COUNTS_MALLOC
 // The interposed malloc must see Eigen's heap use, or the zero counts below would prove nothing.
 TEST(QpSolver, MallocCounterSeesEigenAllocations) {
+  if (!test::counts_malloc()) GTEST_SKIP() << "malloc is not interposed under AddressSanitizer";
   const std::size_t before = malloc_calls();
   VectorXd v = VectorXd::Ones(100);
   EXPECT_GT(malloc_calls(), before);
   EXPECT_EQ(v.sum(), 100.0);
 }
-#endif
 
 TEST(QpSolver, SolveNeverAllocatesAfterResize) {
   Rng rng(14);

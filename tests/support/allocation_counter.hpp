@@ -1,6 +1,8 @@
 #pragma once
 // Counts heap allocations made by the current thread: every test binary links a replacement of the
-// global operator new/delete (allocation_counter.cpp). Use with EIGEN_RUNTIME_NO_MALLOC as well:
+// global operator new/delete and (glibc, no ASan) an interposer of malloc/calloc/realloc, so that
+// Eigen's allocations inside libphri are seen too (allocation_counter.cpp). Use with
+// EIGEN_RUNTIME_NO_MALLOC as well, which asserts on Eigen allocations in the test's own code:
 //
 //   phri::test::AllocationCounter count;          // starts counting at zero
 //   run_the_cycle();
@@ -17,6 +19,8 @@
 namespace phri::test {
 
 std::size_t thread_allocation_count();
+/// True when malloc/calloc/realloc are counted too (not under AddressSanitizer).
+bool counts_malloc();
 
 class AllocationCounter {
 public:

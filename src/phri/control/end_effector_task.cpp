@@ -34,9 +34,15 @@ EndEffectorTask::EndEffectorTask(const Model& model, int frame_id, double smooth
 
 void EndEffectorTask::set_stiffness(const Vector6d& stiffness) { stiffness_.set_target(stiffness); }
 void EndEffectorTask::set_damping(const Vector6d& damping) { damping_.set_target(damping); }
-void EndEffectorTask::set_critical_damping() { damping_.set_target(2.0 * stiffness_.target().cwiseSqrt()); }
+void EndEffectorTask::set_critical_damping() {
+  const Vector6d damping = 2.0 * stiffness_.target().cwiseSqrt();  // fixed size: no temporary on the heap
+  damping_.set_target(damping);
+}
 void EndEffectorTask::set_weight(double weight) { weight_.set_target_constant(weight); }
-void EndEffectorTask::set_gamma(const Vector6d& gamma) { gamma_.set_target(gamma.cwiseMax(0.0).cwiseMin(1.0)); }
+void EndEffectorTask::set_gamma(const Vector6d& gamma) {
+  const Vector6d clamped = gamma.cwiseMax(0.0).cwiseMin(1.0);
+  gamma_.set_target(clamped);
+}
 
 void EndEffectorTask::reset_gains(const Vector6d& stiffness, const Vector6d& damping, double weight,
                                   const Vector6d& gamma) {
@@ -132,7 +138,8 @@ void EndEffectorTask::update(const Model& model, const Data& data, const Eigen::
   // ë* (paper's task reference) minus the drift J̇ qd, plus the compliant part gamma J M^-1 tau_ext.
   reference_ = target_acceleration_ + stiffness_.value().cwiseProduct(error_) +
                damping_.value().cwiseProduct(target_velocity_ - velocity_) - bias;
-  reference_.noalias() += gamma_.value().asDiagonal() * (jacobian_ * qdd_external);
+  external_task_acceleration_.noalias() = jacobian_ * qdd_external;
+  reference_ += gamma_.value().cwiseProduct(external_task_acceleration_);
 }
 
 }  // namespace phri

@@ -93,6 +93,7 @@ private:
   Vector6d target_acceleration_ = Vector6d::Zero();
   Eigen::MatrixXd jacobian_;
   Vector6d reference_ = Vector6d::Zero();
+  Vector6d external_task_acceleration_ = Vector6d::Zero();  // J M^-1 tau_ext
   Vector6d error_ = Vector6d::Zero();
   Vector6d velocity_ = Vector6d::Zero();
   Eigen::Isometry3d pose_ = Eigen::Isometry3d::Identity();

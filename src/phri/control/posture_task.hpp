@@ -15,9 +15,9 @@ public:
   PostureTask(const Model& model, double smoothing_time_constant = 0.1);
 
   void set_stiffness(const Eigen::VectorXd& stiffness);
-  void set_stiffness(double stiffness) { set_stiffness(Eigen::VectorXd::Constant(nv_, stiffness)); }
+  void set_stiffness(double stiffness) { stiffness_.set_target_constant(stiffness); }
   void set_damping(const Eigen::VectorXd& damping);
-  void set_damping(double damping) { set_damping(Eigen::VectorXd::Constant(nv_, damping)); }
+  void set_damping(double damping) { damping_.set_target_constant(damping); }
   void set_weight(double weight);
   void set_gamma(double gamma);
   void reset_gains(double stiffness, double damping, double weight, double gamma);

@@ -13,10 +13,11 @@ public:
       : value_(initial), target_(initial), time_constant_(time_constant) {}
 
   /// The value to reach; the current value follows over a few time constants.
-  void set_target(const Eigen::VectorXd& target) { target_ = target; }
+  /// (A Ref, so that a fixed-size vector binds without a temporary: no allocation in the cycle.)
+  void set_target(const Eigen::Ref<const Eigen::VectorXd>& target) { target_ = target; }
   void set_target_constant(double value) { target_.setConstant(value); }
   /// Sets value and target at once (no smoothing), e.g. at start-up.
-  void reset(const Eigen::VectorXd& value) {
+  void reset(const Eigen::Ref<const Eigen::VectorXd>& value) {
     value_ = value;
     target_ = value;
   }
