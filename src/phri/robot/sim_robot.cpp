@@ -20,11 +20,6 @@ namespace {
 // SimRobotSensors.FtSensorReadsToolWeight against m * g in the sensor frame.
 constexpr double kWrenchSign = -1.0;
 
-// Presliding spring of the stick-slip friction: natural frequency w = 0.5 / dt on the reflected
-// rotor inertia (a lower bound of the joint's apparent inertia), damping ratio 0.7; see
-// StickSlipFriction for the stability argument.
-constexpr double kPreslidingFrequencyTimesStep = 0.5;
-constexpr double kPreslidingDampingRatio = 0.7;
 
 // Stream ids of RandomGenerator, one per noise source.
 constexpr std::uint64_t kJointNoiseStream = 1;
@@ -119,17 +114,13 @@ SimRobot::SimRobot(const SimRobotConfig& config)
     offsets_[i] = config_.noise.torque_sensor_offset_Nm[k];
     const int d = dadr_[k];
     m_->dof_armature[d] = a.reflected_inertia_kgm2;
-    // Friction is applied explicitly (it enters tau_s), not by MuJoCo's damping/frictionloss.
-    m_->dof_damping[d] = 0.0;
+    // Dry friction: StickSlipFriction (its spring through qfrc_applied, its damper and the viscous
+    // friction through MuJoCo's joint damping, which the Euler step integrates implicitly).
+    m_->dof_damping[d] = a.friction.viscous_Nms_per_rad;
     m_->dof_frictionloss[d] = 0.0;
-    StickSlipFriction::Parameters fp;
-    const double w = kPreslidingFrequencyTimesStep / dt;
-    fp.coulomb_Nm = a.friction.coulomb_Nm;
-    fp.static_Nm = a.friction.static_Nm;
-    fp.stiffness_Nm_per_rad = a.reflected_inertia_kgm2 * w * w;
-    fp.damping_Nms_per_rad = 2.0 * kPreslidingDampingRatio * a.reflected_inertia_kgm2 * w;
-    fp.breakaway_velocity_rad_s = config_.friction.breakaway_velocity_rad_s;
-    dry_.emplace_back(fp);
+    dry_.emplace_back(StickSlipFriction::presliding(a.friction.coulomb_Nm, a.friction.static_Nm,
+                                                    a.reflected_inertia_kgm2, dt,
+                                                    config_.friction.breakaway_velocity_rad_s));
   }
   quantum_ = config_.noise.encoder_counts_per_rev > 0.0 ? 2.0 * 3.14159265358979323846 / config_.noise.encoder_counts_per_rev
                                                          : 0.0;
@@ -229,6 +220,10 @@ SimRobot::SimRobot(const SimRobotConfig& config)
   tau_viscous_ = Eigen::VectorXd::Zero(n_);
   tau_dry_ = Eigen::VectorXd::Zero(n_);
   tau_s_ = Eigen::VectorXd::Zero(n_);
+  v_before_ = Eigen::VectorXd::Zero(n_);
+  f_dry_ = Eigen::VectorXd::Zero(n_);
+  damping_ = Eigen::VectorXd::Zero(n_);
+  qdd_ = Eigen::VectorXd::Zero(n_);
   for (Eigen::VectorXd* v : {&truth_.q_rad, &truth_.qd_rad_s, &truth_.qdd_rad_s2, &truth_.current_A,
                              &truth_.tau_motor_Nm, &truth_.tau_friction_Nm, &truth_.tau_transmitted_Nm}) {
     *v = Eigen::VectorXd::Zero(n_);
@@ -295,6 +290,8 @@ void SimRobot::reset() {
   }
   tau_viscous_.setZero();
   tau_dry_.setZero();
+  f_dry_.setZero();
+  qdd_.setZero();
 
   // Initial command: hold the initial pose in Position mode.
   command_.mode = LowLevelMode::kPosition;
@@ -404,7 +401,16 @@ const RobotState& SimRobot::read() {
 }
 
 void SimRobot::substep() {
-  // 1. Positions, velocities, bias forces of the current state.
+  // 1. Dry friction from the current state (its damping enters MuJoCo's passive forces in
+  //    mj_step1 and the implicit part of the Euler step), then positions, velocities, bias forces.
+  for (int i = 0; i < n_; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    const int d = dadr_[k];
+    v_before_[i] = d_->qvel[d];
+    f_dry_[i] = dry_[k].update(d_->qpos[qadr_[k]], d_->qvel[d]);
+    damping_[i] = viscous_[i] + dry_[k].damping();
+    m_->dof_damping[d] = damping_[i];
+  }
   mj_step1(m_, d_);
   const double t = d_->time;
 
@@ -421,14 +427,11 @@ void SimRobot::substep() {
   }
   drive_.tick(q_meas_, qd_meas_, tau_meas_, substep_count_ % static_cast<std::uint64_t>(filter_decimation_) == 0, current_);
 
-  // 3. Joint torques on the motor side: motor, viscous and dry friction.
+  // 3. Joint torques on the motor side: motor and the explicit part of the dry friction.
   for (int i = 0; i < n_; ++i) {
-    const auto k = static_cast<std::size_t>(i);
-    const int d = dadr_[k];
+    const int d = dadr_[static_cast<std::size_t>(i)];
     tau_motor_[i] = torque_per_amp_[i] * current_[i];
-    tau_viscous_[i] = -viscous_[i] * d_->qvel[d];
-    tau_dry_[i] = dry_[k].update(d_->qpos[qadr_[k]], d_->qvel[d]);
-    d_->qfrc_applied[d] = tau_motor_[i] + tau_viscous_[i] + tau_dry_[i];
+    d_->qfrc_applied[d] = tau_motor_[i] + f_dry_[i];
   }
 
   // 4. External forces.
@@ -441,10 +444,16 @@ void SimRobot::substep() {
   mj_step2(m_, d_);
   if (ft_step) m_->opt.disableflags |= mjDSBL_SENSOR;
 
-  // Transmitted torque: motor torque, minus friction and rotor inertia on the motor side.
+  // Transmitted torque: motor torque, minus friction and rotor inertia on the motor side. The
+  // damping (viscous + presliding) acted on the new velocity, and the step's acceleration is
+  // (v1 - v0) / dt (d->qacc is MuJoCo's explicit value, before the implicit damping).
   for (int i = 0; i < n_; ++i) {
     const int d = dadr_[static_cast<std::size_t>(i)];
-    tau_s_[i] = tau_motor_[i] + tau_viscous_[i] + tau_dry_[i] - armature_[i] * d_->qacc[d];
+    const double v1 = d_->qvel[d];
+    qdd_[i] = (v1 - v_before_[i]) / m_->opt.timestep;
+    tau_viscous_[i] = -viscous_[i] * v1;
+    tau_dry_[i] = f_dry_[i] - (damping_[i] - viscous_[i]) * v1;
+    tau_s_[i] = tau_motor_[i] + tau_viscous_[i] + tau_dry_[i] - armature_[i] * qdd_[i];
   }
 
   // 6. F/T sample.
@@ -558,7 +567,7 @@ void SimRobot::sample_state() {
     current_ok = current_ok && std::isfinite(state_.current_A[i]);
     truth_.q_rad[i] = q;
     truth_.qd_rad_s[i] = qd;
-    truth_.qdd_rad_s2[i] = d_->qacc[dadr_[k]];
+    truth_.qdd_rad_s2[i] = qdd_[i];
     truth_.current_A[i] = current_[i];
     truth_.tau_motor_Nm[i] = tau_motor_[i];
     truth_.tau_friction_Nm[i] = tau_viscous_[i] + tau_dry_[i];

@@ -24,12 +24,13 @@
 //   2. the drives' sensors (encoder quantisation; velocity and torque noise) and the vendor loop
 //      of the running mode give the motor current i, saturated at the drive limit;
 //   3. joint torque on the motor side: tau_m = K_T G_r i, viscous friction -b qd, and dry
-//      friction f_dry from StickSlipFriction (static level at rest, Coulomb level when sliding:
-//      a joint at rest sticks until the net torque exceeds the static level); the reflected rotor
+//      friction from StickSlipFriction (static level at rest, Coulomb level when sliding: a joint
+//      at rest sticks until the net torque exceeds the static level); the viscous and presliding
+//      dampers go through MuJoCo's joint damping (implicit in its Euler step); the reflected rotor
 //      inertia is MuJoCo's joint armature;
 //   4. external forces: scripted timeline, random pushes, the drop test's latch and cable;
 //   5. MuJoCo step (semi-implicit Euler); then the joint torque sensor value
-//        tau_s = tau_m - b qd + f_dry - I_r qdd
+//        tau_s = tau_m - b qd + f_dry - I_r qdd      (qd, qdd: the step's new velocity, (v1 - v0)/dt)
 //      i.e. the torque transmitted between the
 //      drive output and the link, with friction and rotor inertia on the motor side;
 //   6. at the F/T rate, MuJoCo's force/torque sensor at the tool origin (the interaction between the
@@ -143,6 +144,7 @@ private:
 
   // per-step buffers
   Eigen::VectorXd q_meas_, qd_meas_, tau_meas_, current_, tau_motor_, tau_viscous_, tau_dry_, tau_s_;
+  Eigen::VectorXd v_before_, f_dry_, damping_, qdd_;
   Vector6d wrench_true_ = Vector6d::Zero();
   Vector6d wrench_meas_ = Vector6d::Zero();
   std::uint32_t wrench_sequence_ = 0;

@@ -40,9 +40,9 @@ void default_vendor_gains(SimRobotConfig& c) {
     if (!out.empty()) return;
     for (int i = 0; i < n; ++i) out.push_back(c.actuators[i].size == ActuatorSize::kLarge ? large : small);
   };
-  fill(v.position_kp_Nm_per_rad, 6000.0, 1500.0);
-  fill(v.position_kd_Nms_per_rad, 60.0, 8.0);
-  fill(v.position_ki_Nm_per_rad_s, 30000.0, 7500.0);
+  fill(v.position_kp_Nm_per_rad, 12000.0, 3000.0);
+  fill(v.position_kd_Nms_per_rad, 150.0, 15.0);
+  fill(v.position_ki_Nm_per_rad_s, 60000.0, 15000.0);
   fill(v.position_integral_limit_Nm, 60.0, 30.0);
   fill(v.torque_feedback_gain, 0.5, 0.5);
   fill(v.torque_velocity_damping_Nms_per_rad, 15.0, 5.0);

@@ -135,8 +135,8 @@ struct SimRobotConfig {
     double mass_kg = 1.25;
     double radius_m = 0.04;
     double cable_length_m = 0.25;
-    double cable_stiffness_N_per_m = 2.0e4;
-    double cable_damping_Ns_per_m = 15.0;
+    double cable_stiffness_N_per_m = 2000.0;
+    double cable_damping_Ns_per_m = 10.0;
     Eigen::Vector3d anchor_m = Eigen::Vector3d(0.0, 0.0, 0.1);  ///< cable anchor, sensor frame
     double release_time_s = 1.0;
     double latch_stiffness_N_per_m = 1.0e5;  ///< holds the mass at the anchor until release
