@@ -143,6 +143,21 @@ TEST(SimRobotConfig, ErrorsNameTheKeyPath) {
   expect_config_error("plant:", "plants:", "plants");
 }
 
+TEST(SimRobotConfig, CodeBuiltConfigGetsDefaults) {
+  phri::SimRobotConfig c;
+  c.mjcf_path = kRoot + "/robots/kinova_gen3/gen3_plant.xml";
+  c.actuators = phri::ActuatorTable::from_yaml_file(kActuatorsYaml);
+  c.initial_q_rad.assign(7, 0.0);
+  EXPECT_THROW(c.validate(), phri::ConfigError);  // vendor gains missing
+  c.fill_defaults();
+  EXPECT_NO_THROW(c.validate());
+  EXPECT_DOUBLE_EQ(c.vendor.position_kp_Nm_per_rad[0], 12000.0);
+  EXPECT_DOUBLE_EQ(c.vendor.position_kp_Nm_per_rad[6], 3000.0);
+  const auto shipped = phri::SimRobotConfig::from_yaml_file(kPlantYaml);
+  EXPECT_EQ(c.vendor.position_kd_Nms_per_rad, shipped.vendor.position_kd_Nms_per_rad);
+  EXPECT_EQ(c.vendor.torque_velocity_damping_Nms_per_rad, shipped.vendor.torque_velocity_damping_Nms_per_rad);
+}
+
 TEST(SimRobotConfig, ReadsOptionalSections) {
   std::string yaml = read_file(kPlantYaml);
   yaml.replace(yaml.find("disturbances: []"), std::string("disturbances: []").size(),

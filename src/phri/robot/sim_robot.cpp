@@ -26,7 +26,8 @@ constexpr std::uint64_t kJointNoiseStream = 1;
 constexpr std::uint64_t kFtNoiseStream = 2;
 constexpr std::uint64_t kMismatchStream = 3;
 
-const SimRobotConfig& validated(const SimRobotConfig& config) {
+SimRobotConfig completed(SimRobotConfig config) {
+  config.fill_defaults();
   config.validate();
   return config;
 }
@@ -58,7 +59,7 @@ Eigen::Matrix3d rotation(const mjtNum* xmat) {
 }  // namespace
 
 SimRobot::SimRobot(const SimRobotConfig& config)
-    : config_(validated(config)),
+    : config_(completed(config)),
       plant_actuators_(config_.plant_actuators()),
       n_(config_.dof()),
       drive_(plant_actuators_, config_.vendor, config_.physics_step_s(), config_.control_period_s) {

@@ -31,24 +31,6 @@ ExternalForce::Profile parse_profile(const std::string& name) {
   return ExternalForce::Profile::kHalfSine;
 }
 
-// Defaults of the vendor loops by actuator size; see KinovaDriveEmulator and
-// robots/kinova_gen3/README.md ("Simulated plant") for why these values.
-void default_vendor_gains(SimRobotConfig& c) {
-  auto& v = c.vendor;
-  const int n = c.actuators.size();
-  auto fill = [&](std::vector<double>& out, double large, double small) {
-    if (!out.empty()) return;
-    for (int i = 0; i < n; ++i) out.push_back(c.actuators[i].size == ActuatorSize::kLarge ? large : small);
-  };
-  fill(v.position_kp_Nm_per_rad, 12000.0, 3000.0);
-  fill(v.position_kd_Nms_per_rad, 150.0, 15.0);
-  fill(v.position_ki_Nm_per_rad_s, 60000.0, 15000.0);
-  fill(v.position_integral_limit_Nm, 60.0, 30.0);
-  fill(v.torque_feedback_gain, 0.5, 0.5);
-  fill(v.torque_velocity_damping_Nms_per_rad, 15.0, 5.0);
-  if (c.noise.torque_sensor_offset_Nm.empty()) c.noise.torque_sensor_offset_Nm.assign(static_cast<std::size_t>(n), 0.0);
-}
-
 std::vector<double> per_joint(const YamlReader& r, std::string_view key, int n, double min, double max) {
   return r.numbers(key, n, min, max);
 }
@@ -256,7 +238,7 @@ SimRobotConfig parse(const YamlReader& root, const std::string& base_dir) {
     if (s.max_duration_s < s.min_duration_s) throw r.error("max_duration_s", "must be >= min_duration_s");
   }
 
-  default_vendor_gains(c);
+  c.fill_defaults();
   c.validate();
   return c;
 }
@@ -283,6 +265,24 @@ SimRobotConfig SimRobotConfig::from_yaml_file(const std::string& path) {
 SimRobotConfig SimRobotConfig::from_yaml_string(const std::string& yaml, const std::string& source_name,
                                                 const std::string& base_dir) {
   return parse(YamlReader::load_string(yaml, source_name), base_dir);
+}
+
+// Defaults of the vendor loops by actuator size; see KinovaDriveEmulator and
+// robots/kinova_gen3/README.md ("Simulated plant") for why these values.
+void SimRobotConfig::fill_defaults() {
+  auto& v = vendor;
+  const int n = actuators.size();
+  auto fill = [&](std::vector<double>& out, double large, double small) {
+    if (!out.empty()) return;
+    for (int i = 0; i < n; ++i) out.push_back(actuators[i].size == ActuatorSize::kLarge ? large : small);
+  };
+  fill(v.position_kp_Nm_per_rad, 12000.0, 3000.0);
+  fill(v.position_kd_Nms_per_rad, 150.0, 15.0);
+  fill(v.position_ki_Nm_per_rad_s, 60000.0, 15000.0);
+  fill(v.position_integral_limit_Nm, 60.0, 30.0);
+  fill(v.torque_feedback_gain, 0.5, 0.5);
+  fill(v.torque_velocity_damping_Nms_per_rad, 15.0, 5.0);
+  if (noise.torque_sensor_offset_Nm.empty()) noise.torque_sensor_offset_Nm.assign(static_cast<std::size_t>(n), 0.0);
 }
 
 int SimRobotConfig::substeps_per_cycle() const {

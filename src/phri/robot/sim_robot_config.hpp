@@ -33,6 +33,10 @@ struct SimRobotConfig {
   static SimRobotConfig from_yaml_string(const std::string& yaml, const std::string& source_name,
                                          const std::string& base_dir);
 
+  /// Fills the per-joint vectors left empty with their defaults: vendor loop gains by actuator size
+  /// (see robots/kinova_gen3/README.md), zero torque-sensor offsets. Called by the loaders and by
+  /// SimRobot's constructor, so a config built in code needs only `actuators` and `initial_q_rad`.
+  void fill_defaults();
   /// Cross-field checks (sizes, divisibility of rates, joint names); throws ConfigError with the
   /// key path. Called by the loaders and by SimRobot's constructor.
   void validate() const;
