@@ -173,6 +173,7 @@ TEST_F(ModelFiniteDifferences, InverseDynamicsIsMassMatrixTimesAccelerationPlusN
       phri::mass_matrix_solve_in_place(data, x);
       EXPECT_LT((mass * x - tau).norm(), 1e-10 * (1.0 + tau.norm()));
       EXPECT_LT((data.nonlinear_effects - h).norm(), 1e-12 * (1.0 + h.norm()));
+      EXPECT_LT((data.gravity_torque - g).norm(), 1e-12 * (1.0 + g.norm()));
     }
   }
 }
@@ -213,6 +214,30 @@ TEST_F(ModelFiniteDifferences, ChristoffelCoriolisMatchesNonlinearEffectsAndMdot
       const Eigen::MatrixXd n_matrix = mdot - 2.0 * coriolis;
       EXPECT_LT((n_matrix + n_matrix.transpose()).norm(), 1e-6 * (1.0 + mdot.norm())) << name;
       EXPECT_NEAR(qd.dot(mdot * qd), 2.0 * qd.dot(h - g), 1e-6 * (1.0 + std::abs(qd.dot(h - g)))) << name;
+    }
+  }
+}
+
+TEST_F(ModelFiniteDifferences, CoriolisTransposeTimesVelocityIsTheKineticEnergyGradient) {
+  const double eps = 1e-6;
+  for (const auto& [model, name] : robots_) {
+    phri::Data data(model);
+    for (int sample = 0; sample < 10; ++sample) {
+      const Eigen::VectorXd q = random_vector(model.nq(), 3.0, rng_);
+      const Eigen::VectorXd qd = random_vector(model.nv(), 2.0, rng_);
+      Eigen::VectorXd gradient(model.nv());
+      for (int k = 0; k < model.nv(); ++k) {
+        Eigen::VectorXd qp = q, qm = q;
+        qp[k] += eps;
+        qm[k] -= eps;
+        const double tp = 0.5 * qd.dot(phri::crba(model, data, qp) * qd);
+        const double tm = 0.5 * qd.dot(phri::crba(model, data, qm) * qd);
+        gradient[k] = (tp - tm) / (2.0 * eps);
+      }
+      // Armature does not depend on q, so the gradient is the same with or without it.
+      phri::compute_all_terms(model, data, q, qd);
+      const Eigen::VectorXd ctqd = phri::coriolis_transpose_times_velocity(model, data);
+      EXPECT_LT((ctqd - gradient).norm(), 1e-6 * (1.0 + gradient.norm())) << name;
     }
   }
 }
@@ -441,6 +466,7 @@ TEST(ModelAllocation, AlgorithmsDoNotAllocate) {
     phri::test::NoMallocScope no_malloc;
     for (int repeat = 0; repeat < 3; ++repeat) {
       phri::compute_all_terms(model, data, q, qd);
+      phri::coriolis_transpose_times_velocity(model, data);
       phri::frame_jacobian(model, data, ee, ReferenceFrame::kLocalWorldAligned, jacobian);
       phri::frame_jacobian(model, data, ee, ReferenceFrame::kLocal, jacobian);
       sink += phri::frame_jdot_qdot(model, data, ee, ReferenceFrame::kLocalWorldAligned);

@@ -126,6 +126,7 @@ public:
     return out;
   }
   const mjModel* model() const { return m_; }
+  mjModel* model_mutable() { return m_; }
   mjData* data() { return d_; }
 
 private:

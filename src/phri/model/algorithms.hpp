@@ -40,6 +40,16 @@ inline Vector6d frame_jdot_qdot(const Model& model, const Data& data, int frame_
 void frame_jacobian(const Model& model, const Data& data, int frame_id, ReferenceFrame rf,
                     Eigen::Ref<Eigen::MatrixXd> jacobian);
 
+/// 3 x nv linear Jacobian of the point of `body` (-1: the base) now at world position `point`:
+/// its velocity in world axes is jacobian * qd (after forward_kinematics).
+void body_point_linear_jacobian(const Model& model, const Data& data, int body, const Eigen::Vector3d& point,
+                                Eigen::Ref<Eigen::MatrixXd> jacobian);
+/// Velocity of that body point (after forward_kinematics with qd).
+Eigen::Vector3d body_point_velocity(const Model& model, const Data& data, int body, const Eigen::Vector3d& point);
+/// Classical acceleration of that body point with the accelerations in data; with qdd = 0 (after
+/// compute_all_terms) it is the point's J̇ q̇.
+Eigen::Vector3d body_point_jdot_qdot(const Model& model, const Data& data, int body, const Eigen::Vector3d& point);
+
 // ---- dynamics --------------------------------------------------------------------------
 /// Joint-space inertia matrix M(q) (composite rigid-body algorithm), into data.mass_matrix.
 const Eigen::MatrixXd& crba(const Model& model, Data& data, const Eigen::VectorXd& q);
@@ -54,11 +64,16 @@ const Eigen::VectorXd& rnea(const Model& model, Data& data, const Eigen::VectorX
 /// h(q, qd) = C(q, qd) qd + g(q), into data.nonlinear_effects.
 const Eigen::VectorXd& nonlinear_effects(const Model& model, Data& data, const Eigen::VectorXd& q,
                                          const Eigen::VectorXd& qd);
-/// g(q), into data.gravity_torque.
+/// g(q), into data.gravity_torque (body velocities and accelerations in data are kept).
 const Eigen::VectorXd& compute_gravity(const Model& model, Data& data, const Eigen::VectorXd& q);
 
+/// C(q, qd)^T qd, which equals dT/dq (T the kinetic energy): the term the generalized-momentum
+/// observer needs, since dp/dt = tau + C^T qd - g for p = M qd. Uses the velocities and body
+/// inertias in data (after compute_all_terms or nonlinear_effects); writes data.coriolis_transpose_qd.
+const Eigen::VectorXd& coriolis_transpose_times_velocity(const Model& model, Data& data);
+
 /// One pass for the controller: placements of bodies and frames, velocities, drift accelerations
-/// (so frame_jdot_qdot works), M(q) and its Cholesky factor, h(q, qd). Returns false if M is
+/// (so frame_jdot_qdot works), M(q) and its Cholesky factor, h(q, qd), g(q). Returns false if M is
 /// not positive definite (which a valid model never gives).
 bool compute_all_terms(const Model& model, Data& data, const Eigen::VectorXd& q,
                        const Eigen::VectorXd& qd);

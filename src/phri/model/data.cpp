@@ -15,7 +15,8 @@ Data::Data(const Model& model)
       mass_matrix_llt(model.nv()),
       tau(Eigen::VectorXd::Zero(model.nv())),
       nonlinear_effects(Eigen::VectorXd::Zero(model.nv())),
-      gravity_torque(Eigen::VectorXd::Zero(model.nv())) {
+      gravity_torque(Eigen::VectorXd::Zero(model.nv())),
+      coriolis_transpose_qd(Eigen::VectorXd::Zero(model.nv())) {
   // Factor the identity once so that the LLT object owns a correctly sized buffer.
   mass_matrix_llt.compute(Eigen::MatrixXd::Identity(model.nv(), model.nv()));
 }

@@ -29,6 +29,7 @@ struct Data {
   Eigen::VectorXd tau;                ///< rnea output
   Eigen::VectorXd nonlinear_effects;  ///< h(q, qd) = C(q, qd) qd + g(q)
   Eigen::VectorXd gravity_torque;     ///< g(q)
+  Eigen::VectorXd coriolis_transpose_qd;  ///< C(q, qd)^T qd (coriolis_transpose_times_velocity)
 };
 
 }  // namespace phri

@@ -56,6 +56,17 @@ void newton_euler_backward(const Model& model, Data& data, const Eigen::VectorXd
   }
 }
 
+// g(q) from the body inertias alone (velocities and accelerations in data are left untouched).
+void gravity_backward(const Model& model, Data& data) {
+  Vector6d base_acceleration;
+  base_acceleration << -model.gravity(), Eigen::Vector3d::Zero();
+  Vector6d force = Vector6d::Zero();
+  for (int i = model.nq() - 1; i >= 0; --i) {
+    force += data.body_inertias[static_cast<std::size_t>(i)].apply(base_acceleration);
+    data.gravity_torque[i] = data.motion_subspace.col(i).dot(force);
+  }
+}
+
 }  // namespace
 
 const Eigen::MatrixXd& crba(const Model& model, Data& data, const Eigen::VectorXd& q) {
@@ -98,17 +109,34 @@ const Eigen::VectorXd& nonlinear_effects(const Model& model, Data& data, const E
 
 const Eigen::VectorXd& compute_gravity(const Model& model, Data& data, const Eigen::VectorXd& q) {
   forward_kinematics(model, data, q);
-  data.body_velocities.setZero();
-  data.body_accelerations.setZero();
   update_body_inertias(model, data);
-  newton_euler_backward(model, data, nullptr, data.gravity_torque);
+  gravity_backward(model, data);
   return data.gravity_torque;
+}
+
+const Eigen::VectorXd& coriolis_transpose_times_velocity(const Model& model, Data& data) {
+  // T = sum_j 1/2 v_j' I_j v_j. Joint i turns every body j >= i; in body coordinates the inertia is
+  // constant and the body velocity changes by -(S_i x v_{i-1}), so dT/dq_i = (v_{i-1} x S_i) . H_i
+  // with H_i = sum_{j >= i} I_j v_j the momentum of the subtree (a running sum on a chain).
+  Vector6d momentum = Vector6d::Zero();
+  for (int i = model.nq() - 1; i >= 0; --i) {
+    const WorldInertia& inertia = data.body_inertias[static_cast<std::size_t>(i)];
+    momentum += inertia.apply(data.body_velocities.col(i));
+    if (i == 0) {
+      data.coriolis_transpose_qd[i] = 0.0;  // the base does not move
+    } else {
+      data.coriolis_transpose_qd[i] =
+          motion_cross(data.body_velocities.col(i - 1), data.motion_subspace.col(i)).dot(momentum);
+    }
+  }
+  return data.coriolis_transpose_qd;
 }
 
 bool compute_all_terms(const Model& model, Data& data, const Eigen::VectorXd& q,
                        const Eigen::VectorXd& qd) {
   nonlinear_effects(model, data, q, qd);  // placements, velocities, drift accelerations, inertias
   update_frame_placements(model, data);
+  gravity_backward(model, data);
   composite_rigid_body(model, data);
   return compute_mass_matrix_cholesky(data);
 }

@@ -132,4 +132,29 @@ void frame_jacobian(const Model& model, const Data& data, int frame_id, Referenc
   }
 }
 
+void body_point_linear_jacobian([[maybe_unused]] const Model& model, const Data& data, int body, const Eigen::Vector3d& point,
+                                Eigen::Ref<Eigen::MatrixXd> jacobian) {
+  assert(jacobian.rows() == 3 && jacobian.cols() == model.nv());
+  jacobian.setZero();
+  for (int j = 0; j <= body; ++j) {
+    const auto s = data.motion_subspace.col(j);
+    jacobian.col(j) = s.head<3>() + s.tail<3>().cross(point);
+  }
+}
+
+Eigen::Vector3d body_point_velocity(const Model&, const Data& data, int body, const Eigen::Vector3d& point) {
+  if (body < 0) return Eigen::Vector3d::Zero();
+  const auto v = data.body_velocities.col(body);
+  return v.head<3>() + v.tail<3>().cross(point);
+}
+
+Eigen::Vector3d body_point_jdot_qdot(const Model&, const Data& data, int body, const Eigen::Vector3d& point) {
+  if (body < 0) return Eigen::Vector3d::Zero();
+  const auto v = data.body_velocities.col(body);
+  const auto a = data.body_accelerations.col(body);
+  const Eigen::Vector3d w = v.tail<3>();
+  const Eigen::Vector3d v_point = v.head<3>() + w.cross(point);
+  return a.head<3>() + a.tail<3>().cross(point) + w.cross(v_point);
+}
+
 }  // namespace phri

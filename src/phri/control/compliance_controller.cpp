@@ -1,0 +1,94 @@
+#include <phri/control/compliance_controller.hpp>
+
+#include <phri/core/config_error.hpp>
+
+#include <algorithm>
+#include <cmath>
+
+namespace phri {
+
+ComplianceController::ComplianceController(const ComplianceSettings& settings) : settings_(settings) {
+  auto fail = [](const std::string& key, const std::string& reason) { throw ConfigError("ComplianceSettings", key, reason); };
+  if (!(settings.release_threshold >= 0 && settings.release_threshold < settings.touch_threshold)) {
+    fail("release_threshold", "need 0 <= release_threshold < touch_threshold");
+  }
+  for (double v : {settings.ee_position_stiffness, settings.ee_orientation_stiffness, settings.ee_weight,
+                   settings.full_body_ee_stiffness, settings.posture_stiffness, settings.posture_damping,
+                   settings.posture_weight, settings.touched_ee_damping, settings.touched_posture_damping}) {
+    if (!(v >= 0) || !std::isfinite(v)) fail("gains", "stiffness, damping and weights must be finite and >= 0");
+  }
+  if (!(settings.posture_weight > 0)) fail("posture_weight", "must be > 0 (it keeps the QP strictly convex)");
+}
+
+void ComplianceController::apply(WholeBodyQp& qp) {
+  EndEffectorTask& ee = qp.end_effector();
+  PostureTask& posture = qp.posture();
+  const bool ee_free = mode_ == ComplianceMode::kDual && touched_;
+  const double gamma_ee = (mode_ == ComplianceMode::kFullBody || ee_free) ? 1.0 : 0.0;
+  const double gamma_posture = mode_ == ComplianceMode::kStiff ? 0.0 : 1.0;
+  Vector6d stiffness;
+  if (ee_free) {
+    stiffness.setZero();
+  } else if (mode_ == ComplianceMode::kFullBody) {
+    stiffness.setConstant(settings_.full_body_ee_stiffness * stiffness_scale_);
+  } else {
+    stiffness << Eigen::Vector3d::Constant(settings_.ee_position_stiffness * stiffness_scale_),
+        Eigen::Vector3d::Constant(settings_.ee_orientation_stiffness * stiffness_scale_);
+  }
+  ee.set_stiffness(stiffness);
+  if (ee_free) {
+    ee.set_damping(Vector6d::Constant(settings_.touched_ee_damping));
+  } else {
+    ee.set_critical_damping();
+  }
+  ee.set_weight(settings_.ee_weight);
+  ee.set_gamma(Vector6d::Constant(gamma_ee));
+  posture.set_stiffness(settings_.posture_stiffness);
+  posture.set_damping(ee_free ? settings_.touched_posture_damping : settings_.posture_damping);
+  posture.set_weight(settings_.posture_weight);
+  posture.set_gamma(gamma_posture);
+}
+
+void ComplianceController::initialise(ComplianceMode mode, WholeBodyQp& qp, const Data& data) {
+  mode_ = mode;
+  touched_ = false;
+  apply(qp);
+  // Start at the set values rather than filtering from zero.
+  EndEffectorTask& ee = qp.end_effector();
+  ee.reset_gains(ee.stiffness_target(), 2.0 * ee.stiffness_target().cwiseSqrt(), settings_.ee_weight,
+                 Vector6d::Constant(mode == ComplianceMode::kFullBody ? 1.0 : 0.0));
+  qp.posture().reset_gains(settings_.posture_stiffness, settings_.posture_damping, settings_.posture_weight,
+                           mode == ComplianceMode::kStiff ? 0.0 : 1.0);
+  ee.hold_current_pose(data);
+}
+
+void ComplianceController::set_mode(ComplianceMode mode, WholeBodyQp& qp, const Data& data) {
+  if (mode == mode_) return;
+  if (touched_) qp.end_effector().hold_current_pose(data);
+  mode_ = mode;
+  touched_ = false;
+  apply(qp);
+}
+
+void ComplianceController::set_stiffness_scale(double scale, WholeBodyQp& qp) {
+  stiffness_scale_ = std::clamp(scale, 0.1, 4.0);
+  apply(qp);
+}
+
+void ComplianceController::update(double wrench_norm, WholeBodyQp& qp, const Data& data) {
+  if (mode_ != ComplianceMode::kDual) return;
+  if (!std::isfinite(wrench_norm)) return;  // a bad sample changes nothing
+  if (!touched_ && wrench_norm >= settings_.touch_threshold) {
+    touched_ = true;
+    ++touch_count_;
+    apply(qp);
+  } else if (touched_ && wrench_norm < settings_.release_threshold) {
+    touched_ = false;
+    qp.end_effector().hold_current_pose(data);  // the pose at release is the new target
+    apply(qp);
+  }
+  // While touched the target follows the hand, so nothing pulls back when the stiffness returns.
+  if (touched_) qp.end_effector().hold_current_pose(data);
+}
+
+}  // namespace phri

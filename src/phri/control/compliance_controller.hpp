@@ -1,0 +1,61 @@
+#pragma once
+// Applies a compliance mode to the QP's tasks (gammas, gains) and runs dual compliance: a Schmitt
+// trigger on the end-effector wrench norm (paper: "touched" above the high threshold, released
+// below the low one). While touched the end-effector task has zero stiffness, low damping and
+// gamma 1, so the hand drags it; on release the pose at release becomes the target and the mode is
+// null-space compliance again. Every gain change goes through the tasks' smoothing filters.
+#include <phri/control/compliance_mode.hpp>
+#include <phri/control/whole_body_qp.hpp>
+
+namespace phri {
+
+struct ComplianceSettings {
+  // End-effector task when it holds its pose (paper demo, NS mode: K 400, W 1e4).
+  double ee_position_stiffness = 400.0;     ///< 1/s^2
+  double ee_orientation_stiffness = 400.0;  ///< 1/s^2
+  double ee_weight = 1e4;
+  /// Full-body compliance: a softer end effector (paper demo, Compliance state: K 30).
+  double full_body_ee_stiffness = 30.0;
+  /// Posture task (weight 1): a weak spring so that a pushed elbow comes back.
+  double posture_stiffness = 10.0;
+  double posture_damping = 6.0;
+  double posture_weight = 1.0;
+  // Dual compliance (paper: 8 up, 4 down on the 6-D wrench norm; touched EE damping 15,
+  // posture damping 2).
+  double touch_threshold = 8.0;
+  double release_threshold = 4.0;
+  double touched_ee_damping = 15.0;
+  double touched_posture_damping = 2.0;
+};
+
+class ComplianceController {
+public:
+  /// Throws ConfigError on inconsistent settings (release >= touch, negative gains).
+  explicit ComplianceController(const ComplianceSettings& settings);
+
+  /// Initial gains, no smoothing (before the first cycle).
+  void initialise(ComplianceMode mode, WholeBodyQp& qp, const Data& data);
+  /// Changes mode (smoothly, from the next cycle on).
+  void set_mode(ComplianceMode mode, WholeBodyQp& qp, const Data& data);
+  /// Once per cycle before qp.update: wrench_norm is the end-effector wrench's norm (F/T).
+  void update(double wrench_norm, WholeBodyQp& qp, const Data& data);
+
+  ComplianceMode mode() const { return mode_; }
+  bool touched() const { return touched_; }
+  /// How many times dual compliance entered and left the touched state.
+  int touch_count() const { return touch_count_; }
+  const ComplianceSettings& settings() const { return settings_; }
+  void set_stiffness_scale(double scale, WholeBodyQp& qp);  ///< live stiffness up/down (gamepad)
+  double stiffness_scale() const { return stiffness_scale_; }
+
+private:
+  void apply(WholeBodyQp& qp);
+
+  ComplianceSettings settings_;
+  ComplianceMode mode_ = ComplianceMode::kNullSpace;
+  bool touched_ = false;
+  int touch_count_ = 0;
+  double stiffness_scale_ = 1.0;
+};
+
+}  // namespace phri

@@ -1,0 +1,34 @@
+#pragma once
+// The paper's compliance modes (section "Control Modes"): which tasks let an external push
+// through (gamma = 1) and which negate it (gamma = 0).
+#include <optional>
+#include <string_view>
+
+namespace phri {
+
+enum class ComplianceMode {
+  kStiff,      ///< gamma_EE = 0, gamma_posture = 0: every push is negated
+  kNullSpace,  ///< gamma_EE = 0, gamma_posture = 1: the posture yields, the end effector holds
+  kFullBody,   ///< gamma_EE = 1, gamma_posture = 1: impedance-like everywhere
+  kDual,       ///< null-space compliance; the end effector becomes free while it is touched
+};
+
+constexpr std::string_view to_string(ComplianceMode mode) {
+  switch (mode) {
+    case ComplianceMode::kStiff: return "stiff";
+    case ComplianceMode::kNullSpace: return "null_space";
+    case ComplianceMode::kFullBody: return "full_body";
+    case ComplianceMode::kDual: return "dual";
+  }
+  return "unknown";
+}
+
+constexpr std::optional<ComplianceMode> compliance_mode_from_string(std::string_view name) {
+  if (name == "stiff") return ComplianceMode::kStiff;
+  if (name == "null_space") return ComplianceMode::kNullSpace;
+  if (name == "full_body") return ComplianceMode::kFullBody;
+  if (name == "dual") return ComplianceMode::kDual;
+  return std::nullopt;
+}
+
+}  // namespace phri

@@ -1,0 +1,104 @@
+#pragma once
+// End-effector pose task of the compliant QP (paper eq. compliantQP, task k):
+//
+//   w || J qdd + J̇ qd - ë* - gamma J M^-1 tau_ext ||^2,   ë* = a_ff + K e + D (v* - v)
+//
+// in world axes (local-world-aligned Jacobian, linear rows first): e = (p* - p, log(R* R^T)).
+// Stiffness K and damping D per axis, gamma per axis in [0, 1], one weight. Gains, weight and
+// gamma follow their set values through a first-order filter (SmoothedVector) so that changing
+// them never steps the torque. Targets: a streamed trajectory (pose, velocity, feed-forward
+// acceleration moving continuously) is tracked as given; a target that jumps is approached by a
+// reference governor with bounded speed and acceleration (TargetLimits), so a new far target
+// never steps the torque either.
+#include <phri/control/smoothed_vector.hpp>
+#include <phri/model/data.hpp>
+#include <phri/model/model.hpp>
+#include <phri/model/spatial.hpp>
+
+namespace phri {
+
+/// Bounds of the reference governor that moves the task's target toward a target that jumped.
+struct TargetLimits {
+  double linear_speed = 0.25;          ///< m/s
+  double linear_acceleration = 0.5;    ///< m/s^2
+  double angular_speed = 0.8;          ///< rad/s
+  double angular_acceleration = 1.6;   ///< rad/s^2
+};
+
+class EndEffectorTask {
+public:
+  EndEffectorTask(const Model& model, int frame_id, double smoothing_time_constant = 0.1,
+                  const TargetLimits& limits = {});
+
+  int frame_id() const { return frame_id_; }
+
+  // ---- gains (smoothed)
+  void set_stiffness(const Vector6d& stiffness);
+  void set_damping(const Vector6d& damping);
+  /// Damping 2 sqrt(K) per axis, for the stiffness just set.
+  void set_critical_damping();
+  void set_weight(double weight);
+  void set_gamma(const Vector6d& gamma);
+  void reset_gains(const Vector6d& stiffness, const Vector6d& damping, double weight, const Vector6d& gamma);
+  Vector6d stiffness() const { return stiffness_.value(); }
+  Vector6d damping() const { return damping_.value(); }
+  double weight() const { return weight_.value()[0]; }
+  Vector6d gamma() const { return gamma_.value(); }
+  Vector6d stiffness_target() const { return stiffness_.target(); }
+
+  // ---- targets
+  /// A trajectory point: pose, twist (linear; angular, world axes) and acceleration feed-forward.
+  void set_target(const Eigen::Isometry3d& pose, const Vector6d& velocity = Vector6d::Zero(),
+                  const Vector6d& acceleration = Vector6d::Zero());
+  /// Holds the current pose (after update or compute_all_terms), zero velocity, immediately.
+  void hold_current_pose(const Data& data);
+  /// The target the task tracks now (the governor's, equal to the set one once reached).
+  const Eigen::Isometry3d& target_pose() const { return target_pose_; }
+  /// The target last set.
+  const Eigen::Isometry3d& commanded_pose() const { return commanded_pose_; }
+  /// Velocity of the tracked target (world axes, linear first).
+  const Vector6d& target_velocity() const { return target_velocity_; }
+  /// True when the tracked target is the one last set (the governor has arrived).
+  bool target_reached() const;
+
+  // ---- per cycle
+  /// data after compute_all_terms; qdd_external = M^-1 tau_ext; advances the gain filters by dt.
+  void update(const Model& model, const Data& data, const Eigen::VectorXd& qdd_external, double dt);
+  const Eigen::MatrixXd& jacobian() const { return jacobian_; }
+  /// What J qdd should equal: ë* - J̇ qd + gamma J qdd_external.
+  const Vector6d& reference() const { return reference_; }
+  /// Pose error (p* - p; log(R* R^T)) and velocity (v; w) of the last update.
+  const Vector6d& error() const { return error_; }
+  const Vector6d& velocity() const { return velocity_; }
+  const Eigen::Isometry3d& pose() const { return pose_; }
+
+private:
+  void govern_target(double dt);
+
+  int frame_id_;
+  TargetLimits limits_;
+  Eigen::Isometry3d commanded_pose_ = Eigen::Isometry3d::Identity();
+  Vector6d commanded_velocity_ = Vector6d::Zero();
+  Vector6d commanded_acceleration_ = Vector6d::Zero();
+  bool tracking_position_ = true;
+  bool tracking_rotation_ = true;
+  double governor_linear_speed_ = 0.0;
+  double governor_angular_speed_ = 0.0;
+  SmoothedVector stiffness_;
+  SmoothedVector damping_;
+  SmoothedVector weight_;
+  SmoothedVector gamma_;
+  Eigen::Isometry3d target_pose_ = Eigen::Isometry3d::Identity();
+  Vector6d target_velocity_ = Vector6d::Zero();
+  Vector6d target_acceleration_ = Vector6d::Zero();
+  Eigen::MatrixXd jacobian_;
+  Vector6d reference_ = Vector6d::Zero();
+  Vector6d error_ = Vector6d::Zero();
+  Vector6d velocity_ = Vector6d::Zero();
+  Eigen::Isometry3d pose_ = Eigen::Isometry3d::Identity();
+};
+
+/// log(R) as a rotation vector (angle * axis), angle in [0, pi].
+Eigen::Vector3d rotation_log(const Eigen::Matrix3d& rotation);
+
+}  // namespace phri

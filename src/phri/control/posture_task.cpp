@@ -1,0 +1,59 @@
+#include <phri/control/posture_task.hpp>
+
+#include <algorithm>
+#include <cmath>
+
+namespace phri {
+
+PostureTask::PostureTask(const Model& model, double smoothing_time_constant)
+    : nv_(model.nv()),
+      stiffness_(Eigen::VectorXd::Zero(model.nv()), smoothing_time_constant),
+      damping_(Eigen::VectorXd::Zero(model.nv()), smoothing_time_constant),
+      weight_(Eigen::VectorXd::Ones(1), smoothing_time_constant),
+      gamma_(Eigen::VectorXd::Zero(1), smoothing_time_constant),
+      target_q_(Eigen::VectorXd::Zero(model.nv())),
+      target_qd_(Eigen::VectorXd::Zero(model.nv())),
+      target_qdd_(Eigen::VectorXd::Zero(model.nv())),
+      error_(Eigen::VectorXd::Zero(model.nv())),
+      reference_(Eigen::VectorXd::Zero(model.nv())) {
+  for (const Joint& j : model.joints()) continuous_.push_back(j.type == JointType::kContinuous);
+}
+
+void PostureTask::set_stiffness(const Eigen::VectorXd& stiffness) { stiffness_.set_target(stiffness); }
+void PostureTask::set_damping(const Eigen::VectorXd& damping) { damping_.set_target(damping); }
+void PostureTask::set_weight(double weight) { weight_.set_target_constant(weight); }
+void PostureTask::set_gamma(double gamma) { gamma_.set_target_constant(std::clamp(gamma, 0.0, 1.0)); }
+void PostureTask::reset_gains(double stiffness, double damping, double weight, double gamma) {
+  stiffness_.reset(Eigen::VectorXd::Constant(nv_, stiffness));
+  damping_.reset(Eigen::VectorXd::Constant(nv_, damping));
+  weight_.reset(Eigen::VectorXd::Constant(1, weight));
+  gamma_.reset(Eigen::VectorXd::Constant(1, std::clamp(gamma, 0.0, 1.0)));
+}
+
+void PostureTask::set_target(const Eigen::VectorXd& q, const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd) {
+  target_q_ = q;
+  target_qd_ = qd;
+  target_qdd_ = qdd;
+}
+void PostureTask::set_target(const Eigen::VectorXd& q) {
+  target_q_ = q;
+  target_qd_.setZero();
+  target_qdd_.setZero();
+}
+
+void PostureTask::update(const Eigen::VectorXd& q, const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd_external,
+                         double dt) {
+  stiffness_.step(dt);
+  damping_.step(dt);
+  weight_.step(dt);
+  gamma_.step(dt);
+  for (int i = 0; i < nv_; ++i) {
+    double e = target_q_[i] - q[i];
+    if (continuous_[static_cast<std::size_t>(i)]) e = std::remainder(e, 2.0 * M_PI);
+    error_[i] = e;
+  }
+  reference_ = target_qdd_ + stiffness_.value().cwiseProduct(error_) + damping_.value().cwiseProduct(target_qd_ - qd) +
+               gamma_.value()[0] * qdd_external;
+}
+
+}  // namespace phri

@@ -1,0 +1,50 @@
+#pragma once
+// Posture task of the compliant QP (paper eq. compliantQP, the w_0 term):
+//
+//   w_0 || qdd - qdd* - gamma_0 M^-1 tau_ext ||^2,   qdd* = qdd_ff + K (q* - q) + D (qd* - qd)
+//
+// The error of a continuous joint is wrapped to (-pi, pi] so the posture never asks for a full
+// turn. Gains, weight and gamma are smoothed like the end-effector task's.
+#include <phri/control/smoothed_vector.hpp>
+#include <phri/model/model.hpp>
+
+namespace phri {
+
+class PostureTask {
+public:
+  PostureTask(const Model& model, double smoothing_time_constant = 0.1);
+
+  void set_stiffness(const Eigen::VectorXd& stiffness);
+  void set_stiffness(double stiffness) { set_stiffness(Eigen::VectorXd::Constant(nv_, stiffness)); }
+  void set_damping(const Eigen::VectorXd& damping);
+  void set_damping(double damping) { set_damping(Eigen::VectorXd::Constant(nv_, damping)); }
+  void set_weight(double weight);
+  void set_gamma(double gamma);
+  void reset_gains(double stiffness, double damping, double weight, double gamma);
+  double weight() const { return weight_.value()[0]; }
+  double gamma() const { return gamma_.value()[0]; }
+  const Eigen::VectorXd& stiffness() const { return stiffness_.value(); }
+  const Eigen::VectorXd& damping() const { return damping_.value(); }
+
+  void set_target(const Eigen::VectorXd& q, const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd);
+  void set_target(const Eigen::VectorXd& q);
+  const Eigen::VectorXd& target() const { return target_q_; }
+
+  void update(const Eigen::VectorXd& q, const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd_external, double dt);
+  /// What qdd should equal: qdd* + gamma_0 M^-1 tau_ext.
+  const Eigen::VectorXd& reference() const { return reference_; }
+  const Eigen::VectorXd& error() const { return error_; }
+
+private:
+  int nv_;
+  std::vector<bool> continuous_;
+  SmoothedVector stiffness_;
+  SmoothedVector damping_;
+  SmoothedVector weight_;
+  SmoothedVector gamma_;
+  Eigen::VectorXd target_q_, target_qd_, target_qdd_;
+  Eigen::VectorXd error_;
+  Eigen::VectorXd reference_;
+};
+
+}  // namespace phri

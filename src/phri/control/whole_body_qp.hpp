@@ -1,0 +1,131 @@
+#pragma once
+// phri::WholeBodyQp: the paper's second-order compliant QP (section "Compliance Tasks", eq.
+// compliantQP) with its stiff safety constraints (section "Safety Features"), and the inverse
+// dynamics that turns the optimal acceleration into the desired joint torque.
+//
+//   min_qdd  w_EE || J qdd + J̇ qd - ë* - gamma_EE J qdd_ext ||^2 + w_0 || qdd - qdd* - gamma_0 qdd_ext ||^2
+//   s.t.     joint limits:   second-order velocity damper on q (eq. sec-order-vel-damp)
+//            velocity:       qdd bounded so that qd converges to within the velocity limits
+//            torque:         tau_min <= M qdd + h - tau_ext <= tau_max
+//            self-collision: the same damper on each capsule-pair distance d (J_d qdd + J̇_d qd)
+//   with qdd_ext = M^-1 tau_ext (tau_ext from the momentum observer).
+//
+// Output convention: tau_d = M(q) qdd_d + h(q, qd) - tau_ext. This is the torque the link side of
+// the joints (the torque sensors) must carry so that, with the external torque tau_ext acting as
+// well, the arm accelerates at qdd_d: M qdd = tau_d + tau_ext - h. M and h here are link-side
+// (no rotor inertia); the low-level loop adds I_r qdd_d on the motor side.
+//
+// Constraints carry no gamma: they hold the *real* acceleration (push included) within bounds,
+// so a push toward a limit is negated. The velocity damper, for a distance e to a limit (e >= d_s
+// wanted), asks ë >= -lambda^2/(4 M^2) (e - d_s) - lambda ė with lambda = 4 M^2 xi / (d_i - d_s)
+// (M > 1: overdamped; xi: the approach speed allowed at the influence distance d_i).
+#include <phri/control/end_effector_task.hpp>
+#include <phri/control/posture_task.hpp>
+#include <phri/model/collision_model.hpp>
+#include <phri/model/data.hpp>
+#include <phri/model/model.hpp>
+#include <phri/qp/qp_problem.hpp>
+#include <phri/qp/qp_solver.hpp>
+
+#include <optional>
+#include <string_view>
+
+namespace phri {
+
+struct VelocityDamperSettings {
+  double influence_distance = 0.0;  ///< d_i (rad for joints, m for distances)
+  double safety_distance = 0.0;     ///< d_s < d_i
+  double xi = 0.0;                  ///< approach speed allowed at d_i (rad/s or m/s)
+  double amortization = 1.8;        ///< M > 1 (paper's demo value 1.8)
+  double lambda() const { return 4.0 * amortization * amortization * xi / (influence_distance - safety_distance); }
+};
+
+struct WholeBodyQpSettings {
+  std::string end_effector_frame = "end_effector_link";
+  Eigen::VectorXd torque_limit;    ///< |tau_d| bound per joint (N.m); empty: the URDF effort limits
+  Eigen::VectorXd velocity_limit;  ///< per joint (rad/s), before the fraction; empty: URDF limits
+  double velocity_limit_fraction = 0.9;  ///< paper: 0.9 of the robot's limits
+  /// Joint limits: d_i and d_s as fractions of the joint range (paper: 0.1 and 0.01); xi per
+  /// joint = its (scaled) velocity limit, so the damper lets the joint arrive at full speed at d_i.
+  double joint_influence_fraction = 0.1;
+  double joint_safety_fraction = 0.01;
+  double joint_damper_amortization = 1.8;
+  /// lambda of the velocity-limit constraint for continuous joints (limited joints use their damper's).
+  double velocity_limit_gain = 50.0;
+  /// Self-collision damper (paper: d_i 0.03 m, d_s 0.015 m, M 1.8; xi 0.08 m/s gives its lambda ~ 70).
+  VelocityDamperSettings collision{0.03, 0.015, 0.08, 1.8};
+  double regularization = 1e-9;   ///< added to the Hessian's diagonal
+  double brake_damping = 20.0;    ///< 1/s, the fallback's joint damping brake
+  double smoothing_time_constant = 0.1;  ///< s, of the tasks' gain filters
+};
+
+enum class ControllerStatus {
+  kOk,
+  kQpInfeasible,       ///< fallback brake used
+  kQpIterationLimit,   ///< fallback brake used
+  kQpFailed,           ///< invalid QP data (NaN) or numerical error: fallback brake used
+  kInvalidInput,       ///< non-finite state or tau_ext: last finite command held
+};
+constexpr std::string_view to_string(ControllerStatus status) {
+  switch (status) {
+    case ControllerStatus::kOk: return "ok";
+    case ControllerStatus::kQpInfeasible: return "qp_infeasible";
+    case ControllerStatus::kQpIterationLimit: return "qp_iteration_limit";
+    case ControllerStatus::kQpFailed: return "qp_failed";
+    case ControllerStatus::kInvalidInput: return "invalid_input";
+  }
+  return "unknown";
+}
+
+class WholeBodyQp {
+public:
+  /// collision may be null (no self-collision constraint). Throws ConfigError on bad settings.
+  WholeBodyQp(const Model& model, const CollisionModel* collision, const WholeBodyQpSettings& settings);
+
+  EndEffectorTask& end_effector() { return end_effector_; }
+  PostureTask& posture() { return posture_; }
+  const EndEffectorTask& end_effector() const { return end_effector_; }
+  const PostureTask& posture() const { return posture_; }
+
+  /// One control cycle. `data`: after compute_all_terms(q, qd) on the controller's (link-side)
+  /// model; tau_ext: estimated external torque. Returns the status; results below.
+  ControllerStatus update(const Model& model, const Data& data, const Eigen::VectorXd& q, const Eigen::VectorXd& qd,
+                          const Eigen::VectorXd& tau_ext, double dt);
+
+  const Eigen::VectorXd& desired_acceleration() const { return qdd_desired_; }
+  const Eigen::VectorXd& desired_torque() const { return tau_desired_; }
+  const Eigen::VectorXd& external_acceleration() const { return qdd_external_; }
+  ControllerStatus status() const { return status_; }
+  QpStatus qp_status() const { return solver_.status(); }
+  int qp_iterations() const { return solver_.iterations(); }
+  const CollisionData* collision_data() const { return collision_data_ ? &*collision_data_ : nullptr; }
+  const Eigen::VectorXd& torque_limit() const { return torque_limit_; }
+  const Eigen::VectorXd& velocity_limit() const { return velocity_limit_; }
+  /// Joint position bounds the dampers keep: limit -+ d_s (infinite for continuous joints).
+  const Eigen::VectorXd& safe_lower() const { return safe_lower_; }
+  const Eigen::VectorXd& safe_upper() const { return safe_upper_; }
+  const WholeBodyQpSettings& settings() const { return settings_; }
+
+private:
+  void joint_bounds(const Eigen::VectorXd& q, const Eigen::VectorXd& qd);
+  void fallback_brake(const Data& data, const Eigen::VectorXd& qd, const Eigen::VectorXd& tau_ext);
+
+  WholeBodyQpSettings settings_;
+  const CollisionModel* collision_;
+  std::optional<CollisionData> collision_data_;
+  EndEffectorTask end_effector_;
+  PostureTask posture_;
+  int nv_;
+  int num_pairs_;
+  Eigen::VectorXd torque_limit_, velocity_limit_;
+  Eigen::VectorXd lower_, upper_, influence_, safety_, lambda_;  // joint damper per joint
+  Eigen::VectorXd safe_lower_, safe_upper_;
+  QpProblem problem_;
+  QpSolver solver_;
+  Eigen::VectorXd qdd_external_, qdd_desired_, tau_desired_, last_good_tau_;
+  Eigen::MatrixXd weighted_jacobian_;  // 6 x nv scratch
+  ControllerStatus status_ = ControllerStatus::kOk;
+  bool warm_ = false;
+};
+
+}  // namespace phri

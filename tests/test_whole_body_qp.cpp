@@ -1,0 +1,229 @@
+// ctest-labels: unit
+// The compliant QP against closed forms: the unconstrained optimum of the weighted least squares,
+// the effect of gamma on tau_d (compliant tasks let the push through exactly, stiff ones negate it
+// exactly), the dampers' bounds, torque limits, the fallback, and zero allocation per cycle.
+#include <phri/control/compliance_controller.hpp>
+#include <phri/control/momentum_observer.hpp>
+#include <phri/control/whole_body_qp.hpp>
+#include <phri/core/config_error.hpp>
+#include <phri/model/algorithms.hpp>
+
+#include "allocation_counter.hpp"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+namespace {
+
+const std::string kGen3 = std::string(PHRI_SOURCE_DIR) + "/robots/kinova_gen3/";
+
+class WholeBodyQpTest : public ::testing::Test {
+protected:
+  void SetUp() override {
+    q_ << 0, 0.58, 3.14, -1.84, 0, 0.85, 1.57;
+    qd_ << 0.1, -0.2, 0.3, 0.1, -0.2, 0.1, 0.3;
+    phri::compute_all_terms(model_, data_, q_, qd_);
+  }
+  // Far from every limit: large torque limits, gains that keep the bounds slack.
+  phri::WholeBodyQpSettings loose_settings() const {
+    phri::WholeBodyQpSettings s;
+    s.torque_limit = Eigen::VectorXd::Constant(7, 1e4);
+    s.velocity_limit = Eigen::VectorXd::Constant(7, 100.0);
+    return s;
+  }
+  void set_tasks(phri::WholeBodyQp& qp, double gamma_ee, double gamma_posture) {
+    qp.end_effector().reset_gains(phri::Vector6d::Constant(100.0), phri::Vector6d::Constant(20.0), 1e3,
+                                  phri::Vector6d::Constant(gamma_ee));
+    Eigen::Isometry3d target = data_.frame_placements[static_cast<std::size_t>(model_.frame_id("end_effector_link"))];
+    target.translation() += Eigen::Vector3d(0.01, -0.02, 0.015);
+    qp.end_effector().set_target(target);
+    qp.posture().reset_gains(5.0, 3.0, 1.0, gamma_posture);
+    Eigen::VectorXd posture = q_;
+    posture[0] += 0.2;
+    qp.posture().set_target(posture);
+  }
+
+  phri::Model model_ = phri::Model::from_urdf_file(kGen3 + "gen3.urdf");
+  phri::Data data_{model_};
+  Eigen::VectorXd q_ = Eigen::VectorXd(7), qd_ = Eigen::VectorXd(7);
+};
+
+TEST_F(WholeBodyQpTest, UnconstrainedOptimumIsTheWeightedLeastSquaresSolution) {
+  phri::WholeBodyQp qp(model_, nullptr, loose_settings());
+  set_tasks(qp, 0.0, 0.0);
+  const Eigen::VectorXd tau_ext = Eigen::VectorXd::Zero(7);
+  ASSERT_EQ(qp.update(model_, data_, q_, qd_, tau_ext, 1e-3), phri::ControllerStatus::kOk);
+  const auto& ee = qp.end_effector();
+  const double w = ee.weight(), w0 = qp.posture().weight();
+  const Eigen::MatrixXd h = w * ee.jacobian().transpose() * ee.jacobian() +
+                            (w0 + qp.settings().regularization) * Eigen::MatrixXd::Identity(7, 7);
+  const Eigen::VectorXd rhs = w * ee.jacobian().transpose() * ee.reference() + w0 * qp.posture().reference();
+  const Eigen::VectorXd expected = h.ldlt().solve(rhs);
+  EXPECT_LT((qp.desired_acceleration() - expected).norm(), 1e-9 * (1.0 + expected.norm()));
+  // tau_d = M qdd_d + h - tau_ext.
+  EXPECT_LT((qp.desired_torque() - (data_.mass_matrix * expected + data_.nonlinear_effects)).norm(), 1e-8);
+  // The task reference is ë* - J̇ qd: K e + D (v_target - v) - bias, where the target jumped by a
+  // few cm, so the governor moves the tracked target toward it (first step: speed a dt).
+  const phri::Vector6d bias = phri::frame_jdot_qdot(model_, data_, ee.frame_id(), phri::ReferenceFrame::kLocalWorldAligned);
+  EXPECT_LT((ee.reference() - (100.0 * ee.error() + 20.0 * (ee.target_velocity() - ee.velocity()) - bias)).norm(), 1e-12);
+  EXPECT_NEAR(ee.target_velocity().head<3>().norm(), 0.5 * 1e-3, 1e-12);
+  EXPECT_FALSE(ee.target_reached());
+}
+
+TEST_F(WholeBodyQpTest, GammaOneLetsThePushThroughAndGammaZeroNegatesIt) {
+  Eigen::VectorXd tau_ext(7);
+  tau_ext << 3.0, -5.0, 1.0, 4.0, -0.5, 0.3, 0.2;
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(7);
+  for (double gamma : {0.0, 1.0}) {
+    phri::WholeBodyQp a(model_, nullptr, loose_settings()), b(model_, nullptr, loose_settings());
+    set_tasks(a, gamma, gamma);
+    set_tasks(b, gamma, gamma);
+    a.update(model_, data_, q_, qd_, zero, 1e-3);
+    b.update(model_, data_, q_, qd_, tau_ext, 1e-3);
+    // gamma = 1: every reference shifts by the push's acceleration, so qdd_d does too and
+    // tau_d = M (qdd_0 + M^-1 tau_ext) + h - tau_ext is unchanged: the controller does not resist.
+    // gamma = 0: qdd_d is unchanged, tau_d = tau_0 - tau_ext cancels the push.
+    const Eigen::VectorXd expected = gamma == 1.0 ? a.desired_torque() : Eigen::VectorXd(a.desired_torque() - tau_ext);
+    // Exact but for the 1e-9 Hessian regularisation.
+    EXPECT_LT((b.desired_torque() - expected).norm(), 1e-8 * (1.0 + expected.norm())) << "gamma " << gamma;
+  }
+}
+
+TEST_F(WholeBodyQpTest, NullSpaceComplianceKeepsTheTaskAccelerationWhileThePostureYields) {
+  Eigen::VectorXd tau_ext(7);
+  tau_ext << 0.0, 4.0, 2.0, -3.0, 0.0, 0.0, 0.0;
+  phri::WholeBodyQp a(model_, nullptr, loose_settings()), b(model_, nullptr, loose_settings());
+  set_tasks(a, 0.0, 1.0);
+  set_tasks(b, 0.0, 1.0);
+  a.update(model_, data_, q_, qd_, Eigen::VectorXd::Zero(7), 1e-3);
+  b.update(model_, data_, q_, qd_, tau_ext, 1e-3);
+  const Eigen::VectorXd delta = b.desired_acceleration() - a.desired_acceleration();
+  const Eigen::MatrixXd& j = b.end_effector().jacobian();
+  // The push changes the joint accelerations, but (up to the weight ratio 1e-3) not the task's.
+  EXPECT_GT(delta.norm(), 0.1);
+  EXPECT_LT((j * delta).norm(), 2e-3 * delta.norm() * j.norm());
+}
+
+TEST_F(WholeBodyQpTest, JointDamperAndTorqueLimitsBound) {
+  phri::WholeBodyQpSettings settings;
+  phri::WholeBodyQp qp(model_, nullptr, settings);
+  set_tasks(qp, 0.0, 0.0);
+  // Joint 2 close to its upper limit and moving toward it: the bound brakes it.
+  Eigen::VectorXd q = q_, qd = Eigen::VectorXd::Zero(7);
+  q[1] = 2.24 - 0.05;
+  qd[1] = 0.8;
+  phri::compute_all_terms(model_, data_, q, qd);
+  Eigen::VectorXd posture = q;
+  posture[1] = 3.0;  // the posture pulls beyond the limit
+  qp.posture().reset_gains(200.0, 10.0, 1.0, 0.0);
+  qp.posture().set_target(posture);
+  ASSERT_EQ(qp.update(model_, data_, q, qd, Eigen::VectorXd::Zero(7), 1e-3), phri::ControllerStatus::kOk);
+  const double range = 4.48, d_s = 0.01 * range, d_i = 0.1 * range;
+  const double xi = 0.9 * 1.3963, m = 1.8, lambda = 4 * m * m * xi / (d_i - d_s);
+  const double bound = lambda * lambda / (4 * m * m) * (0.05 - d_s) - lambda * qd[1];
+  EXPECT_LE(qp.desired_acceleration()[1], bound + 1e-9);
+  EXPECT_NEAR(qp.desired_acceleration()[1], bound, 1e-6);  // the posture pushes into it: active
+  EXPECT_LT(bound, 0.0);  // moving at 0.8 rad/s 5 cm from the limit: must decelerate
+  // Torques within limits even for an absurd target.
+  Eigen::Isometry3d far = qp.end_effector().target_pose();
+  far.translation() += Eigen::Vector3d(5.0, 5.0, 5.0);
+  qp.end_effector().set_target(far);
+  qp.end_effector().reset_gains(phri::Vector6d::Constant(1e4), phri::Vector6d::Constant(200.0), 1e4, phri::Vector6d::Zero());
+  phri::compute_all_terms(model_, data_, q_, qd_);
+  qp.update(model_, data_, q_, qd_, Eigen::VectorXd::Zero(7), 1e-3);
+  EXPECT_TRUE((qp.desired_torque().cwiseAbs().array() <= qp.torque_limit().array() + 1e-6).all())
+      << qp.desired_torque().transpose();
+}
+
+TEST_F(WholeBodyQpTest, InvalidInputHoldsTheLastCommandAndInfeasibleBrakes) {
+  phri::WholeBodyQp qp(model_, nullptr, phri::WholeBodyQpSettings{});
+  set_tasks(qp, 0.0, 1.0);
+  ASSERT_EQ(qp.update(model_, data_, q_, qd_, Eigen::VectorXd::Zero(7), 1e-3), phri::ControllerStatus::kOk);
+  const Eigen::VectorXd good = qp.desired_torque();
+  Eigen::VectorXd bad = Eigen::VectorXd::Zero(7);
+  bad[3] = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(qp.update(model_, data_, q_, qd_, bad, 1e-3), phri::ControllerStatus::kInvalidInput);
+  EXPECT_EQ(qp.desired_torque(), good);
+  // A push no torque can cancel within the limits while the dampers demand braking: infeasible.
+  Eigen::VectorXd q = q_, qd = Eigen::VectorXd::Zero(7);
+  q[1] = 2.24 - 0.02;
+  qd[1] = 1.3;
+  phri::compute_all_terms(model_, data_, q, qd);
+  Eigen::VectorXd huge = Eigen::VectorXd::Zero(7);
+  huge[1] = 500.0;
+  const auto status = qp.update(model_, data_, q, qd, huge, 1e-3);
+  EXPECT_EQ(status, phri::ControllerStatus::kQpInfeasible);
+  EXPECT_TRUE(qp.desired_torque().allFinite());
+  EXPECT_TRUE((qp.desired_torque().cwiseAbs().array() <= qp.torque_limit().array() + 1e-9).all());
+  EXPECT_LT(qp.desired_acceleration()[1], 0.0);  // braking joint 2
+}
+
+TEST_F(WholeBodyQpTest, OneFullCycleDoesNotAllocate) {
+  const phri::CollisionModel collision = phri::CollisionModel::from_yaml_file(kGen3 + "collision.yaml", model_);
+  phri::WholeBodyQp qp(model_, &collision, phri::WholeBodyQpSettings{});
+  phri::ComplianceController compliance{phri::ComplianceSettings{}};
+  compliance.initialise(phri::ComplianceMode::kDual, qp, data_);
+  qp.posture().set_target(q_);
+  phri::MomentumObserver observer(model_, 10.0);
+  const Eigen::VectorXd tau_s = data_.gravity_torque;
+  // Warm up once (first observer call resets), then count.
+  phri::compute_all_terms(model_, data_, q_, qd_);
+  phri::coriolis_transpose_times_velocity(model_, data_);
+  observer.update(data_, qd_, tau_s, 1e-3);
+  qp.update(model_, data_, q_, qd_, observer.external_torque(), 1e-3);
+  phri::test::AllocationCounter count;
+  {
+    phri::test::NoMallocScope no_malloc;
+    for (int k = 0; k < 10; ++k) {
+      phri::compute_all_terms(model_, data_, q_, qd_);
+      phri::coriolis_transpose_times_velocity(model_, data_);
+      observer.update(data_, qd_, tau_s, 1e-3);
+      compliance.update(k < 5 ? 10.0 : 1.0, qp, data_);
+      qp.update(model_, data_, q_, qd_, observer.external_torque(), 1e-3);
+    }
+  }
+  EXPECT_EQ(count.allocations(), 0u);
+  EXPECT_EQ(compliance.touch_count(), 1);
+  EXPECT_FALSE(compliance.touched());
+}
+
+TEST_F(WholeBodyQpTest, TargetGovernorReachesAJumpedTargetWithBoundedSpeedAndTracksStreams) {
+  phri::EndEffectorTask task(model_, model_.frame_id("end_effector_link"));
+  task.hold_current_pose(data_);
+  const Eigen::Isometry3d start = task.target_pose();
+  Eigen::Isometry3d goal = start;
+  goal.translation() += Eigen::Vector3d(0.1, 0.0, 0.0);
+  task.set_target(goal);
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(7);
+  double max_speed = 0.0, time = 0.0;
+  while (!task.target_reached() && time < 5.0) {
+    task.update(model_, data_, zero, 1e-3);
+    max_speed = std::max(max_speed, task.target_velocity().head<3>().norm());
+    time += 1e-3;
+  }
+  // Triangular profile at 0.5 m/s^2 over 0.1 m: 2 sqrt(d / a) = 0.894 s, peak 0.224 m/s.
+  EXPECT_NEAR(time, 2.0 * std::sqrt(0.1 / 0.5), 0.01);
+  EXPECT_LE(max_speed, 0.25);
+  EXPECT_LT((task.target_pose().translation() - goal.translation()).norm(), 1e-9);
+  // A streamed trajectory at 0.1 m/s is tracked as given, feed-forward included.
+  for (int k = 1; k <= 100; ++k) {
+    Eigen::Isometry3d point = goal;
+    point.translation().z() += 1e-4 * k;
+    phri::Vector6d velocity = phri::Vector6d::Zero();
+    velocity[2] = 0.1;
+    task.set_target(point, velocity);
+    task.update(model_, data_, zero, 1e-3);
+    EXPECT_LT((task.target_pose().translation() - point.translation()).norm(), 1e-12);
+    EXPECT_NEAR(task.target_velocity()[2], 0.1, 1e-12);
+  }
+}
+
+TEST(ComplianceControllerTest, SchmittTriggerAndValidation) {
+  phri::ComplianceSettings inverted;
+  inverted.touch_threshold = 4.0;
+  inverted.release_threshold = 8.0;
+  EXPECT_THROW(phri::ComplianceController{inverted}, phri::ConfigError);
+}
+
+}  // namespace
