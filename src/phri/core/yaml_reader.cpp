@@ -1,0 +1,217 @@
+#include <phri/core/yaml_reader.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+
+namespace phri {
+namespace {
+
+std::string format_number(double value) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof(buffer), "%.10g", value);
+  return buffer;
+}
+
+std::string range_text(double min, double max) {
+  return "[" + format_number(min) + ", " + format_number(max) + "]";
+}
+
+}  // namespace
+
+YamlReader YamlReader::load_file(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw ConfigError(path, "", "cannot open the file");
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  return load_string(buffer.str(), path);
+}
+
+YamlReader YamlReader::load_string(const std::string& text, const std::string& source_name) {
+  try {
+    return YamlReader(YAML::Load(text), source_name, "");
+  } catch (const YAML::Exception& e) {
+    throw ConfigError(source_name, "", std::string("invalid YAML: ") + e.what());
+  }
+}
+
+YamlReader::YamlReader(YAML::Node node, std::string file, std::string path)
+    : node_(std::move(node)), file_(std::move(file)), path_(std::move(path)) {}
+
+std::string YamlReader::path_of(std::string_view key) const {
+  if (key.empty()) return path_;
+  if (path_.empty()) return std::string(key);
+  return path_ + "." + std::string(key);
+}
+
+ConfigError YamlReader::error(std::string_view key, const std::string& reason) const {
+  return ConfigError(file_, path_of(key), reason);
+}
+
+void YamlReader::expect_map() const {
+  if (is_null()) return;
+  if (!node_.IsMap()) throw error("", "expected a map of keys");
+}
+
+void YamlReader::expect_sequence() const {
+  if (!node_.IsSequence()) throw error("", "expected a sequence");
+}
+
+void YamlReader::allow_keys(std::initializer_list<std::string_view> keys) const {
+  expect_map();
+  if (is_null()) return;
+  for (const auto& item : node_) {
+    std::string key;
+    try {
+      key = item.first.as<std::string>();
+    } catch (const YAML::Exception&) {
+      throw error("", "keys must be strings");
+    }
+    bool known = false;
+    for (const auto& allowed : keys) known = known || key == allowed;
+    if (!known) {
+      std::string list;
+      for (const auto& allowed : keys) list += (list.empty() ? "" : ", ") + std::string(allowed);
+      throw error(key, "unknown key (allowed here: " + list + ")");
+    }
+  }
+}
+
+std::vector<std::string> YamlReader::keys() const {
+  expect_map();
+  std::vector<std::string> out;
+  if (is_null()) return out;
+  for (const auto& item : node_) {
+    try {
+      out.push_back(item.first.as<std::string>());
+    } catch (const YAML::Exception&) {
+      throw error("", "keys must be strings");
+    }
+  }
+  return out;
+}
+
+bool YamlReader::has(std::string_view key) const {
+  if (is_null() || !node_.IsMap()) return false;
+  const YAML::Node child = node_[std::string(key)];
+  return child && !child.IsNull();
+}
+
+YamlReader YamlReader::at(std::string_view key) const {
+  expect_map();
+  if (!has(key)) throw error(key, "missing key");
+  return YamlReader(node_[std::string(key)], file_, path_of(key));
+}
+
+std::size_t YamlReader::size() const {
+  if (is_null()) return 0;
+  expect_sequence();
+  return node_.size();
+}
+
+YamlReader YamlReader::at(std::size_t index) const {
+  expect_sequence();
+  if (index >= node_.size()) throw error("", "index " + std::to_string(index) + " out of range");
+  return YamlReader(node_[index], file_, path_ + "[" + std::to_string(index) + "]");
+}
+
+double YamlReader::as_number(double min, double max) const {
+  if (is_null() || !node_.IsScalar()) throw error("", "expected a number");
+  double value = 0.0;
+  try {
+    value = node_.as<double>();
+  } catch (const YAML::Exception&) {
+    throw error("", "expected a number, got '" + node_.Scalar() + "'");
+  }
+  if (!std::isfinite(value)) throw error("", "must be finite, got '" + node_.Scalar() + "'");
+  if (value < min || value > max) {
+    throw error("", "must be in " + range_text(min, max) + ", got " + format_number(value));
+  }
+  return value;
+}
+
+long long YamlReader::as_integer(long long min, long long max) const {
+  if (is_null() || !node_.IsScalar()) throw error("", "expected an integer");
+  long long value = 0;
+  try {
+    value = node_.as<long long>();
+  } catch (const YAML::Exception&) {
+    throw error("", "expected an integer, got '" + node_.Scalar() + "'");
+  }
+  if (value < min || value > max) {
+    throw error("", "must be in [" + std::to_string(min) + ", " + std::to_string(max) + "], got " +
+                        std::to_string(value));
+  }
+  return value;
+}
+
+bool YamlReader::as_boolean() const {
+  if (is_null() || !node_.IsScalar()) throw error("", "expected true or false");
+  const std::string& s = node_.Scalar();
+  if (s == "true") return true;
+  if (s == "false") return false;
+  throw error("", "expected true or false, got '" + s + "'");
+}
+
+std::string YamlReader::as_text() const {
+  if (is_null() || !node_.IsScalar()) throw error("", "expected a string");
+  return node_.Scalar();
+}
+
+double YamlReader::number(std::string_view key, double min, double max) const {
+  return at(key).as_number(min, max);
+}
+
+double YamlReader::number_or(std::string_view key, double fallback, double min, double max) const {
+  return has(key) ? number(key, min, max) : fallback;
+}
+
+long long YamlReader::integer(std::string_view key, long long min, long long max) const {
+  return at(key).as_integer(min, max);
+}
+
+long long YamlReader::integer_or(std::string_view key, long long fallback, long long min, long long max) const {
+  return has(key) ? integer(key, min, max) : fallback;
+}
+
+bool YamlReader::boolean(std::string_view key) const { return at(key).as_boolean(); }
+
+bool YamlReader::boolean_or(std::string_view key, bool fallback) const {
+  return has(key) ? boolean(key) : fallback;
+}
+
+std::string YamlReader::text(std::string_view key) const { return at(key).as_text(); }
+
+std::string YamlReader::text_or(std::string_view key, const std::string& fallback) const {
+  return has(key) ? text(key) : fallback;
+}
+
+std::string YamlReader::choice(std::string_view key, std::initializer_list<std::string_view> choices) const {
+  const std::string value = text(key);
+  std::string list;
+  for (const auto& c : choices) {
+    if (value == c) return value;
+    list += (list.empty() ? "" : ", ") + std::string(c);
+  }
+  throw error(key, "must be one of " + list + ", got '" + value + "'");
+}
+
+std::string YamlReader::choice_or(std::string_view key, const std::string& fallback,
+                                  std::initializer_list<std::string_view> choices) const {
+  return has(key) ? choice(key, choices) : fallback;
+}
+
+std::vector<double> YamlReader::numbers(std::string_view key, int expected_size, double min, double max) const {
+  const YamlReader list = at(key);
+  if (!list.is_sequence()) throw error(key, "expected a sequence of numbers");
+  if (expected_size >= 0 && list.size() != static_cast<std::size_t>(expected_size)) {
+    throw error(key, "expected " + std::to_string(expected_size) + " numbers, got " + std::to_string(list.size()));
+  }
+  std::vector<double> out;
+  out.reserve(list.size());
+  for (std::size_t i = 0; i < list.size(); ++i) out.push_back(list.at(i).as_number(min, max));
+  return out;
+}
+
+}  // namespace phri

@@ -1,0 +1,42 @@
+#pragma once
+// phri::LowLevelMode: how the arm's joint drives interpret a RobotCommand, i.e. which of the
+// vendor's actuator control loops runs (Kinova Kortex low-level servoing, ActuatorConfig
+// ControlMode POSITION / TORQUE / TORQUE_HIGH_VELOCITY / CURRENT).
+#include <cstdint>
+#include <string_view>
+
+namespace phri {
+
+enum class LowLevelMode : std::uint8_t {
+  kPosition = 0,                  ///< joint position servo on q_des (the vendor's stiff position loop)
+  kKinovaTorque = 1,              ///< vendor torque loop with velocity negative feedback on tau_des
+  kKinovaTorqueHighVelocity = 2,  ///< vendor torque loop: tau_des + H(z)(tau_des - tau_sensor)
+  kCurrent = 3,                   ///< raw motor current i_des (what a custom torque controller drives)
+};
+
+inline constexpr int kLowLevelModeCount = 4;
+
+constexpr bool is_valid(LowLevelMode mode) { return static_cast<int>(mode) < kLowLevelModeCount; }
+
+constexpr std::string_view to_string(LowLevelMode mode) {
+  switch (mode) {
+    case LowLevelMode::kPosition: return "position";
+    case LowLevelMode::kKinovaTorque: return "kinova_torque";
+    case LowLevelMode::kKinovaTorqueHighVelocity: return "kinova_torque_high_velocity";
+    case LowLevelMode::kCurrent: return "current";
+  }
+  return "invalid";
+}
+
+/// Parses the names of to_string; false when unknown.
+constexpr bool parse_low_level_mode(std::string_view name, LowLevelMode& mode) {
+  for (int i = 0; i < kLowLevelModeCount; ++i) {
+    if (to_string(static_cast<LowLevelMode>(i)) == name) {
+      mode = static_cast<LowLevelMode>(i);
+      return true;
+    }
+  }
+  return false;
+}
+
+}  // namespace phri

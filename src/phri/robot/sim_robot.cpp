@@ -1,0 +1,608 @@
+#include <phri/core/config_error.hpp>
+#include <phri/robot/sim_robot.hpp>
+#include <phri/robot/link_inertial.hpp>
+#include <phri/robot/sim_scene.hpp>
+
+#include <Eigen/Geometry>
+#include <mujoco/mujoco.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <memory>
+
+namespace phri {
+namespace {
+
+// MuJoCo's force sensor gives the force the child body (the tool) receives from its parent (the
+// adapter), in the site frame. The F/T sensor reports the opposite, the load the tool puts on the
+// flange side (RobotState's convention: a hanging tool reads its weight). Checked by the test
+// SimRobotSensors.FtSensorReadsToolWeight against m * g in the sensor frame.
+constexpr double kWrenchSign = -1.0;
+
+
+// Stream ids of RandomGenerator, one per noise source.
+constexpr std::uint64_t kJointNoiseStream = 1;
+constexpr std::uint64_t kFtNoiseStream = 2;
+constexpr std::uint64_t kMismatchStream = 3;
+
+SimRobotConfig completed(SimRobotConfig config) {
+  config.fill_defaults();
+  config.validate();
+  return config;
+}
+
+mjModel* load_scene(const std::string& xml, const std::string& source) {
+  mjVFS vfs;
+  mj_defaultVFS(&vfs);
+  const char* name = "phri_scene.xml";
+  if (mj_makeEmptyFileVFS(&vfs, name, static_cast<int>(xml.size())) != 0) {
+    throw ConfigError(source, "", "MuJoCo virtual file system is full");
+  }
+  const int index = mj_findFileVFS(&vfs, name);
+  std::memcpy(vfs.filedata[index], xml.data(), xml.size());
+  char error[1024] = "";
+  mjModel* m = mj_loadXML(name, &vfs, error, sizeof(error));
+  mj_deleteVFS(&vfs);
+  if (m == nullptr) throw ConfigError(source, "scene", std::string("MuJoCo cannot load the composed scene: ") + error);
+  return m;
+}
+
+Eigen::Matrix3d rotation(const mjtNum* xmat) {
+  Eigen::Matrix3d r;
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) r(i, j) = xmat[3 * i + j];
+  }
+  return r;
+}
+
+}  // namespace
+
+SimRobot::SimRobot(const SimRobotConfig& config)
+    : config_(completed(config)),
+      plant_actuators_(config_.plant_actuators()),
+      n_(config_.dof()),
+      drive_(plant_actuators_, config_.vendor, config_.physics_step_s(), config_.control_period_s) {
+  const std::string& src = config_.source;
+  substeps_ = config_.substeps_per_cycle();
+  filter_decimation_ = static_cast<int>(std::lround(config_.physics_rate_Hz / config_.vendor.high_velocity_rate_Hz));
+  ft_decimation_ = static_cast<int>(std::lround(config_.physics_rate_Hz / config_.ft_sensor.rate_Hz));
+
+  scene_xml_ = SimScene::build_mjcf(config_);
+  m_ = load_scene(scene_xml_, config_.mjcf_path);
+  std::unique_ptr<mjModel, void (*)(mjModel*)> model_guard(m_, mj_deleteModel);
+
+  // ---- options
+  const double dt = config_.physics_step_s();
+  m_->opt.timestep = dt;
+  m_->opt.integrator = mjINT_EULER;
+  m_->opt.disableflags |= mjDSBL_SENSOR;  // enabled only on F/T sampling steps
+  if (!config_.floor.enabled) m_->opt.disableflags |= mjDSBL_CONTACT;
+
+  // ---- arm joints, in the order of actuators.yaml
+  qadr_.resize(static_cast<std::size_t>(n_));
+  dadr_.resize(static_cast<std::size_t>(n_));
+  lower_.resize(n_);
+  upper_.resize(n_);
+  torque_per_amp_.resize(n_);
+  current_limit_.resize(n_);
+  max_torque_.resize(n_);
+  armature_.resize(n_);
+  viscous_.resize(n_);
+  offsets_.resize(n_);
+  std::vector<int> arm_bodies;
+  for (int i = 0; i < n_; ++i) {
+    const ActuatorParameters& a = plant_actuators_[i];
+    const int j = mj_name2id(m_, mjOBJ_JOINT, a.joint_name.c_str());
+    if (j < 0) throw ConfigError(config_.mjcf_path, a.joint_name, "joint of actuators.yaml missing in the MJCF");
+    if (m_->jnt_type[j] != mjJNT_HINGE) throw ConfigError(config_.mjcf_path, a.joint_name, "expected a hinge joint");
+    const auto k = static_cast<std::size_t>(i);
+    qadr_[k] = m_->jnt_qposadr[j];
+    dadr_[k] = m_->jnt_dofadr[j];
+    arm_bodies.push_back(m_->jnt_bodyid[j]);
+    if (m_->jnt_limited[j]) {
+      lower_[i] = m_->jnt_range[2 * j];
+      upper_[i] = m_->jnt_range[2 * j + 1];
+    } else {
+      lower_[i] = -100.0;
+      upper_[i] = 100.0;
+    }
+    torque_per_amp_[i] = a.torque_per_amp();
+    current_limit_[i] = a.current_limit_A;
+    max_torque_[i] = a.max_motor_torque_Nm();
+    armature_[i] = a.reflected_inertia_kgm2;
+    viscous_[i] = a.friction.viscous_Nms_per_rad;
+    offsets_[i] = config_.noise.torque_sensor_offset_Nm[k];
+    const int d = dadr_[k];
+    m_->dof_armature[d] = a.reflected_inertia_kgm2;
+    // Dry friction: StickSlipFriction (its spring through qfrc_applied, its damper and the viscous
+    // friction through MuJoCo's joint damping, which the Euler step integrates implicitly).
+    m_->dof_damping[d] = a.friction.viscous_Nms_per_rad;
+    m_->dof_frictionloss[d] = 0.0;
+    dry_.emplace_back(StickSlipFriction::presliding(a.friction.coulomb_Nm, a.friction.static_Nm,
+                                                    a.reflected_inertia_kgm2, dt,
+                                                    config_.friction.breakaway_velocity_rad_s));
+  }
+  quantum_ = config_.noise.encoder_counts_per_rev > 0.0 ? 2.0 * 3.14159265358979323846 / config_.noise.encoder_counts_per_rev
+                                                         : 0.0;
+
+  // ---- link inertial mismatch (arm links only; the scene's tool is configured explicitly)
+  if (config_.mismatch.enabled) {
+    RandomGenerator rng(config_.mismatch.seed, kMismatchStream);
+    for (int b : arm_bodies) {
+      LinkInertial li;
+      li.mass_kg = m_->body_mass[b];
+      li.com_m = Eigen::Vector3d(m_->body_ipos[3 * b], m_->body_ipos[3 * b + 1], m_->body_ipos[3 * b + 2]);
+      li.principal_kgm2 =
+          Eigen::Vector3d(m_->body_inertia[3 * b], m_->body_inertia[3 * b + 1], m_->body_inertia[3 * b + 2]);
+      const LinkInertial p = li.perturbed(config_.mismatch.mass_fraction, config_.mismatch.com_fraction,
+                                          config_.mismatch.inertia_fraction, rng);
+      m_->body_mass[b] = p.mass_kg;
+      for (int k = 0; k < 3; ++k) {
+        m_->body_ipos[3 * b + k] = p.com_m[k];
+        m_->body_inertia[3 * b + k] = p.principal_kgm2[k];
+      }
+    }
+  }
+
+  // ---- scene objects
+  tool_body_ = mj_name2id(m_, mjOBJ_BODY, SimScene::kToolBody);
+  sensor_site_ = mj_name2id(m_, mjOBJ_SITE, SimScene::kSensorSite);
+  const int force_sensor = mj_name2id(m_, mjOBJ_SENSOR, SimScene::kForceSensor);
+  const int torque_sensor = mj_name2id(m_, mjOBJ_SENSOR, SimScene::kTorqueSensor);
+  if (tool_body_ < 0 || sensor_site_ < 0 || force_sensor < 0 || torque_sensor < 0) {
+    throw ConfigError(src, "scene", "tool body or F/T sensor missing from the composed scene");
+  }
+  force_adr_ = m_->sensor_adr[force_sensor];
+  torque_adr_ = m_->sensor_adr[torque_sensor];
+  if (config_.drop_test.enabled) {
+    anchor_site_ = mj_name2id(m_, mjOBJ_SITE, SimScene::kAnchorSite);
+    drop_body_ = mj_name2id(m_, mjOBJ_BODY, SimScene::kDropBody);
+    const int free = m_->body_jntadr[drop_body_];
+    drop_qadr_ = m_->jnt_qposadr[free];
+    drop_dadr_ = m_->jnt_dofadr[free];
+    latch_damping_ = 2.0 * std::sqrt(config_.drop_test.latch_stiffness_N_per_m * config_.drop_test.mass_kg);
+  }
+  for (std::size_t i = 0; i < config_.disturbances.size(); ++i) {
+    const auto& f = config_.disturbances[i];
+    const int b = mj_name2id(m_, mjOBJ_BODY, f.body.c_str());
+    if (b <= 0) {
+      throw ConfigError(src, "plant.disturbances[" + std::to_string(i) + "].body", "no body '" + f.body + "' in the scene");
+    }
+    disturbance_bodies_.push_back(b);
+  }
+  if (config_.random_pushes.enabled) {
+    std::vector<std::string> names = config_.random_pushes.links;
+    if (names.empty()) {
+      for (int b : arm_bodies) names.emplace_back(mj_id2name(m_, mjOBJ_BODY, b));
+    }
+    for (std::size_t i = 0; i < names.size(); ++i) {
+      const int b = mj_name2id(m_, mjOBJ_BODY, names[i].c_str());
+      const std::string key = "plant.random_pushes.links[" + std::to_string(i) + "]";
+      if (b <= 0) throw ConfigError(src, key, "no body '" + names[i] + "' in the scene");
+      int capsule = -1;
+      for (int g = m_->body_geomadr[b]; g >= 0 && g < m_->body_geomadr[b] + m_->body_geomnum[b]; ++g) {
+        if (m_->geom_type[g] == mjGEOM_CAPSULE) {
+          capsule = g;
+          break;
+        }
+      }
+      if (capsule < 0) throw ConfigError(src, key, "body '" + names[i] + "' has no capsule geom to push on");
+      RandomPushGenerator::LinkSurface s;
+      s.body = b;
+      s.radius = m_->geom_size[3 * capsule];
+      const double half = m_->geom_size[3 * capsule + 1];
+      // Capsule axis = the geom's local z, placed by geom_pos / geom_quat in the body frame.
+      mjtNum axis[3];
+      const mjtNum z[3] = {0.0, 0.0, half};
+      mju_rotVecQuat(axis, z, m_->geom_quat + 4 * capsule);
+      const Eigen::Vector3d c(m_->geom_pos[3 * capsule], m_->geom_pos[3 * capsule + 1], m_->geom_pos[3 * capsule + 2]);
+      const Eigen::Vector3d a(axis[0], axis[1], axis[2]);
+      s.p0 = c - a;
+      s.p1 = c + a;
+      push_links_.push_back(s);
+    }
+  }
+
+  d_ = mj_makeData(m_);
+  if (d_ == nullptr) throw ConfigError(src, "scene", "MuJoCo could not allocate its data");
+  mj_setConst(m_, d_);  // derived constants after the inertial and armature edits
+  model_guard.release();
+
+  // ---- buffers
+  command_ = RobotCommand(n_);
+  pending_ = RobotCommand(n_);
+  state_ = RobotState(n_);
+  q_meas_ = Eigen::VectorXd::Zero(n_);
+  qd_meas_ = Eigen::VectorXd::Zero(n_);
+  tau_meas_ = Eigen::VectorXd::Zero(n_);
+  current_ = Eigen::VectorXd::Zero(n_);
+  tau_motor_ = Eigen::VectorXd::Zero(n_);
+  tau_viscous_ = Eigen::VectorXd::Zero(n_);
+  tau_dry_ = Eigen::VectorXd::Zero(n_);
+  tau_s_ = Eigen::VectorXd::Zero(n_);
+  v_before_ = Eigen::VectorXd::Zero(n_);
+  f_dry_ = Eigen::VectorXd::Zero(n_);
+  damping_ = Eigen::VectorXd::Zero(n_);
+  qdd_ = Eigen::VectorXd::Zero(n_);
+  for (Eigen::VectorXd* v : {&truth_.q_rad, &truth_.qd_rad_s, &truth_.qdd_rad_s2, &truth_.current_A,
+                             &truth_.tau_motor_Nm, &truth_.tau_friction_Nm, &truth_.tau_transmitted_Nm}) {
+    *v = Eigen::VectorXd::Zero(n_);
+  }
+  reset();
+}
+
+SimRobot::~SimRobot() {
+  if (d_ != nullptr) mj_deleteData(d_);
+  if (m_ != nullptr) mj_deleteModel(m_);
+}
+
+void SimRobot::reset() {
+  mj_resetData(m_, d_);
+  joint_noise_.reseed(config_.seed, kJointNoiseStream);
+  ft_noise_.reseed(config_.seed, kFtNoiseStream);
+  pushes_ = RandomPushGenerator(config_.random_pushes, push_links_, config_.seed);
+  fault_ = false;
+  has_pending_ = false;
+  substep_count_ = 0;
+  wrench_sequence_ = 0;
+  state_ = RobotState(n_);
+  truth_.drop_released = false;
+  truth_.cable_force_N = 0.0;
+
+  for (int i = 0; i < n_; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    d_->qpos[qadr_[k]] = config_.initial_q_rad[k];
+    dry_[k].reset(config_.initial_q_rad[k]);
+  }
+  mj_kinematics(m_, d_);
+  Eigen::Vector3d drop_force_on_tool = Eigen::Vector3d::Zero();
+  if (drop_body_ >= 0) {
+    // The mass hangs on the latch at its static deflection m g / k below the anchor.
+    const double k = config_.drop_test.latch_stiffness_N_per_m;
+    const Eigen::Vector3d g(m_->opt.gravity[0], m_->opt.gravity[1], m_->opt.gravity[2]);
+    const mjtNum* anchor = d_->site_xpos + 3 * anchor_site_;
+    const Eigen::Vector3d p = Eigen::Vector3d(anchor[0], anchor[1], anchor[2]) + config_.drop_test.mass_kg * g / k;
+    for (int k3 = 0; k3 < 3; ++k3) d_->qpos[drop_qadr_ + k3] = p[k3];
+    d_->qpos[drop_qadr_ + 3] = 1.0;
+    d_->qpos[drop_qadr_ + 4] = d_->qpos[drop_qadr_ + 5] = d_->qpos[drop_qadr_ + 6] = 0.0;
+    drop_force_on_tool = config_.drop_test.mass_kg * g;
+  }
+  mj_forward(m_, d_);  // kinematics, bias forces, Jacobians at the initial pose
+
+  // The arm starts at rest, already holding itself (and the latched drop mass): the holding torque
+  // is the bias force minus the generalized force of the mass's weight at the anchor.
+  Eigen::VectorXd hold = Eigen::VectorXd::Zero(n_);
+  for (int i = 0; i < n_; ++i) hold[i] = d_->qfrc_bias[dadr_[static_cast<std::size_t>(i)]];
+  if (drop_body_ >= 0) {
+    std::vector<mjtNum> jacp(static_cast<std::size_t>(3 * m_->nv));
+    mj_jacSite(m_, d_, jacp.data(), nullptr, anchor_site_);
+    for (int i = 0; i < n_; ++i) {
+      const int d = dadr_[static_cast<std::size_t>(i)];
+      double gen = 0.0;
+      for (int r = 0; r < 3; ++r) gen += jacp[static_cast<std::size_t>(r * m_->nv + d)] * drop_force_on_tool[r];
+      hold[i] -= gen;
+    }
+  }
+  for (int i = 0; i < n_; ++i) {
+    tau_motor_[i] = hold[i];
+    current_[i] = hold[i] / torque_per_amp_[i];
+    tau_s_[i] = hold[i];
+  }
+  tau_viscous_.setZero();
+  tau_dry_.setZero();
+  f_dry_.setZero();
+  qdd_.setZero();
+
+  // Initial command: hold the initial pose in Position mode.
+  command_.mode = LowLevelMode::kPosition;
+  for (int i = 0; i < n_; ++i) command_.q_rad[i] = config_.initial_q_rad[static_cast<std::size_t>(i)];
+  for (int i = 0; i < n_; ++i) q_meas_[i] = quantize(d_->qpos[qadr_[static_cast<std::size_t>(i)]]);
+  drive_ = KinovaDriveEmulator(plant_actuators_, config_.vendor, config_.physics_step_s(), config_.control_period_s);
+  drive_.begin_cycle(command_, false, q_meas_, tau_motor_);
+  drive_.set_position_integral(hold);
+
+  // Initial F/T sample with the arm held (qacc ~ 0) and the latch carrying the mass.
+  for (int i = 0; i < n_; ++i) d_->qfrc_applied[dadr_[static_cast<std::size_t>(i)]] = hold[i];
+  mju_zero(d_->xfrc_applied, 6 * m_->nbody);
+  apply_drop_forces(0.0);
+  m_->opt.disableflags &= ~mjDSBL_SENSOR;
+  mj_forward(m_, d_);
+  m_->opt.disableflags |= mjDSBL_SENSOR;
+  for (int k = 0; k < 3; ++k) {
+    wrench_true_[k] = kWrenchSign * d_->sensordata[force_adr_ + k];
+    wrench_true_[3 + k] = kWrenchSign * d_->sensordata[torque_adr_ + k];
+  }
+  for (int k = 0; k < 3; ++k) {
+    wrench_meas_[k] = wrench_true_[k] + config_.ft_sensor.force_bias_N[k] + ft_noise_.normal(config_.ft_sensor.force_std_N);
+    wrench_meas_[3 + k] =
+        wrench_true_[3 + k] + config_.ft_sensor.torque_bias_Nm[k] + ft_noise_.normal(config_.ft_sensor.torque_std_Nm);
+  }
+  wrench_sequence_ = 1;
+  wrench_stamp_ = 0.0;
+  truth_.wrench_sensor = wrench_true_;
+  sample_state();
+  state_.cycle = 0;
+}
+
+double SimRobot::quantize(double q) const { return quantum_ > 0.0 ? quantum_ * std::round(q / quantum_) : q; }
+
+WriteStatus SimRobot::validate(const RobotCommand& c) const {
+  if (fault_) return WriteStatus::kFault;
+  if (!is_valid(c.mode)) return WriteStatus::kInvalidMode;
+  const Eigen::VectorXd* v = nullptr;
+  switch (c.mode) {
+    case LowLevelMode::kPosition: v = &c.q_rad; break;
+    case LowLevelMode::kKinovaTorque:
+    case LowLevelMode::kKinovaTorqueHighVelocity: v = &c.tau_Nm; break;
+    case LowLevelMode::kCurrent: v = &c.current_A; break;
+  }
+  if (v->size() != n_) return WriteStatus::kSizeMismatch;
+  if (!v->allFinite()) return WriteStatus::kNotFinite;
+  for (int i = 0; i < n_; ++i) {
+    const double x = (*v)[i];
+    switch (c.mode) {
+      case LowLevelMode::kPosition:
+        if (x < lower_[i] || x > upper_[i]) return WriteStatus::kOutOfRange;
+        break;
+      case LowLevelMode::kKinovaTorque:
+      case LowLevelMode::kKinovaTorqueHighVelocity:
+        if (std::abs(x) > max_torque_[i]) return WriteStatus::kOutOfRange;
+        break;
+      case LowLevelMode::kCurrent:
+        if (std::abs(x) > current_limit_[i]) return WriteStatus::kOutOfRange;
+        break;
+    }
+  }
+  return WriteStatus::kOk;
+}
+
+WriteStatus SimRobot::write(const RobotCommand& command) {
+  const WriteStatus status = validate(command);
+  state_.last_write_status = status;
+  if (status != WriteStatus::kOk) {
+    ++state_.rejected_writes;
+    return status;
+  }
+  pending_.mode = command.mode;
+  switch (command.mode) {
+    case LowLevelMode::kPosition: pending_.q_rad = command.q_rad; break;
+    case LowLevelMode::kKinovaTorque:
+    case LowLevelMode::kKinovaTorqueHighVelocity: pending_.tau_Nm = command.tau_Nm; break;
+    case LowLevelMode::kCurrent: pending_.current_A = command.current_A; break;
+  }
+  has_pending_ = true;
+  return WriteStatus::kOk;
+}
+
+const RobotState& SimRobot::read() {
+  if (fault_) {
+    ++state_.cycle;
+    return state_;
+  }
+  const bool fresh = has_pending_;
+  if (fresh) {
+    command_.mode = pending_.mode;
+    switch (pending_.mode) {
+      case LowLevelMode::kPosition: command_.q_rad = pending_.q_rad; break;
+      case LowLevelMode::kKinovaTorque:
+      case LowLevelMode::kKinovaTorqueHighVelocity: command_.tau_Nm = pending_.tau_Nm; break;
+      case LowLevelMode::kCurrent: command_.current_A = pending_.current_A; break;
+    }
+    has_pending_ = false;
+  }
+  drive_.begin_cycle(command_, fresh, q_meas_, tau_motor_);
+  for (int s = 0; s < substeps_; ++s) substep();
+  if (d_->warning[mjWARN_BADQACC].number > 0 || d_->warning[mjWARN_BADQVEL].number > 0 ||
+      d_->warning[mjWARN_BADQPOS].number > 0) {
+    fault_ = true;
+  }
+  sample_state();
+  return state_;
+}
+
+void SimRobot::substep() {
+  // 1. Dry friction from the current state (its damping enters MuJoCo's passive forces in
+  //    mj_step1 and the implicit part of the Euler step), then positions, velocities, bias forces.
+  for (int i = 0; i < n_; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    const int d = dadr_[k];
+    v_before_[i] = d_->qvel[d];
+    f_dry_[i] = dry_[k].update(d_->qpos[qadr_[k]], d_->qvel[d]);
+    damping_[i] = viscous_[i] + dry_[k].damping();
+    m_->dof_damping[d] = damping_[i];
+  }
+  mj_step1(m_, d_);
+  const double t = d_->time;
+
+  // 2. The drives' sensors and the vendor loop.
+  const bool noisy_velocity = drive_.uses_velocity();
+  const bool noisy_torque = drive_.uses_torque();
+  const double sv = config_.noise.velocity_std_rad_s;
+  const double st = config_.noise.torque_sensor_std_Nm;
+  for (int i = 0; i < n_; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    q_meas_[i] = quantize(d_->qpos[qadr_[k]]);
+    qd_meas_[i] = d_->qvel[dadr_[k]] + (noisy_velocity ? joint_noise_.normal(sv) : 0.0);
+    tau_meas_[i] = tau_s_[i] + offsets_[i] + (noisy_torque ? joint_noise_.normal(st) : 0.0);
+  }
+  drive_.tick(q_meas_, qd_meas_, tau_meas_, substep_count_ % static_cast<std::uint64_t>(filter_decimation_) == 0, current_);
+
+  // 3. Joint torques on the motor side: motor and the explicit part of the dry friction.
+  for (int i = 0; i < n_; ++i) {
+    const int d = dadr_[static_cast<std::size_t>(i)];
+    tau_motor_[i] = torque_per_amp_[i] * current_[i];
+    d_->qfrc_applied[d] = tau_motor_[i] + f_dry_[i];
+  }
+
+  // 4. External forces.
+  mju_zero(d_->xfrc_applied, 6 * m_->nbody);
+  apply_external_forces(t);
+
+  // 5. Step, with the F/T sensor evaluated on its sampling steps only.
+  const bool ft_step = (substep_count_ + 1) % static_cast<std::uint64_t>(ft_decimation_) == 0;
+  if (ft_step) m_->opt.disableflags &= ~mjDSBL_SENSOR;
+  mj_step2(m_, d_);
+  if (ft_step) m_->opt.disableflags |= mjDSBL_SENSOR;
+
+  // Transmitted torque: motor torque, minus friction and rotor inertia on the motor side. The
+  // damping (viscous + presliding) acted on the new velocity, and the step's acceleration is
+  // (v1 - v0) / dt (d->qacc is MuJoCo's explicit value, before the implicit damping).
+  for (int i = 0; i < n_; ++i) {
+    const int d = dadr_[static_cast<std::size_t>(i)];
+    const double v1 = d_->qvel[d];
+    qdd_[i] = (v1 - v_before_[i]) / m_->opt.timestep;
+    tau_viscous_[i] = -viscous_[i] * v1;
+    tau_dry_[i] = f_dry_[i] - (damping_[i] - viscous_[i]) * v1;
+    tau_s_[i] = tau_motor_[i] + tau_viscous_[i] + tau_dry_[i] - armature_[i] * qdd_[i];
+  }
+
+  // 6. F/T sample.
+  if (ft_step) {
+    for (int k = 0; k < 3; ++k) {
+      wrench_true_[k] = kWrenchSign * d_->sensordata[force_adr_ + k];
+      wrench_true_[3 + k] = kWrenchSign * d_->sensordata[torque_adr_ + k];
+    }
+    const auto& ft = config_.ft_sensor;
+    for (int k = 0; k < 3; ++k) {
+      wrench_meas_[k] = wrench_true_[k] + ft.force_bias_N[k] + ft_noise_.normal(ft.force_std_N);
+      wrench_meas_[3 + k] = wrench_true_[3 + k] + ft.torque_bias_Nm[k] + ft_noise_.normal(ft.torque_std_Nm);
+    }
+    ++wrench_sequence_;
+    wrench_stamp_ = t;
+  }
+  ++substep_count_;
+}
+
+void SimRobot::apply_force(int body, const Eigen::Vector3d& point_local, bool local_frame, const Eigen::Vector3d& force,
+                           const Eigen::Vector3d& torque) {
+  const Eigen::Matrix3d R = rotation(d_->xmat + 9 * body);
+  const Eigen::Vector3d x(d_->xpos[3 * body], d_->xpos[3 * body + 1], d_->xpos[3 * body + 2]);
+  const Eigen::Vector3d com(d_->xipos[3 * body], d_->xipos[3 * body + 1], d_->xipos[3 * body + 2]);
+  const Eigen::Vector3d p = x + R * point_local;
+  const Eigen::Vector3d f = local_frame ? Eigen::Vector3d(R * force) : force;
+  const Eigen::Vector3d m = (local_frame ? Eigen::Vector3d(R * torque) : torque) + (p - com).cross(f);
+  mjtNum* out = d_->xfrc_applied + 6 * body;
+  for (int k = 0; k < 3; ++k) {
+    out[k] += f[k];
+    out[3 + k] += m[k];
+  }
+}
+
+void SimRobot::apply_external_forces(double t) {
+  for (std::size_t i = 0; i < config_.disturbances.size(); ++i) {
+    const ExternalForce& f = config_.disturbances[i];
+    const double s = f.scale_at(t);
+    if (s == 0.0) continue;
+    apply_force(disturbance_bodies_[i], f.point_m, f.frame == ExternalForce::Frame::kLocal, s * f.force_N,
+                s * f.torque_Nm);
+  }
+  if (const RandomPushGenerator::Push* push = pushes_.active(t)) {
+    const double s = push->scale_at(t);
+    if (s > 0.0) {
+      apply_force(push->body, push->point_local, true, s * push->peak_force_N * push->direction_local,
+                  Eigen::Vector3d::Zero());
+    }
+  }
+  apply_drop_forces(t);
+}
+
+void SimRobot::apply_drop_forces(double t) {
+  if (drop_body_ < 0) return;
+  const auto& cfg = config_.drop_test;
+  if (!truth_.drop_released && t >= cfg.release_time_s) truth_.drop_released = true;
+
+  const mjtNum* a = d_->site_xpos + 3 * anchor_site_;
+  const Eigen::Vector3d anchor(a[0], a[1], a[2]);
+  mjtNum v6[6];
+  mj_objectVelocity(m_, d_, mjOBJ_SITE, anchor_site_, v6, 0);  // (angular; linear), world axes
+  const Eigen::Vector3d anchor_velocity(v6[3], v6[4], v6[5]);
+  const Eigen::Vector3d p(d_->qpos[drop_qadr_], d_->qpos[drop_qadr_ + 1], d_->qpos[drop_qadr_ + 2]);
+  const Eigen::Vector3d v(d_->qvel[drop_dadr_], d_->qvel[drop_dadr_ + 1], d_->qvel[drop_dadr_ + 2]);
+  const Eigen::Vector3d rel = p - anchor;
+  const Eigen::Vector3d rel_v = v - anchor_velocity;
+
+  Eigen::Vector3d on_mass = Eigen::Vector3d::Zero();
+  if (!truth_.drop_released) {
+    on_mass = -cfg.latch_stiffness_N_per_m * rel - latch_damping_ * rel_v;
+  }
+  const double length = rel.norm();
+  double tension = 0.0;
+  if (length > cfg.cable_length_m) {
+    const Eigen::Vector3d u = rel / length;
+    tension = std::max(0.0, cfg.cable_stiffness_N_per_m * (length - cfg.cable_length_m) +
+                                cfg.cable_damping_Ns_per_m * u.dot(rel_v));
+    on_mass -= tension * u;
+  }
+  truth_.cable_length_m = length;
+  truth_.cable_force_N = tension;
+  if (on_mass.squaredNorm() == 0.0) return;
+  // On the mass at its centre; the reaction on the tool at the anchor (world axes).
+  mjtNum* fm = d_->xfrc_applied + 6 * drop_body_;
+  for (int k = 0; k < 3; ++k) fm[k] += on_mass[k];
+  const Eigen::Vector3d com(d_->xipos[3 * tool_body_], d_->xipos[3 * tool_body_ + 1], d_->xipos[3 * tool_body_ + 2]);
+  const Eigen::Vector3d m = (anchor - com).cross(-on_mass);
+  mjtNum* ft = d_->xfrc_applied + 6 * tool_body_;
+  for (int k = 0; k < 3; ++k) {
+    ft[k] -= on_mass[k];
+    ft[3 + k] += m[k];
+  }
+}
+
+void SimRobot::sample_state() {
+  const double t = d_->time;
+  const auto& z = config_.noise;
+  bool joints_ok = true;
+  bool torque_ok = true;
+  bool current_ok = true;
+  for (int i = 0; i < n_; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    const double q = d_->qpos[qadr_[k]];
+    const double qd = d_->qvel[dadr_[k]];
+    state_.q_rad[i] = quantize(q);
+    state_.qd_rad_s[i] = qd + joint_noise_.normal(z.velocity_std_rad_s);
+    state_.tau_sensor_Nm[i] = tau_s_[i] + offsets_[i] + joint_noise_.normal(z.torque_sensor_std_Nm);
+    state_.current_A[i] = current_[i] + joint_noise_.normal(z.current_std_A);
+    joints_ok = joints_ok && std::isfinite(state_.q_rad[i]) && std::isfinite(state_.qd_rad_s[i]);
+    torque_ok = torque_ok && std::isfinite(state_.tau_sensor_Nm[i]);
+    current_ok = current_ok && std::isfinite(state_.current_A[i]);
+    truth_.q_rad[i] = q;
+    truth_.qd_rad_s[i] = qd;
+    truth_.qdd_rad_s2[i] = qdd_[i];
+    truth_.current_A[i] = current_[i];
+    truth_.tau_motor_Nm[i] = tau_motor_[i];
+    truth_.tau_friction_Nm[i] = tau_viscous_[i] + tau_dry_[i];
+    truth_.tau_transmitted_Nm[i] = tau_s_[i];
+  }
+  if (!joints_ok || !torque_ok || !current_ok || !wrench_meas_.allFinite()) fault_ = true;
+  state_.time_s = t;
+  ++state_.cycle;
+  state_.mode = drive_.mode();
+  state_.fault = fault_;
+  for (SignalStatus* s : {&state_.joints, &state_.torque, &state_.current}) {
+    ++s->sequence;
+    s->stamp_s = t;
+  }
+  state_.joints.valid = joints_ok && !fault_;
+  state_.torque.valid = torque_ok && !fault_;
+  state_.current.valid = current_ok && !fault_;
+  if (wrench_sequence_ != state_.wrench.sequence) {
+    state_.wrench_sensor = wrench_meas_;
+    state_.wrench.sequence = wrench_sequence_;
+    state_.wrench.stamp_s = wrench_stamp_;
+  }
+  state_.wrench.valid = wrench_meas_.allFinite() && !fault_;
+
+  truth_.time_s = t;
+  truth_.wrench_sensor = wrench_true_;
+  const mjtNum* sp = d_->site_xpos + 3 * sensor_site_;
+  truth_.sensor_position_m = Eigen::Vector3d(sp[0], sp[1], sp[2]);
+  truth_.sensor_rotation = rotation(d_->site_xmat + 9 * sensor_site_);
+  if (drop_body_ >= 0) {
+    truth_.drop_mass_position_m = Eigen::Vector3d(d_->qpos[drop_qadr_], d_->qpos[drop_qadr_ + 1], d_->qpos[drop_qadr_ + 2]);
+    truth_.drop_mass_velocity_m_s = Eigen::Vector3d(d_->qvel[drop_dadr_], d_->qvel[drop_dadr_ + 1], d_->qvel[drop_dadr_ + 2]);
+  }
+  truth_.last_push = pushes_.latest();
+}
+
+}  // namespace phri

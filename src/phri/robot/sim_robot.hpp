@@ -1,0 +1,170 @@
+#pragma once
+// phri::SimRobot: the simulated Kinova Gen3 behind phri::RobotInterface — MuJoCo 2.2.2 rigid-body
+// physics plus what makes a torque-controlled arm hard to control: the drives (current
+// saturation, reflected rotor inertia, Coulomb/viscous/static joint friction), the vendor's own
+// actuator loops (KinovaDriveEmulator), realistic sensors, model mismatch and disturbances.
+//
+//   phri::SimRobot robot(phri::SimRobotConfig::from_yaml_file("configs/plant_gen3.yaml"));
+//   phri::LoopClock clock(robot.period_s(), phri::LoopClock::Pacing::kLockstep);  // or kRealTime
+//   phri::RobotCommand cmd(robot.dof());
+//   for (int k = 0; k < 5000; ++k) {
+//     const phri::RobotState& s = robot.read();   // advances the physics by one control period
+//     cmd.mode = phri::LowLevelMode::kCurrent;
+//     cmd.current_A = ...;                        // from s
+//     robot.write(cmd);                           // takes effect at the next read()
+//     clock.wait_next();
+//   }
+//
+// Lockstep: read() runs config.substeps_per_cycle() physics steps (4 at 4 kHz / 1 kHz) on the
+// command in force, then returns the new state; the wall-clock pace is the caller's (LoopClock).
+// Before the first write() the arm holds its initial pose in Position mode.
+//
+// One physics step (period dt):
+//   1. MuJoCo's position/velocity stage (mj_step1) on the current state;
+//   2. the drives' sensors (encoder quantisation; velocity and torque noise) and the vendor loop
+//      of the running mode give the motor current i, saturated at the drive limit;
+//   3. joint torque on the motor side: tau_m = K_T G_r i, viscous friction -b qd, and dry
+//      friction from StickSlipFriction (static level at rest, Coulomb level when sliding: a joint
+//      at rest sticks until the net torque exceeds the static level); the viscous and presliding
+//      dampers go through MuJoCo's joint damping (implicit in its Euler step); the reflected rotor
+//      inertia is MuJoCo's joint armature;
+//   4. external forces: scripted timeline, random pushes, the drop test's latch and cable;
+//   5. MuJoCo step (semi-implicit Euler); then the joint torque sensor value
+//        tau_s = tau_m - b qd + f_dry - I_r qdd      (qd, qdd: the step's new velocity, (v1 - v0)/dt)
+//      i.e. the torque transmitted between the
+//      drive output and the link, with friction and rotor inertia on the motor side;
+//   6. at the F/T rate, MuJoCo's force/torque sensor at the tool origin (the interaction between the
+//      tool body and the adapter body it is welded to).
+// Sensor values reach the vendor loops one physics step later (the sampling delay).
+//
+// No allocation and no exception inside read() and write(); refused commands are statuses.
+// A divergence of the physics (MuJoCo reports bad accelerations) latches RobotState::fault.
+#include <phri/core/random_generator.hpp>
+#include <phri/robot/actuator_table.hpp>
+#include <phri/robot/kinova_drive_emulator.hpp>
+#include <phri/robot/random_push_generator.hpp>
+#include <phri/robot/robot_interface.hpp>
+#include <phri/robot/sim_robot_config.hpp>
+#include <phri/robot/stick_slip_friction.hpp>
+
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <vector>
+
+struct mjModel_;
+struct mjData_;
+
+namespace phri {
+
+class SimRobot final : public RobotInterface {
+public:
+  using Vector6d = Eigen::Matrix<double, 6, 1>;
+
+  /// Noise-free plant quantities no real sensor gives, for tests, logs and experiments.
+  struct Truth {
+    double time_s = 0.0;
+    Eigen::VectorXd q_rad, qd_rad_s, qdd_rad_s2;  ///< qdd: of the last physics step
+    Eigen::VectorXd current_A;                     ///< applied (saturated) motor current
+    Eigen::VectorXd tau_motor_Nm;                  ///< K_T G_r i
+    Eigen::VectorXd tau_friction_Nm;               ///< friction acting on the joint (viscous + dry), opposing motion
+    Eigen::VectorXd tau_transmitted_Nm;            ///< what the torque sensor measures, without noise/offset
+    Vector6d wrench_sensor = Vector6d::Zero();     ///< F/T at its last sample, without noise/bias
+    Eigen::Vector3d sensor_position_m = Eigen::Vector3d::Zero();  ///< F/T frame origin in the world
+    Eigen::Matrix3d sensor_rotation = Eigen::Matrix3d::Identity(); ///< F/T frame axes in the world
+    // drop test
+    bool drop_released = false;
+    Eigen::Vector3d drop_mass_position_m = Eigen::Vector3d::Zero();
+    Eigen::Vector3d drop_mass_velocity_m_s = Eigen::Vector3d::Zero();
+    double cable_length_m = 0.0;  ///< anchor to mass centre
+    double cable_force_N = 0.0;   ///< cable tension (0 while slack)
+    // random pushes
+    RandomPushGenerator::Push last_push;  ///< latest push drawn (index 0: none yet)
+  };
+
+  explicit SimRobot(const SimRobotConfig& config);
+  ~SimRobot() override;
+
+  int dof() const override { return n_; }
+  double period_s() const override { return config_.control_period_s; }
+  const RobotState& read() override;
+  WriteStatus write(const RobotCommand& command) override;
+
+  /// The latest state, without advancing (after construction: the initial state).
+  const RobotState& state() const { return state_; }
+  const Truth& truth() const { return truth_; }
+  const SimRobotConfig& config() const { return config_; }
+  /// The drives as simulated (actuators.yaml with the plant overrides).
+  const ActuatorTable& plant_actuators() const { return plant_actuators_; }
+  /// Position limits used to validate kPosition set-points (+-100 rad for continuous joints).
+  const Eigen::VectorXd& position_lower_rad() const { return lower_; }
+  const Eigen::VectorXd& position_upper_rad() const { return upper_; }
+  const KinovaDriveEmulator& drive() const { return drive_; }
+  /// Back to the initial state: same configuration and seeds, so the same run again.
+  void reset();
+
+  /// MuJoCo model and data, read-only (viewers, tests comparing with MuJoCo's own quantities).
+  const mjModel_* mujoco_model() const { return m_; }
+  const mjData_* mujoco_data() const { return d_; }
+  /// MJCF text of the scene that was loaded.
+  const std::string& scene_mjcf() const { return scene_xml_; }
+
+private:
+  void substep();
+  void apply_external_forces(double t);
+  void apply_force(int body, const Eigen::Vector3d& point_local, bool local_frame, const Eigen::Vector3d& force,
+                   const Eigen::Vector3d& torque);
+  void apply_drop_forces(double t);
+  void sample_state();
+  WriteStatus validate(const RobotCommand& command) const;
+  double quantize(double q) const;
+
+  SimRobotConfig config_;
+  ActuatorTable plant_actuators_;
+  int n_ = 0;
+  int substeps_ = 1;
+  int filter_decimation_ = 1;
+  int ft_decimation_ = 1;
+  std::string scene_xml_;
+  mjModel_* m_ = nullptr;
+  mjData_* d_ = nullptr;
+
+  // joint addressing and drive/friction constants (plant side)
+  std::vector<int> qadr_, dadr_;
+  Eigen::VectorXd lower_, upper_, torque_per_amp_, current_limit_, max_torque_, armature_;
+  Eigen::VectorXd viscous_, offsets_;
+  std::vector<StickSlipFriction> dry_;
+  double quantum_ = 0.0;
+
+  KinovaDriveEmulator drive_;
+  RobotCommand command_, pending_;
+  bool has_pending_ = false;
+  bool fault_ = false;
+  std::uint64_t substep_count_ = 0;
+
+  // per-step buffers
+  Eigen::VectorXd q_meas_, qd_meas_, tau_meas_, current_, tau_motor_, tau_viscous_, tau_dry_, tau_s_;
+  Eigen::VectorXd v_before_, f_dry_, damping_, qdd_;
+  Vector6d wrench_true_ = Vector6d::Zero();
+  Vector6d wrench_meas_ = Vector6d::Zero();
+  std::uint32_t wrench_sequence_ = 0;
+  double wrench_stamp_ = 0.0;
+
+  RandomGenerator joint_noise_, ft_noise_;
+  RandomPushGenerator pushes_;
+  std::vector<RandomPushGenerator::LinkSurface> push_links_;
+
+  // scene objects
+  int tool_body_ = -1;
+  int sensor_site_ = -1;
+  int force_adr_ = -1, torque_adr_ = -1;
+  int anchor_site_ = -1;
+  int drop_body_ = -1, drop_qadr_ = -1, drop_dadr_ = -1;
+  double latch_damping_ = 0.0;
+  std::vector<int> disturbance_bodies_;
+
+  RobotState state_;
+  Truth truth_;
+};
+
+}  // namespace phri

@@ -1,0 +1,158 @@
+#pragma once
+// phri::SimRobotConfig: everything the simulated arm (phri::SimRobot) needs, loaded from a plant
+// YAML (configs/plant_gen3.yaml documents every key with its unit and source) or built in code.
+//
+//   auto config = phri::SimRobotConfig::from_yaml_file("configs/plant_gen3.yaml");
+//   config.noise.torque_sensor_std_Nm = 0.0;   // tests and experiments may edit fields
+//   phri::SimRobot robot(config);              // validate() runs again there
+//
+// Loading validates types, ranges, unknown keys and cross-field consistency; errors are
+// phri::ConfigError(file, key path, reason), e.g. key path "plant.noise.torque_sensor_std_Nm".
+// Relative file names in the YAML are relative to the YAML file's directory.
+//
+// `actuators` is the nominal table of actuators.yaml (what the controller believes);
+// `actuator_overrides` and `friction_scale` make the plant's drives differ from it, and `mismatch`
+// perturbs the plant's link inertials relative to the URDF (model mismatch).
+#include <phri/core/config_error.hpp>
+#include <phri/robot/actuator_table.hpp>
+#include <phri/robot/external_force.hpp>
+#include <phri/robot/random_push_settings.hpp>
+
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace phri {
+
+struct SimRobotConfig {
+  static SimRobotConfig from_yaml_file(const std::string& path);
+  /// `base_dir` resolves relative file names; `source_name` stands for the file in errors.
+  static SimRobotConfig from_yaml_string(const std::string& yaml, const std::string& source_name,
+                                         const std::string& base_dir);
+
+  /// Fills the per-joint vectors left empty with their defaults: vendor loop gains by actuator size
+  /// (see robots/kinova_gen3/README.md), zero torque-sensor offsets. Called by the loaders and by
+  /// SimRobot's constructor, so a config built in code needs only `actuators` and `initial_q_rad`.
+  void fill_defaults();
+  /// Cross-field checks (sizes, divisibility of rates, joint names); throws ConfigError with the
+  /// key path. Called by the loaders and by SimRobot's constructor.
+  void validate() const;
+
+  /// Joint-side parameters of the plant's drives: `actuators` with the overrides applied.
+  ActuatorTable plant_actuators() const;
+  int dof() const { return actuators.size(); }
+  double physics_step_s() const { return 1.0 / physics_rate_Hz; }
+  int substeps_per_cycle() const;
+
+  std::string source = "<SimRobotConfig>";  ///< file the config came from (error messages)
+
+  // ---- robot description
+  std::string mjcf_path;       ///< MJCF of the arm alone (robots/kinova_gen3/gen3_plant.xml)
+  std::string actuators_path;  ///< actuators.yaml
+  ActuatorTable actuators;     ///< nominal drive models, loaded from actuators_path
+
+  // ---- timing
+  double physics_rate_Hz = 4000.0;  ///< MuJoCo step rate; multiple of 1 kHz (the Kortex filter rate)
+  double control_period_s = 0.001;  ///< read()/write() period; multiple of the physics step
+
+  // ---- initial state: the arm starts at rest, holding initial_q in Position mode
+  std::vector<double> initial_q_rad;  ///< one per joint
+
+  std::uint64_t seed = 1;  ///< sensor noise and random pushes
+
+  // ---- plant drives differing from actuators.yaml (model mismatch on the drive side)
+  struct ActuatorOverride {
+    std::string joint;
+    std::optional<double> coulomb_Nm;
+    std::optional<double> viscous_Nms_per_rad;
+    std::optional<double> static_Nm;
+    std::optional<double> reflected_inertia_kgm2;
+    std::optional<double> torque_constant_scale;  ///< plant K_T = scale x nominal K_T
+  };
+  std::vector<ActuatorOverride> actuator_overrides;
+  double friction_scale = 1.0;  ///< multiplies every plant friction coefficient (after the overrides)
+
+  struct Friction {
+    /// Below this joint speed the friction limit is the static (breakaway) level, above it the
+    /// Coulomb level [rad/s].
+    double breakaway_velocity_rad_s = 1e-3;
+  } friction;
+
+  // ---- joint sensors
+  struct Noise {
+    double torque_sensor_std_Nm = 0.05;
+    std::vector<double> torque_sensor_offset_Nm;  ///< one per joint (empty: zeros)
+    double velocity_std_rad_s = 0.002;
+    double current_std_A = 0.01;
+    double encoder_counts_per_rev = 262144.0;  ///< position quantum 2 pi / counts; 0: no quantisation
+  } noise;
+
+  // ---- F/T sensor between the flange and the tool
+  struct FtSensor {
+    std::string flange_site = "end_effector";  ///< MJCF site of the tool flange (z out of the flange)
+    double sensor_offset_m = 0.065;            ///< flange -> sensor measuring frame, along flange z
+    double flange_side_mass_kg = 0.26931;      ///< adapter + sensor body, not measured by the sensor
+    Eigen::Vector3d flange_side_com_m = Eigen::Vector3d(0.0, 0.0, 0.03);       ///< flange frame
+    Eigen::Vector3d flange_side_inertia_kgm2 = Eigen::Vector3d(2.0e-4, 2.0e-4, 2.2e-4);
+    double rate_Hz = 1000.0;
+    double force_std_N = 0.05;
+    double torque_std_Nm = 0.002;
+    Eigen::Vector3d force_bias_N = Eigen::Vector3d::Zero();
+    Eigen::Vector3d torque_bias_Nm = Eigen::Vector3d::Zero();
+  } ft_sensor;
+
+  // ---- the tool below the F/T sensor (DS4 gamepad and its mount by default)
+  struct Tool {
+    double mass_kg = 0.3;
+    Eigen::Vector3d com_m = Eigen::Vector3d(0.0, 0.0, 0.05);  ///< sensor frame
+    Eigen::Vector3d inertia_kgm2 = Eigen::Vector3d(3.4e-4, 7.3e-4, 8.9e-4);  ///< principal, sensor axes
+  } tool;
+
+  // ---- link inertial mismatch relative to the URDF
+  struct Mismatch {
+    bool enabled = false;
+    std::uint64_t seed = 7;
+    double mass_fraction = 0.05;
+    double com_fraction = 0.05;
+    double inertia_fraction = 0.05;
+  } mismatch;
+
+  // ---- the vendor's actuator loops, emulated inside the plant (see KinovaDriveEmulator)
+  struct Vendor {
+    std::vector<double> position_kp_Nm_per_rad;
+    std::vector<double> position_kd_Nms_per_rad;
+    std::vector<double> position_ki_Nm_per_rad_s;
+    std::vector<double> position_integral_limit_Nm;
+    std::vector<double> torque_feedback_gain;
+    std::vector<double> torque_velocity_damping_Nms_per_rad;
+    std::vector<double> high_velocity_numerator = {0.020175, -0.036975, 0.016917};
+    std::vector<double> high_velocity_denominator = {1.0, -1.975063, 0.97518};
+    double high_velocity_rate_Hz = 1000.0;
+  } vendor;
+
+  // ---- the paper's drop test: a mass on a slack cable under the tool, released at a given time
+  struct DropTest {
+    bool enabled = false;
+    double mass_kg = 1.25;
+    double radius_m = 0.04;
+    double cable_length_m = 0.25;
+    double cable_stiffness_N_per_m = 2000.0;
+    double cable_damping_Ns_per_m = 10.0;
+    Eigen::Vector3d anchor_m = Eigen::Vector3d(0.0, 0.0, 0.1);  ///< cable anchor, sensor frame
+    double release_time_s = 1.0;
+    double latch_stiffness_N_per_m = 1.0e5;  ///< holds the mass at the anchor until release
+  } drop_test;
+
+  struct Floor {
+    bool enabled = false;
+    double height_m = 0.0;
+  } floor;
+
+  std::vector<ExternalForce> disturbances;  ///< scripted timeline
+  RandomPushSettings random_pushes;
+};
+
+}  // namespace phri

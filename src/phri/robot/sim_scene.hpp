@@ -1,0 +1,38 @@
+#pragma once
+// phri::SimScene: the MuJoCo scene of the simulated arm, composed in memory around the arm's own
+// MJCF (robots/kinova_gen3/gen3_plant.xml stays the arm alone; it is also the reference model of
+// the dynamics tests). Added to the arm:
+//
+//   <flange body> (the body of config.ft_sensor.flange_site, bracelet_link on the Gen3)
+//     ft_adapter       welded at the flange site: F/T adapter + sensor body (flange side, not measured)
+//       tool           welded at sensor_offset_m along the flange z: the tool (DS4 gamepad + mount);
+//                      its origin is the sensor's measuring frame, site "ft_sensor" with a MuJoCo
+//                      force and torque sensor; site "cable_anchor" when the drop test is enabled
+//   world
+//     drop_mass        (drop test only) free body, a sphere; held at the anchor until release
+//     floor            (optional) a plane; only the drop mass collides with it
+//
+// The arm's keyframes are removed (their qpos would not match once the drop mass adds a free
+// joint); the initial state comes from the plant configuration.
+#include <phri/robot/sim_robot_config.hpp>
+
+#include <string>
+
+namespace phri {
+
+struct SimScene {
+  static constexpr const char* kAdapterBody = "ft_adapter";
+  static constexpr const char* kToolBody = "tool";
+  static constexpr const char* kSensorSite = "ft_sensor";
+  static constexpr const char* kForceSensor = "ft_force";
+  static constexpr const char* kTorqueSensor = "ft_torque";
+  static constexpr const char* kAnchorSite = "cable_anchor";
+  static constexpr const char* kDropBody = "drop_mass";
+  static constexpr const char* kFloorGeom = "floor";
+
+  /// The scene MJCF text for `config`. Reads config.mjcf_path; throws phri::ConfigError when the
+  /// arm file cannot be read or loaded, has no flange site, or already uses one of the names above.
+  static std::string build_mjcf(const SimRobotConfig& config);
+};
+
+}  // namespace phri
