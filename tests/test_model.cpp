@@ -316,6 +316,32 @@ TEST(ModelOptionsTest, ExtraFramesAreFixedToTheirParent) {
   EXPECT_TRUE(frame.isApprox(ee * tcp.placement, 1e-14));
 }
 
+TEST(ModelOptionsTest, PayloadEqualsTheSameMassWrittenInTheUrdf) {
+  // A 0.5 kg box on end_effector_link, as a payload and as a fixed link in the URDF.
+  phri::ModelOptions options;
+  phri::Payload payload;
+  payload.name = "tool";
+  payload.frame = "end_effector_link";
+  payload.inertia.mass = 0.5;
+  payload.inertia.com = Eigen::Vector3d(0.01, 0.0, 0.08);
+  payload.inertia.inertia_com = Eigen::Vector3d(1e-3, 2e-3, 2.5e-3).asDiagonal();
+  options.payloads.push_back(payload);
+  const phri::Model with_payload = phri::Model::from_urdf_file(kGen3Urdf, options);
+  std::string urdf = read_file(kGen3Urdf);
+  urdf.insert(urdf.rfind("</robot>"),
+              "<link name=\"box\"><inertial><origin xyz=\"0.01 0 0.08\"/><mass value=\"0.5\"/><inertia ixx=\"1e-3\" "
+              "ixy=\"0\" ixz=\"0\" iyy=\"2e-3\" iyz=\"0\" izz=\"2.5e-3\"/></inertial></link><joint name=\"box_joint\" "
+              "type=\"fixed\"><parent link=\"end_effector_link\"/><child link=\"box\"/></joint>");
+  const phri::Model in_urdf = phri::Model::from_urdf_string(urdf);
+  phri::Data a(with_payload), b(in_urdf);
+  const Eigen::VectorXd q = Eigen::VectorXd::Constant(7, 0.7);
+  EXPECT_TRUE(phri::crba(with_payload, a, q).isApprox(phri::crba(in_urdf, b, q), 1e-14));
+  EXPECT_TRUE(phri::compute_gravity(with_payload, a, q).isApprox(phri::compute_gravity(in_urdf, b, q), 1e-14));
+  payload.inertia.mass = -1.0;
+  options.payloads = {payload};
+  EXPECT_THROW(phri::Model::from_urdf_file(kGen3Urdf, options), phri::ConfigError);
+}
+
 TEST(ModelOptionsTest, LockedJointBehavesAsFixedAtZero) {
   // A gripper-like branch: a movable joint off the chain is an error unless locked.
   std::string urdf = read_file(kGen3Urdf);

@@ -111,6 +111,7 @@ public:
     }
     for (std::size_t i = 0; i < model_.bodies_.size(); ++i) check_body(static_cast<int>(i));
     add_extra_frames();
+    add_payloads();
     apply_armature();
     for (const std::string& name : options_.locked_joints) {
       if (!urdf_.getJoint(name)) fail("ModelOptions.locked_joints", "unknown joint '" + name + "'");
@@ -316,6 +317,24 @@ private:
       if (!extra.placement.matrix().allFinite()) fail(where, "placement must be finite");
       const Frame& parent = model_.frame(model_.frame_id(extra.parent_frame));
       model_.frames_.push_back(Frame{extra.name, FrameType::kExtra, parent.body, parent.placement * extra.placement});
+    }
+  }
+
+  void add_payloads() {
+    for (const Payload& payload : options_.payloads) {
+      const std::string where = "ModelOptions.payloads '" + payload.name + "'";
+      if (!model_.has_frame(payload.frame)) fail(where, "unknown frame '" + payload.frame + "'");
+      const Inertia& in = payload.inertia;
+      if (!(in.mass > 0.0) || !std::isfinite(in.mass)) fail(where, "mass must be positive");
+      if (!in.com.allFinite() || !in.inertia_com.allFinite()) fail(where, "values must be finite");
+      if ((in.inertia_com - in.inertia_com.transpose()).norm() > 1e-12 * (1.0 + in.inertia_com.norm())) {
+        fail(where, "inertia must be symmetric");
+      }
+      if (!in.inertia_com.isZero(0.0)) check_inertia_tensor(in.inertia_com, where);
+      const Frame& frame = model_.frame(model_.frame_id(payload.frame));
+      if (frame.body < 0) continue;  // on the base: no effect on the dynamics
+      Inertia& body = model_.bodies_[static_cast<std::size_t>(frame.body)];
+      body = body.combined_with(in.transformed(frame.placement));
     }
   }
 

@@ -67,6 +67,13 @@ struct ExtraFrame {
   Eigen::Isometry3d placement = Eigen::Isometry3d::Identity();
 };
 
+/// A rigid payload fixed to a frame (a tool, an F/T sensor), merged into that frame's body.
+struct Payload {
+  std::string name;
+  std::string frame;
+  Inertia inertia;  ///< mass, centre of mass and inertia about it, in `frame`
+};
+
 struct ModelOptions {
   std::string base_link;  ///< empty: the URDF root link
   std::string tip_link;   ///< empty: the end of the chain of movable joints below the base
@@ -74,6 +81,8 @@ struct ModelOptions {
   /// listed joints are treated as fixed at position 0 and their links merged.
   std::vector<std::string> locked_joints;
   std::vector<ExtraFrame> extra_frames;
+  /// Payloads added to the bodies (what the URDF does not carry: sensor, tool).
+  std::vector<Payload> payloads;
   /// Reflected rotor inertia per chain joint (empty: none).
   std::vector<double> armature;
   Eigen::Vector3d gravity = Eigen::Vector3d(0.0, 0.0, -9.81);  ///< in the world frame

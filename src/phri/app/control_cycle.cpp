@@ -1,0 +1,148 @@
+#include <phri/app/control_cycle.hpp>
+
+#include <phri/core/config_error.hpp>
+#include <phri/model/algorithms.hpp>
+
+namespace phri {
+
+Model ControlCycle::load_model(const ControlCycleSettings& settings) {
+  ModelOptions options;
+  ExtraFrame sensor;
+  sensor.name = "ft_sensor";
+  sensor.parent_frame = settings.end_effector_frame;
+  sensor.placement.translation() = Eigen::Vector3d(0.0, 0.0, settings.ft_sensor_offset_m);
+  options.extra_frames.push_back(sensor);
+  for (Payload payload : settings.payloads) {
+    if (payload.frame.empty()) payload.frame = settings.end_effector_frame;  // default: the end effector
+    options.payloads.push_back(payload);
+  }
+  return Model::from_urdf_file(settings.urdf_path, options);
+}
+
+WholeBodyQpSettings ControlCycle::qp_settings(const ControlCycleSettings& settings, const ActuatorTable& actuators) {
+  WholeBodyQpSettings qp = settings.qp;
+  qp.end_effector_frame = settings.end_effector_frame;
+  if (qp.torque_limit.size() == 0) {
+    qp.torque_limit.resize(actuators.size());
+    for (int i = 0; i < actuators.size(); ++i) qp.torque_limit[i] = actuators[i].torque_limit_Nm;
+  }
+  if (qp.velocity_limit.size() == 0) {
+    qp.velocity_limit.resize(actuators.size());
+    for (int i = 0; i < actuators.size(); ++i) qp.velocity_limit[i] = actuators[i].velocity_limit_rad_s;
+  }
+  return qp;
+}
+
+namespace {
+ActuatorTable load_actuators(const ControlCycleSettings& settings, const Model& model) {
+  ActuatorTable table = ActuatorTable::from_yaml_file(settings.actuators_path);
+  if (table.size() != model.nq()) {
+    throw ConfigError(settings.actuators_path, "joints",
+                      std::to_string(table.size()) + " actuators for a model with " + std::to_string(model.nq()) + " joints");
+  }
+  for (int i = 0; i < model.nq(); ++i) {
+    if (table[i].joint_name != model.joint(i).name) {
+      throw ConfigError(settings.actuators_path, "joints[" + std::to_string(i) + "].name",
+                        "'" + table[i].joint_name + "' but the model's joint " + std::to_string(i + 1) + " is '" +
+                            model.joint(i).name + "'");
+    }
+  }
+  return table;
+}
+}  // namespace
+
+ControlCycle::ControlCycle(const ControlCycleSettings& settings)
+    : settings_(settings),
+      model_(load_model(settings)),
+      data_(model_),
+      actuators_(load_actuators(settings, model_)),
+      collision_(settings.collision_path.empty()
+                     ? std::nullopt
+                     : std::optional<CollisionModel>(CollisionModel::from_yaml_file(settings.collision_path, model_))),
+      qp_(model_, collision_ ? &*collision_ : nullptr, qp_settings(settings, actuators_)),
+      compliance_(settings.compliance),
+      observer_(model_, settings.observer_gain),
+      wrench_(settings.wrench),
+      low_level_(actuators_, [&] {
+        CustomTorqueSettings c = settings.custom_torque;
+        c.period_s = settings.period_s;
+        return c;
+      }(), settings.initial_loop),
+      end_effector_frame_(model_.frame_id(settings.end_effector_frame)),
+      sensor_frame_(model_.frame_id("ft_sensor")),
+      q_(Eigen::VectorXd::Zero(model_.nq())),
+      qd_(Eigen::VectorXd::Zero(model_.nv())),
+      zero_torque_(Eigen::VectorXd::Zero(model_.nv())) {
+  if (!(settings.period_s > 0)) throw ConfigError("ControlCycleSettings", "period_s", "must be > 0");
+  if (!(settings.observer_gain > 0)) throw ConfigError("ControlCycleSettings", "observer_gain", "must be > 0");
+}
+
+void ControlCycle::set_compliance_mode(ComplianceMode mode) { pending_mode_ = mode; }
+
+bool ControlCycle::state_usable(const RobotState& state) {
+  if (state.q_rad.size() != model_.nq() || state.qd_rad_s.size() != model_.nv() ||
+      state.tau_sensor_Nm.size() != model_.nv() || !state.joints.valid || !state.torque.valid ||
+      !state.q_rad.allFinite() || !state.qd_rad_s.allFinite() || !state.tau_sensor_Nm.allFinite() ||
+      !state.current_A.allFinite()) {
+    status_ = CycleStatus::kInvalidState;
+    return false;
+  }
+  if (started_ && state.joints.sequence == last_joint_sequence_) {
+    status_ = CycleStatus::kStaleState;
+    return false;
+  }
+  return true;
+}
+
+CycleStatus ControlCycle::step(const RobotState& state, RobotCommand& command) {
+  if (!state_usable(state)) {
+    ++held_cycles_;
+    // The previous command stays in `command`; before any, hold the measured pose if possible.
+    if (!have_command_ && state.q_rad.size() == model_.nq() && state.q_rad.allFinite()) {
+      command.mode = LowLevelMode::kPosition;
+      command.q_rad = state.q_rad;
+    }
+    return status_;
+  }
+  last_joint_sequence_ = state.joints.sequence;
+  q_ = state.q_rad;
+  qd_ = state.qd_rad_s;
+  const double dt = settings_.period_s;
+
+  // ---- estimate
+  compute_all_terms(model_, data_, q_, qd_);
+  coriolis_transpose_times_velocity(model_, data_);
+  observer_.update(data_, qd_, state.tau_sensor_Nm, dt);
+  if (state.wrench.valid && state.wrench.sequence != last_wrench_sequence_) {
+    last_wrench_sequence_ = state.wrench.sequence;
+    const Eigen::Isometry3d& sensor = data_.frame_placements[static_cast<std::size_t>(sensor_frame_)];
+    const Eigen::Isometry3d& ee = data_.frame_placements[static_cast<std::size_t>(end_effector_frame_)];
+    wrench_.update(state.wrench_sensor, sensor, ee.translation());
+  }
+
+  // ---- modes and targets
+  if (!started_) {
+    started_ = true;
+    qp_.posture().set_target(q_);
+    compliance_.initialise(settings_.initial_compliance, qp_, data_);
+  }
+  if (pending_mode_) {
+    compliance_.set_mode(*pending_mode_, qp_, data_);
+    pending_mode_.reset();
+  }
+  compliance_.update(wrench_.calibrated() ? wrench_.norm() : 0.0, qp_, data_);
+
+  // ---- QP and inverse dynamics. Under the robot's position loop the external torque is not fed
+  // back: the stiff servo rejects it and the observer would only see servo effort.
+  const bool torque_loop = low_level_.requested() != LowLevelLoop::kPosition;
+  const ControllerStatus qp_status =
+      qp_.update(model_, data_, q_, qd_, torque_loop ? observer_.external_torque() : zero_torque_, dt);
+
+  // ---- low level
+  low_level_.update(state, qp_.desired_torque(), qp_.desired_acceleration(), command);
+  have_command_ = true;
+  status_ = qp_status == ControllerStatus::kOk ? CycleStatus::kOk : CycleStatus::kQpFallback;
+  return status_;
+}
+
+}  // namespace phri

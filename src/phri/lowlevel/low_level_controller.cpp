@@ -1,0 +1,51 @@
+#include <phri/lowlevel/low_level_controller.hpp>
+
+namespace phri {
+
+LowLevelController::LowLevelController(const ActuatorTable& actuators, const CustomTorqueSettings& custom,
+                                       LowLevelLoop initial)
+    : custom_(actuators, custom),
+      period_s_(custom.period_s),
+      loop_(initial),
+      requested_(initial),
+      q_ref_(Eigen::VectorXd::Zero(actuators.size())),
+      qd_ref_(Eigen::VectorXd::Zero(actuators.size())) {}
+
+void LowLevelController::update(const RobotState& state, const Eigen::VectorXd& tau_desired,
+                                const Eigen::VectorXd& qdd_desired, RobotCommand& command) {
+  const bool entering = !started_ || requested_ != loop_;
+  if (requested_ != loop_) ++switches_;
+  loop_ = requested_;
+  started_ = true;
+  switch (loop_) {
+    case LowLevelLoop::kPosition:
+      if (entering) {
+        // Start the reference where the arm is, moving as it moves: no position step.
+        q_ref_ = state.q_rad;
+        qd_ref_ = state.qd_rad_s;
+      }
+      // Semi-implicit Euler integration of the desired acceleration.
+      qd_ref_ += period_s_ * qdd_desired;
+      q_ref_ += period_s_ * qd_ref_;
+      command.mode = LowLevelMode::kPosition;
+      command.q_rad = q_ref_;
+      break;
+    case LowLevelLoop::kKinovaTorque:
+    case LowLevelLoop::kKinovaTorqueHighVelocity:
+      command.mode = loop_ == LowLevelLoop::kKinovaTorque ? LowLevelMode::kKinovaTorque
+                                                          : LowLevelMode::kKinovaTorqueHighVelocity;
+      command.tau_Nm = tau_desired;
+      break;
+    case LowLevelLoop::kCustom:
+      if (entering) {
+        custom_.reset(state.current_A, tau_desired, qdd_desired, state.tau_sensor_Nm, state.qd_rad_s);
+      } else {
+        custom_.update(tau_desired, qdd_desired, state.tau_sensor_Nm, state.qd_rad_s);
+      }
+      command.mode = LowLevelMode::kCurrent;
+      command.current_A = custom_.current();
+      break;
+  }
+}
+
+}  // namespace phri

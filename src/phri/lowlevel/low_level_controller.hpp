@@ -1,0 +1,72 @@
+#pragma once
+// phri::LowLevelController: the last stage of the control cycle. It turns the QP's desired
+// acceleration qdd_d and torque tau_d into a RobotCommand for the selected loop, and switches
+// between loops at any cycle without a jump (paper: position control, Kinova's torque loops and
+// the custom torque loop, switched live from the gamepad):
+//
+//   kPosition                 q_ref += T qd_ref, qd_ref += T qdd_d (the robot's position servo
+//                             tracks q_ref); entered at the measured q, qd
+//   kKinovaTorque             tau_d to the vendor's torque loop
+//   kKinovaTorqueHighVelocity tau_d to the vendor's high-velocity torque loop
+//   kCustom                   CustomTorqueController: motor current (reset bumplessly on entry
+//                             from the current the drives carry)
+//
+// A requested switch takes effect at the next update(); every switch is counted and its torque
+// step (the change of the robot's measured motor torque across the switch is what a test checks)
+// can be logged from switch_count() and last_switch_time().
+#include <phri/lowlevel/custom_torque_controller.hpp>
+#include <phri/robot/robot_command.hpp>
+#include <phri/robot/robot_state.hpp>
+
+#include <optional>
+#include <string_view>
+
+namespace phri {
+
+enum class LowLevelLoop { kPosition, kKinovaTorque, kKinovaTorqueHighVelocity, kCustom };
+
+constexpr std::string_view to_string(LowLevelLoop loop) {
+  switch (loop) {
+    case LowLevelLoop::kPosition: return "position";
+    case LowLevelLoop::kKinovaTorque: return "kinova_torque";
+    case LowLevelLoop::kKinovaTorqueHighVelocity: return "kinova_torque_high_velocity";
+    case LowLevelLoop::kCustom: return "custom";
+  }
+  return "unknown";
+}
+constexpr std::optional<LowLevelLoop> low_level_loop_from_string(std::string_view name) {
+  if (name == "position") return LowLevelLoop::kPosition;
+  if (name == "kinova_torque") return LowLevelLoop::kKinovaTorque;
+  if (name == "kinova_torque_high_velocity") return LowLevelLoop::kKinovaTorqueHighVelocity;
+  if (name == "custom") return LowLevelLoop::kCustom;
+  return std::nullopt;
+}
+
+class LowLevelController {
+public:
+  LowLevelController(const ActuatorTable& actuators, const CustomTorqueSettings& custom, LowLevelLoop initial);
+
+  /// Switch to `loop` at the next update (no effect if it is already running).
+  void request(LowLevelLoop loop) { requested_ = loop; }
+  LowLevelLoop loop() const { return loop_; }
+  LowLevelLoop requested() const { return requested_; }
+  int switch_count() const { return switches_; }
+
+  /// One control period: the command for the running loop, in `command` (sized for the robot).
+  void update(const RobotState& state, const Eigen::VectorXd& tau_desired, const Eigen::VectorXd& qdd_desired,
+              RobotCommand& command);
+
+  const CustomTorqueController& custom() const { return custom_; }
+  const Eigen::VectorXd& position_reference() const { return q_ref_; }
+
+private:
+  CustomTorqueController custom_;
+  double period_s_;
+  LowLevelLoop loop_;
+  LowLevelLoop requested_;
+  bool started_ = false;
+  int switches_ = 0;
+  Eigen::VectorXd q_ref_, qd_ref_;
+};
+
+}  // namespace phri
