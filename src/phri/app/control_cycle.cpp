@@ -26,6 +26,13 @@ WholeBodyQpSettings ControlCycle::qp_settings(const ControlCycleSettings& settin
     qp.torque_limit.resize(actuators.size());
     for (int i = 0; i < actuators.size(); ++i) qp.torque_limit[i] = actuators[i].torque_limit_Nm;
   }
+  if (qp.compliance_deadband.size() == 0) {
+    qp.compliance_deadband.resize(actuators.size());
+    for (int i = 0; i < actuators.size(); ++i) {
+      qp.compliance_deadband[i] = actuators[i].size == ActuatorSize::kLarge ? settings.deadband_large_Nm
+                                                                            : settings.deadband_small_Nm;
+    }
+  }
   if (qp.velocity_limit.size() == 0) {
     qp.velocity_limit.resize(actuators.size());
     for (int i = 0; i < actuators.size(); ++i) qp.velocity_limit[i] = actuators[i].velocity_limit_rad_s;

@@ -43,6 +43,10 @@ struct ControlCycleSettings {
   /// of 5x more torque-sensor noise in tau_ext (about 0.05 N.m rms with the plant's sensor noise).
   double observer_gain = 50.0;
   WholeBodyQpSettings qp;  ///< torque/velocity limits default to actuators.yaml's
+  /// Dead band of tau_ext in the compliant tasks when qp.compliance_deadband is empty, by actuator
+  /// size [N.m]: above the estimate's bias (5 % mismatch, sensor offsets), far below a push.
+  double deadband_large_Nm = 1.0;
+  double deadband_small_Nm = 0.4;
   ComplianceSettings compliance;
   WrenchEstimatorSettings wrench;
   CustomTorqueSettings custom_torque;

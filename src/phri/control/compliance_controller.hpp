@@ -17,8 +17,8 @@ struct ComplianceSettings {
   /// Full-body compliance: a softer end effector (paper demo, Compliance state: K 30).
   double full_body_ee_stiffness = 30.0;
   /// Posture task (weight 1): a weak spring so that a pushed elbow comes back.
-  double posture_stiffness = 10.0;
-  double posture_damping = 6.0;
+  double posture_stiffness = 20.0;
+  double posture_damping = 9.0;
   double posture_weight = 1.0;
   // Dual compliance (paper: 8 up, 4 down on the 6-D wrench norm; touched EE damping 15,
   // posture damping 2).

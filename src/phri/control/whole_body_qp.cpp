@@ -40,6 +40,10 @@ WholeBodyQp::WholeBodyQp(const Model& model, const CollisionModel* collision, co
   }
   if (!(settings.velocity_limit_gain > 0) || !(settings.brake_damping > 0)) fail("velocity_limit_gain", "gains must be > 0");
   velocity_limit_ *= settings.velocity_limit_fraction;
+  deadband_ = settings.compliance_deadband.size() ? settings.compliance_deadband : Eigen::VectorXd::Zero(nv_);
+  if (deadband_.size() != nv_ || !(deadband_.array() >= 0).all() || !deadband_.allFinite()) {
+    fail("compliance_deadband", "needs one finite value >= 0 per joint");
+  }
 
   lower_ = model.lower_limits();
   upper_ = model.upper_limits();
@@ -98,8 +102,11 @@ ControllerStatus WholeBodyQp::update(const Model& model, const Data& data, const
     status_ = ControllerStatus::kInvalidInput;
     return status_;
   }
-  // qdd_ext = M^-1 tau_ext: what the push alone would do to the arm.
-  qdd_external_ = tau_ext;
+  // qdd_ext = M^-1 tau_ext: what the push alone would do to the arm (through the dead band).
+  for (int i = 0; i < nv_; ++i) {
+    const double x = tau_ext[i];
+    qdd_external_[i] = std::copysign(std::max(std::abs(x) - deadband_[i], 0.0), x);
+  }
   data.mass_matrix_llt.solveInPlace(qdd_external_);
 
   end_effector_.update(model, data, qdd_external_, dt);

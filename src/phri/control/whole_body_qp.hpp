@@ -54,6 +54,12 @@ struct WholeBodyQpSettings {
   double velocity_limit_gain = 50.0;
   /// Self-collision damper (paper: d_i 0.03 m, d_s 0.015 m, M 1.8; xi 0.08 m/s gives its lambda ~ 70).
   VelocityDamperSettings collision{0.03, 0.015, 0.08, 1.8};
+  /// Soft dead band on tau_ext before it enters the compliant tasks (gamma terms) only, per joint
+  /// [N.m]; empty: none. The observer's estimate carries the model's errors (a 5 % mass error is
+  /// ~1 N.m on the shoulder) and the torque sensors' offsets as a constant "push"; through
+  /// gamma = 1 they would bend the posture or drift a soft end effector. Inverse dynamics and the
+  /// constraints keep the full estimate. The dead band is continuous: x -> sign(x) max(|x| - b, 0).
+  Eigen::VectorXd compliance_deadband;
   double regularization = 1e-9;   ///< added to the Hessian's diagonal
   double brake_damping = 20.0;    ///< 1/s, the fallback's joint damping brake
   double smoothing_time_constant = 0.1;  ///< s, of the tasks' gain filters
@@ -122,6 +128,7 @@ private:
   Eigen::VectorXd safe_lower_, safe_upper_;
   QpProblem problem_;
   QpSolver solver_;
+  Eigen::VectorXd deadband_;
   Eigen::VectorXd qdd_external_, qdd_desired_, tau_desired_, last_good_tau_;
   Eigen::MatrixXd weighted_jacobian_;  // 6 x nv scratch
   ControllerStatus status_ = ControllerStatus::kOk;

@@ -1,0 +1,261 @@
+// ctest-labels: physics
+// The whole framework on the realistic plant: phri::ControlCycle (observer, F/T, compliance, QP,
+// custom low-level torque loop) driving phri::SimRobot with 5 % link-inertial mismatch, friction,
+// rotor inertia and sensor noise. The paper's compliance behaviours and stiff safety constraints,
+// with the figures printed.
+#include <phri/app/control_cycle.hpp>
+#include <phri/control/end_effector_task.hpp>
+#include <phri/model/algorithms.hpp>
+#include <phri/robot/sim_robot.hpp>
+
+#include "allocation_counter.hpp"
+
+#include <gtest/gtest.h>
+
+#include <functional>
+#include <memory>
+
+namespace {
+
+const std::string kRoot = PHRI_SOURCE_DIR;
+
+phri::ExternalForce push(const std::string& body, const Eigen::Vector3d& point, const Eigen::Vector3d& force,
+                         double start, double duration) {
+  phri::ExternalForce f;
+  f.body = body;
+  f.point_m = point;
+  f.force_N = force;
+  f.profile = phri::ExternalForce::Profile::kRamp;  // a hand: 50 ms rise, hold, release
+  f.rise_s = 0.05;
+  f.start_s = start;
+  f.duration_s = duration;
+  return f;
+}
+
+class Rig {
+public:
+  Rig(phri::ComplianceMode mode, std::vector<phri::ExternalForce> pushes,
+      phri::LowLevelLoop loop = phri::LowLevelLoop::kCustom)
+      : config_(make_config(std::move(pushes))), robot_(config_), cycle_(make_settings(mode, loop)), command_(7) {}
+
+  static phri::SimRobotConfig make_config(std::vector<phri::ExternalForce> pushes) {
+    phri::SimRobotConfig c = phri::SimRobotConfig::from_yaml_file(kRoot + "/configs/plant_gen3.yaml");
+    c.initial_q_rad = {0, 0.58, 3.14, -1.84, 0, 0.85, 1.57};  // the paper demo's postureTarget
+    c.mismatch.enabled = true;  // 5 % masses, COMs, inertias
+    c.disturbances = std::move(pushes);
+    return c;
+  }
+  static phri::ControlCycleSettings make_settings(phri::ComplianceMode mode, phri::LowLevelLoop loop) {
+    phri::ControlCycleSettings s;
+    s.urdf_path = kRoot + "/robots/kinova_gen3/gen3.urdf";
+    s.actuators_path = kRoot + "/robots/kinova_gen3/actuators.yaml";
+    s.collision_path = kRoot + "/robots/kinova_gen3/collision.yaml";
+    s.initial_compliance = mode;
+    s.initial_loop = loop;
+    return s;
+  }
+
+  void run(double seconds, const std::function<void()>& each = {}) {
+    const int n = static_cast<int>(std::lround(seconds / robot_.period_s()));
+    for (int k = 0; k < n; ++k) {
+      const phri::RobotState& state = robot_.read();
+      cycle_.step(state, command_);
+      robot_.write(command_);
+      torque_ok_ &= (cycle_.qp().desired_torque().cwiseAbs().array() <= cycle_.qp().torque_limit().array() + 1e-6).all();
+      if (each) each();
+    }
+  }
+  Eigen::Isometry3d ee() const {
+    // The plant's true flange pose (site end_effector), not the controller's estimate.
+    return body_site_pose();
+  }
+  double ee_position_error() const {
+    return (cycle_.qp().end_effector().target_pose().translation() - ee().translation()).norm();
+  }
+  double ee_orientation_error_deg() const {
+    return phri::rotation_log(cycle_.qp().end_effector().target_pose().linear() * ee().linear().transpose()).norm() *
+           180.0 / M_PI;
+  }
+  Eigen::Vector3d body_position(const std::string& name) const;
+
+  phri::SimRobotConfig config_;
+  phri::SimRobot robot_;
+  phri::ControlCycle cycle_;
+  phri::RobotCommand command_;
+  bool torque_ok_ = true;
+
+private:
+  Eigen::Isometry3d body_site_pose() const;
+};
+
+}  // namespace
+
+#include <mujoco/mujoco.h>
+
+namespace {
+
+Eigen::Isometry3d Rig::body_site_pose() const {
+  const mjModel* m = robot_.mujoco_model();
+  const mjData* d = robot_.mujoco_data();
+  const int site = mj_name2id(m, mjOBJ_SITE, "end_effector");
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.translation() << d->site_xpos[3 * site], d->site_xpos[3 * site + 1], d->site_xpos[3 * site + 2];
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) pose.linear()(r, c) = d->site_xmat[9 * site + 3 * r + c];
+  return pose;
+}
+
+Eigen::Vector3d Rig::body_position(const std::string& name) const {
+  const mjModel* m = robot_.mujoco_model();
+  const mjData* d = robot_.mujoco_data();
+  const int body = mj_name2id(m, mjOBJ_BODY, name.c_str());
+  return Eigen::Vector3d(d->xpos[3 * body], d->xpos[3 * body + 1], d->xpos[3 * body + 2]);
+}
+
+TEST(SimControl, HoldsItsPoseAtRest) {
+  Rig rig(phri::ComplianceMode::kNullSpace, {});
+  rig.run(0.5);
+  double max_error = 0.0;
+  rig.run(2.0, [&]() { max_error = std::max(max_error, rig.ee_position_error()); });
+  std::printf("rest: EE position error max %.3f mm, orientation %.3f deg\n", 1e3 * max_error, rig.ee_orientation_error_deg());
+  EXPECT_LT(max_error, 0.002);
+  EXPECT_EQ(rig.cycle_.status(), phri::CycleStatus::kOk);
+}
+
+TEST(SimControl, NullSpaceComplianceElbowMovesEndEffectorHolds) {
+  Rig rig(phri::ComplianceMode::kNullSpace, {push("forearm_link", Eigen::Vector3d::Zero(), Eigen::Vector3d(0, 30, 0), 1.0, 1.0)});
+  rig.run(0.9);
+  const Eigen::Vector3d elbow_start = rig.body_position("forearm_link");
+  double max_pos = 0.0, max_ori = 0.0, elbow_move = 0.0;
+  rig.run(4.0, [&]() {
+    max_pos = std::max(max_pos, rig.ee_position_error());
+    max_ori = std::max(max_ori, rig.ee_orientation_error_deg());
+    elbow_move = std::max(elbow_move, (rig.body_position("forearm_link") - elbow_start).norm());
+  });
+  const double back = (rig.body_position("forearm_link") - elbow_start).norm();
+  std::printf("null-space (plant): elbow moved %.1f mm, EE error max %.3f mm / %.3f deg, elbow back to %.2f mm\n",
+              1e3 * elbow_move, 1e3 * max_pos, max_ori, 1e3 * back);
+  EXPECT_GT(elbow_move, 0.05);
+  EXPECT_LT(max_pos, 0.002);
+  EXPECT_LT(max_ori, 1.0);
+  // Returns: within 5 % of its excursion 3 s after the push (what is left is static friction the
+  // weak posture spring cannot break, as on the real arm).
+  EXPECT_LT(back, 0.05 * elbow_move);
+  EXPECT_TRUE(rig.torque_ok_);
+}
+
+TEST(SimControl, FullBodyComplianceYieldsAndReturns) {
+  Rig rig(phri::ComplianceMode::kFullBody, {push("tool", Eigen::Vector3d(0, 0, 0.05), Eigen::Vector3d(0, 0, -20), 1.0, 1.5)});
+  rig.run(0.9);
+  const Eigen::Vector3d start = rig.ee().translation();
+  double moved = 0.0;
+  rig.run(1.6, [&]() { moved = std::max(moved, (rig.ee().translation() - start).norm()); });
+  rig.run(4.0);
+  const double back = (rig.ee().translation() - start).norm();
+  std::printf("full-body (plant): EE moved %.1f mm under 20 N, %.2f mm from the target 4 s after release\n", 1e3 * moved, 1e3 * back);
+  EXPECT_GT(moved, 0.03);
+  // Back to within 5 % of the excursion: the soft full-body spring (K 30) against static friction.
+  EXPECT_LT(back, 0.05 * moved);
+}
+
+TEST(SimControl, DualComplianceKeepsTheNewPoseAndIgnoresLightTouches) {
+  Rig rig(phri::ComplianceMode::kDual, {push("tool", Eigen::Vector3d(0, 0, 0.05), Eigen::Vector3d(0, 3, 0), 1.0, 1.0),
+                                         push("tool", Eigen::Vector3d(0, 0, 0.05), Eigen::Vector3d(0, 15, 0), 2.5, 1.0)});
+  rig.run(0.9);
+  const Eigen::Vector3d start = rig.ee().translation();
+  rig.run(1.4);
+  EXPECT_EQ(rig.cycle_.compliance().touch_count(), 0) << "a 3 N touch switched the mode";
+  const double light = (rig.ee().translation() - start).norm();
+  rig.run(1.8);  // to t = 4.1 s: the 15 N push from 2.5 to 3.5 s, then released
+  EXPECT_EQ(rig.cycle_.compliance().touch_count(), 1);
+  EXPECT_FALSE(rig.cycle_.compliance().touched());
+  const Eigen::Vector3d released = rig.ee().translation();
+  double drift = 0.0;
+  rig.run(2.0, [&]() { drift = std::max(drift, (rig.ee().translation() - released).norm()); });
+  std::printf("dual (plant): 3 N moved the EE %.2f mm (no switch); 15 N moved it %.1f mm; drift over 2 s after release %.3f mm\n",
+              1e3 * light, 1e3 * (released - start).norm(), 1e3 * drift);
+  EXPECT_GT((released - start).norm(), 0.03);
+  EXPECT_LT(drift, 0.001);
+}
+
+// Directions computed on the controller's model at the start posture.
+struct StartPose {
+  phri::Model model = phri::Model::from_urdf_file(kRoot + "/robots/kinova_gen3/gen3.urdf");
+  phri::Data data{model};
+  StartPose() {
+    Eigen::VectorXd q(7);
+    q << 0, 0.58, 3.14, -1.84, 0, 0.85, 1.57;
+    phri::forward_kinematics(model, data, q);
+    phri::update_frame_placements(model, data);
+  }
+  Eigen::Vector3d origin(const std::string& link) const {
+    return data.frame_placements[static_cast<std::size_t>(model.frame_id(link))].translation();
+  }
+};
+
+TEST(SimControl, JointLimitDamperNegatesAPushTowardTheLimit) {
+  // 60 N for 2 s at the wrist, folding the elbow (joint 4) toward its lower limit, full-body mode.
+  StartPose start;
+  Eigen::MatrixXd jacobian(3, 7);
+  const Eigen::Vector3d wrist = start.origin("spherical_wrist_1_link");
+  phri::body_point_linear_jacobian(start.model, start.data, 3, wrist, jacobian);
+  const Eigen::Vector3d direction = -jacobian.col(3).normalized();
+  Rig rig(phri::ComplianceMode::kFullBody, {push("spherical_wrist_1_link", Eigen::Vector3d::Zero(), 60.0 * direction, 1.0, 2.0)});
+  const double lower = -2.57, d_s = 0.01 * 5.14;
+  double min_q4 = 0.0, max_speed_ratio = 0.0;
+  rig.run(3.5, [&]() {
+    const auto& truth = rig.robot_.truth();
+    min_q4 = std::min(min_q4, truth.q_rad[3]);
+    for (int i = 0; i < 7; ++i) {
+      max_speed_ratio = std::max(max_speed_ratio, std::abs(truth.qd_rad_s[i]) / rig.robot_.plant_actuators()[i].velocity_limit_rad_s);
+    }
+  });
+  std::printf("joint limit (plant): q4 min %.4f rad (limit + d_s = %.4f), max |qd| / velocity limit %.3f\n", min_q4,
+              lower + d_s, max_speed_ratio);
+  EXPECT_LT(min_q4, -2.2);  // the push did drive it toward the limit
+  EXPECT_GT(min_q4, lower + d_s - 0.5 * M_PI / 180.0);
+  EXPECT_LT(max_speed_ratio, 1.0);
+  EXPECT_TRUE(rig.torque_ok_);
+}
+
+TEST(SimControl, SelfCollisionDamperKeepsTheWristOffTheBase) {
+  StartPose start;
+  const Eigen::Vector3d direction = (Eigen::Vector3d(0, 0, 0.1) - start.origin("spherical_wrist_2_link")).normalized();
+  Rig rig(phri::ComplianceMode::kFullBody,
+          {push("spherical_wrist_2_link", Eigen::Vector3d::Zero(), 60.0 * direction, 1.0, 3.0)});
+  double min_distance = 1.0;
+  rig.run(4.5, [&]() { min_distance = std::min(min_distance, rig.cycle_.qp().collision_data()->distance.minCoeff()); });
+  std::printf("self-collision (plant): smallest capsule distance %.1f mm (d_s = 15 mm)\n", 1e3 * min_distance);
+  EXPECT_LT(min_distance, 0.03);  // the push did bring the wrist within the influence distance
+  EXPECT_GT(min_distance, 0.015 - 0.002);
+  EXPECT_TRUE(rig.torque_ok_);
+}
+
+TEST(SimControl, UnreachableTargetGivesBoundedSmoothTorquesAndTheCycleDoesNotAllocate) {
+  Rig rig(phri::ComplianceMode::kStiff, {});
+  rig.run(0.5);
+  Eigen::Isometry3d far = rig.cycle_.qp().end_effector().target_pose();
+  far.translation() = Eigen::Vector3d(1.5, 0.0, 0.4);  // out of reach: the arm stretches to a singularity
+  rig.cycle_.qp().end_effector().set_target(far);
+  double max_step = 0.0;
+  Eigen::VectorXd last = rig.cycle_.qp().desired_torque();
+  std::size_t allocations = 0;
+  rig.run(3.0, [&]() {
+    max_step = std::max(max_step, (rig.cycle_.qp().desired_torque() - last).cwiseAbs().maxCoeff());
+    last = rig.cycle_.qp().desired_torque();
+  });
+  // One more second, counting heap allocations of the whole loop (plant read/write included).
+  {
+    phri::test::AllocationCounter count;
+    rig.run(1.0);
+    allocations = count.allocations();
+  }
+  std::printf("unreachable target (plant): max step of tau_d %.3f N.m per ms; %zu allocations in 1000 cycles\n", max_step,
+              allocations);
+  EXPECT_TRUE(rig.torque_ok_);
+  EXPECT_TRUE(last.allFinite());
+  EXPECT_LT(max_step, 5.0);
+  EXPECT_EQ(allocations, 0u);
+}
+
+}  // namespace
