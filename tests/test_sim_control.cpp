@@ -258,4 +258,41 @@ TEST(SimControl, UnreachableTargetGivesBoundedSmoothTorquesAndTheCycleDoesNotAll
   EXPECT_EQ(allocations, 0u);
 }
 
+TEST(SimControl, ComplianceModeSwitchesAreSmooth) {
+  // Cycle through every mode while a 10 N push rests on the tool (so gamma matters), and measure the
+  // largest change of the desired torque from one cycle to the next around the switches.
+  Rig rig(phri::ComplianceMode::kStiff, {push("tool", Eigen::Vector3d(0, 0, 0.05), Eigen::Vector3d(5, 5, -6), 0.5, 6.0)});
+  rig.run(1.0);
+  const phri::ComplianceMode modes[] = {phri::ComplianceMode::kNullSpace, phri::ComplianceMode::kFullBody,
+                                        phri::ComplianceMode::kDual, phri::ComplianceMode::kStiff,
+                                        phri::ComplianceMode::kFullBody, phri::ComplianceMode::kNullSpace};
+  Eigen::VectorXd last = rig.cycle_.qp().desired_torque();
+  double max_step = 0.0;
+  double baseline = 0.0;
+  rig.run(0.5, [&]() {
+    baseline = std::max(baseline, (rig.cycle_.qp().desired_torque() - last).cwiseAbs().maxCoeff());
+    last = rig.cycle_.qp().desired_torque();
+  });
+  for (phri::ComplianceMode mode : modes) {
+    rig.cycle_.set_compliance_mode(mode);
+    double segment = 0.0;
+    int at = 0, k = 0;
+    rig.run(0.5, [&]() {
+      const double step = (rig.cycle_.qp().desired_torque() - last).cwiseAbs().maxCoeff();
+      if (step > segment) { segment = step; at = k; }
+      ++k;
+      last = rig.cycle_.qp().desired_torque();
+    });
+    std::printf("  to %s: max step %.3f at cycle %d\n", std::string(phri::to_string(mode)).c_str(), segment, at);
+    max_step = std::max(max_step, segment);
+  }
+  std::printf("  baseline (no switch) %.3f\n", baseline);
+  std::printf("compliance mode switches (plant): max |tau_d step| %.3f N.m per ms over 6 switches\n", max_step);
+  // Stated bound: 1.5 N.m per control period, sensor-noise jitter included (without any switch,
+  // tau_d moves by up to ~0.9 N.m per period here: torque-sensor and velocity noise through the
+  // observer and the task damping).
+  EXPECT_LT(max_step, 1.5);
+  EXPECT_TRUE(rig.torque_ok_);
+}
+
 }  // namespace

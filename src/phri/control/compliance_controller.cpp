@@ -79,16 +79,16 @@ void ComplianceController::update(double wrench_norm, WholeBodyQp& qp, const Dat
   if (mode_ != ComplianceMode::kDual) return;
   if (!std::isfinite(wrench_norm)) return;  // a bad sample changes nothing
   if (!touched_ && wrench_norm >= settings_.touch_threshold) {
+    // The spring fades out through the gain filter (the target stays put, so nothing steps).
     touched_ = true;
     ++touch_count_;
     apply(qp);
   } else if (touched_ && wrench_norm < settings_.release_threshold) {
+    // The pose at release is the new target; the spring, faded by now, grows back from zero.
     touched_ = false;
-    qp.end_effector().hold_current_pose(data);  // the pose at release is the new target
+    qp.end_effector().hold_current_pose(data);
     apply(qp);
   }
-  // While touched the target follows the hand, so nothing pulls back when the stiffness returns.
-  if (touched_) qp.end_effector().hold_current_pose(data);
 }
 
 }  // namespace phri

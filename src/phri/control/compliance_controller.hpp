@@ -3,7 +3,10 @@
 // trigger on the end-effector wrench norm (paper: "touched" above the high threshold, released
 // below the low one). While touched the end-effector task has zero stiffness, low damping and
 // gamma 1, so the hand drags it; on release the pose at release becomes the target and the mode is
-// null-space compliance again. Every gain change goes through the tasks' smoothing filters.
+// null-space compliance again. Every gain change goes through the tasks' smoothing filters: on a
+// touch the spring fades out (time constant 0.1 s) with its target unchanged, so the torque never
+// steps; a touch shorter than a few time constants releases onto a spring not yet fully faded,
+// which is the bounded step of K(t) times the distance dragged.
 #include <phri/control/compliance_mode.hpp>
 #include <phri/control/whole_body_qp.hpp>
 
