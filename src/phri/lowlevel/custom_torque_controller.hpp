@@ -12,7 +12,9 @@
 //   coefficients, at 1 kHz) with gain lambda, plus a leaky integrator K_I / (s + theta).
 //
 // The leaky integrator is discretised by zero-order hold (exact for an error held over each
-// period): x[k+1] = a x[k] + K_I (1 - a) / theta e[k], a = exp(-theta T). Its leak time constant
+// period), with the newest error sample: x[k] = a x[k-1] + K_I (1 - a) / theta e[k],
+// a = exp(-theta T), so a constant error gives the continuous step response's samples
+// (K_I / theta) e (1 - e^{-theta k T}). Its leak time constant
 // is 1 / theta; its output is clamped (a fraction of the joint's torque limit, 5 % in the paper's
 // code) and it stops integrating toward a saturated current (anti-windup).
 //
