@@ -39,8 +39,9 @@ void CustomTorqueController::reset(const Eigen::VectorXd& current_now, const Eig
   // so that this first period's filter output is accounted for.
   for (int i = 0; i < dof(); ++i) {
     const ActuatorParameters& a = actuators_[static_cast<std::size_t>(i)];
+    // The whole gap, even beyond the integrator's clamp: it leaks away with time constant 1/theta.
     const double gap = current_now[i] * a.torque_per_amp() - tau_command_[i];
-    integral_[i] = std::clamp(gap, -integral_limit_[i], integral_limit_[i]);
+    integral_[i] = std::clamp(gap, -a.max_motor_torque_Nm(), a.max_motor_torque_Nm());
     tau_command_[i] += integral_[i];
     current_[i] = std::clamp(tau_command_[i] / a.torque_per_amp(), -a.current_limit_A, a.current_limit_A);
   }
@@ -62,8 +63,9 @@ const Eigen::VectorXd& CustomTorqueController::update(const Eigen::VectorXd& tau
     filtered_[i] = settings_.transfer_gain * filters_[j].step(error);
     const double without_integral = tau_desired[i] + rotor_[i] + friction_[i] + filtered_[i];
     // Leaky integrator, with anti-windup: no integration pushing further into saturation.
-    const double candidate = std::clamp(leak_factor_ * integral_[i] + input_factor_ * error, -integral_limit_[i],
-                                        integral_limit_[i]);
+    // Above the clamp only after a bumpless entry (reset): then the integral may only leak down.
+    const double bound = std::max(integral_limit_[i], std::abs(leak_factor_ * integral_[i]));
+    const double candidate = std::clamp(leak_factor_ * integral_[i] + input_factor_ * error, -bound, bound);
     const double max_torque = a.max_motor_torque_Nm();
     const double unsaturated = without_integral + candidate;
     const bool pushes_into_limit = (unsaturated > max_torque && candidate > integral_[i]) ||

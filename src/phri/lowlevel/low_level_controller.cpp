@@ -1,6 +1,11 @@
 #include <phri/lowlevel/low_level_controller.hpp>
 
+#include <cmath>
+
 namespace phri {
+namespace {
+constexpr double kTorqueBlendTime = 0.05;  // s
+}
 
 LowLevelController::LowLevelController(const ActuatorTable& actuators, const CustomTorqueSettings& custom,
                                        LowLevelLoop initial)
@@ -9,7 +14,9 @@ LowLevelController::LowLevelController(const ActuatorTable& actuators, const Cus
       loop_(initial),
       requested_(initial),
       q_ref_(Eigen::VectorXd::Zero(actuators.size())),
-      qd_ref_(Eigen::VectorXd::Zero(actuators.size())) {}
+      qd_ref_(Eigen::VectorXd::Zero(actuators.size())),
+      torque_offset_(Eigen::VectorXd::Zero(actuators.size())),
+      offset_decay_(std::exp(-custom.period_s / kTorqueBlendTime)) {}
 
 void LowLevelController::update(const RobotState& state, const Eigen::VectorXd& tau_desired,
                                 const Eigen::VectorXd& qdd_desired, RobotCommand& command) {
@@ -34,7 +41,10 @@ void LowLevelController::update(const RobotState& state, const Eigen::VectorXd& 
     case LowLevelLoop::kKinovaTorqueHighVelocity:
       command.mode = loop_ == LowLevelLoop::kKinovaTorque ? LowLevelMode::kKinovaTorque
                                                           : LowLevelMode::kKinovaTorqueHighVelocity;
-      command.tau_Nm = tau_desired;
+      // Bumpless: start from the torque the joints carry now, fade into tau_d.
+      if (entering) torque_offset_ = state.tau_sensor_Nm - tau_desired;
+      command.tau_Nm = tau_desired + torque_offset_;
+      torque_offset_ *= offset_decay_;
       break;
     case LowLevelLoop::kCustom:
       if (entering) {

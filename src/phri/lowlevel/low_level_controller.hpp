@@ -8,6 +8,8 @@
 //                             tracks q_ref); entered at the measured q, qd
 //   kKinovaTorque             tau_d to the vendor's torque loop
 //   kKinovaTorqueHighVelocity tau_d to the vendor's high-velocity torque loop
+//                             (both entered at the torque the joints carry: the set-point starts
+//                             at the measured tau_s and blends into tau_d, time constant 50 ms)
 //   kCustom                   CustomTorqueController: motor current (reset bumplessly on entry
 //                             from the current the drives carry)
 //
@@ -67,6 +69,8 @@ private:
   bool started_ = false;
   int switches_ = 0;
   Eigen::VectorXd q_ref_, qd_ref_;
+  Eigen::VectorXd torque_offset_;  // measured minus desired torque at a torque-loop entry, fading
+  double offset_decay_ = 0.0;
 };
 
 }  // namespace phri

@@ -35,6 +35,7 @@ KinovaDriveEmulator::KinovaDriveEmulator(const ActuatorTable& drives, const SimR
   current_des_ = Eigen::VectorXd::Zero(n);
   integral_ = Eigen::VectorXd::Zero(n);
   filter_out_ = Eigen::VectorXd::Zero(n);
+  last_qd_meas_ = Eigen::VectorXd::Zero(n);
 }
 
 void KinovaDriveEmulator::set_position_integral(const Eigen::VectorXd& integral) {
@@ -46,8 +47,9 @@ void KinovaDriveEmulator::enter(LowLevelMode mode, const Eigen::VectorXd& q_meas
   entered_ = true;
   switch (mode) {
     case LowLevelMode::kPosition:
-      // Bumpless: the servo starts by producing the torque the motor produced last.
-      qd_ff_.setZero();
+      // Bumpless: the servo starts by producing the torque the motor produced last; moving as the
+      // arm moves, so the D term starts at zero (the next fresh set-point gives the feed-forward).
+      qd_ff_ = last_qd_meas_.cwiseMax(-velocity_limit_).cwiseMin(velocity_limit_);
       integral_ = (tau_motor - kp_.cwiseProduct(q_des_ - q_meas)).cwiseMax(-integral_limit_).cwiseMin(integral_limit_);
       break;
     case LowLevelMode::kKinovaTorqueHighVelocity:
@@ -90,6 +92,7 @@ void KinovaDriveEmulator::begin_cycle(const RobotCommand& command, bool fresh, c
 
 void KinovaDriveEmulator::tick(const Eigen::VectorXd& q_meas, const Eigen::VectorXd& qd_meas,
                                const Eigen::VectorXd& tau_meas, bool filter_tick, Eigen::VectorXd& current_out) {
+  last_qd_meas_ = qd_meas;
   const int n = dof();
   for (int i = 0; i < n; ++i) {
     double tau = 0.0;

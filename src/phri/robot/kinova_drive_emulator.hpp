@@ -13,7 +13,9 @@
 //   trajectories are tracked without lag while a set-point step gives only a bounded kick). No
 //   model: gravity and friction are rejected by the stiff gains and the integrator, which gives a
 //   small steady-state error that decays, and an underdamped excursion under impacts. Entering the
-//   mode is bumpless: I starts at the motor torque of the previous cycle minus the P term.
+//   mode is bumpless, also while the arm moves: the velocity feed-forward starts at the measured
+//   velocity (the D term starts at zero) and I at the motor torque of the previous cycle minus
+//   the P term.
 // * kKinovaTorque — "torque control with negative feedback on the joint velocity" (paper, section
 //   "Low-level Control": an over-damped, sluggish robot):
 //     tau = tau_d + Kt (tau_d - tau_s) - B qd
@@ -83,6 +85,7 @@ private:
   bool entered_ = false;
   Eigen::VectorXd q_des_, qd_ff_, tau_des_, current_des_;
   Eigen::VectorXd integral_, filter_out_;
+  Eigen::VectorXd last_qd_meas_;  // the velocity the drive last measured (bumpless position entry)
 };
 
 }  // namespace phri
