@@ -168,7 +168,7 @@ TEST_F(Gen3Collision, BadYamlNamesTheKey) {
                          "capsules[0].p0[2]", model_);
   expect_collision_error(capsule_a + "pairs:\n  - [base_link, forearm_link]\n", "pairs[0][1]", model_);
   expect_collision_error(capsule_a + capsule_b + "pairs:\n  - [base_link]\n", "pairs[0]", model_);
-  expect_collision_error("capsules: [ {link: base_link\n", "not valid YAML", model_);
+  expect_collision_error("capsules: [ {link: base_link\n", "invalid YAML", model_);
   expect_collision_error(capsule_a + capsule_b + "pairs:\n  - [forearm_link, forearm_link]\n", "same body", model_);
 }
 

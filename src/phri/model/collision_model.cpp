@@ -4,128 +4,79 @@
 #include <phri/model/algorithms.hpp>
 #include <phri/model/capsule_distance.hpp>
 
-#include <yaml-cpp/yaml.h>
+#include <phri/core/yaml_reader.hpp>
 
 #include <cmath>
-#include <fstream>
-#include <set>
-#include <sstream>
 
 namespace phri {
 
 // ---------------------------------------------------------------------------------- loading
 namespace {
 
-class CollisionYamlReader {
-public:
-  CollisionYamlReader(const Model& model, std::string source) : model_(model), source_(std::move(source)) {}
-
-  [[noreturn]] void fail(const std::string& key, const std::string& reason) const {
-    throw ConfigError(source_, key, reason);
-  }
-
-  void only_keys(const YAML::Node& node, const std::string& path, const std::set<std::string>& allowed) const {
-    for (const auto& item : node) {
-      const std::string key = item.first.as<std::string>();
-      if (!allowed.count(key)) fail(path.empty() ? key : path + "." + key, "unknown key");
-    }
-  }
-
-  double number(const YAML::Node& node, const std::string& path) const {
-    if (!node || !node.IsScalar()) fail(path, "expected a number");
-    double value = 0.0;
-    try {
-      value = node.as<double>();
-    } catch (const YAML::Exception&) {
-      fail(path, "expected a number, got '" + node.Scalar() + "'");
-    }
-    if (!std::isfinite(value)) fail(path, "must be finite");
-    return value;
-  }
-
-  Eigen::Vector3d vector3(const YAML::Node& node, const std::string& path) const {
-    if (!node || !node.IsSequence() || node.size() != 3) fail(path, "expected a list of 3 numbers");
-    return {number(node[0], path + "[0]"), number(node[1], path + "[1]"), number(node[2], path + "[2]")};
-  }
-
-  std::string link_name(const YAML::Node& node, const std::string& path) const {
-    if (!node || !node.IsScalar()) fail(path, "expected a link name");
-    const std::string name = node.as<std::string>();
-    if (!model_.has_frame(name)) fail(path, "unknown link '" + name + "'");
+void read_collision_yaml(const YamlReader& root, const Model& model, std::vector<Capsule>& capsules,
+                         std::vector<CapsulePair>& pairs) {
+  root.expect_map();
+  root.allow_keys({"capsules", "pairs"});
+  auto link_of = [&](const YamlReader& node) {
+    const std::string name = node.as_text();
+    if (!model.has_frame(name)) throw node.error("", "unknown link '" + name + "'");
     return name;
-  }
-
-  void read(const YAML::Node& root, std::vector<Capsule>& capsules, std::vector<CapsulePair>& pairs) const {
-    if (!root || !root.IsMap()) fail("", "expected a map with 'capsules' and 'pairs'");
-    only_keys(root, "", {"capsules", "pairs"});
-    const YAML::Node list = root["capsules"];
-    if (!list || !list.IsSequence()) fail("capsules", "expected a list of capsules");
-    for (std::size_t i = 0; i < list.size(); ++i) {
-      const std::string path = "capsules[" + std::to_string(i) + "]";
-      const YAML::Node item = list[i];
-      if (!item.IsMap()) fail(path, "expected {link, p0, p1, radius}");
-      only_keys(item, path, {"link", "p0", "p1", "radius"});
-      Capsule capsule;
-      capsule.link = link_name(item["link"], path + ".link");
-      const Frame& frame = model_.frame(model_.frame_id(capsule.link));
-      capsule.body = frame.body;
-      capsule.p0 = frame.placement * vector3(item["p0"], path + ".p0");
-      capsule.p1 = frame.placement * vector3(item["p1"], path + ".p1");
-      capsule.radius = number(item["radius"], path + ".radius");
-      if (capsule.radius <= 0.0) fail(path + ".radius", "must be positive");
-      for (const Capsule& other : capsules) {
-        if (other.link == capsule.link) fail(path + ".link", "a second capsule for '" + capsule.link + "'");
-      }
-      capsules.push_back(capsule);
+  };
+  const YamlReader list = root.at("capsules");
+  list.expect_sequence();
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    const YamlReader item = list.at(i);
+    item.expect_map();
+    item.allow_keys({"link", "p0", "p1", "radius"});
+    Capsule capsule;
+    capsule.link = link_of(item.at("link"));
+    const Frame& frame = model.frame(model.frame_id(capsule.link));
+    capsule.body = frame.body;
+    const auto p0 = item.numbers("p0", 3, -1e3, 1e3), p1 = item.numbers("p1", 3, -1e3, 1e3);
+    capsule.p0 = frame.placement * Eigen::Vector3d(p0[0], p0[1], p0[2]);
+    capsule.p1 = frame.placement * Eigen::Vector3d(p1[0], p1[1], p1[2]);
+    capsule.radius = item.number("radius", 1e-6, 10.0);
+    for (const Capsule& other : capsules) {
+      if (other.link == capsule.link) throw item.error("link", "a second capsule for '" + capsule.link + "'");
     }
-    auto capsule_index = [&](const std::string& link, const std::string& path) {
-      for (std::size_t c = 0; c < capsules.size(); ++c) {
-        if (capsules[c].link == link) return static_cast<int>(c);
-      }
-      fail(path, "link '" + link + "' has no capsule");
-    };
-    const YAML::Node pair_list = root["pairs"];
-    if (!pair_list || !pair_list.IsSequence()) fail("pairs", "expected a list of [link_a, link_b]");
-    for (std::size_t i = 0; i < pair_list.size(); ++i) {
-      const std::string path = "pairs[" + std::to_string(i) + "]";
-      const YAML::Node item = pair_list[i];
-      if (!item.IsSequence() || item.size() != 2) fail(path, "expected [link_a, link_b]");
-      CapsulePair pair;
-      pair.first = capsule_index(link_name(item[0], path + "[0]"), path + "[0]");
-      pair.second = capsule_index(link_name(item[1], path + "[1]"), path + "[1]");
-      const Capsule& a = capsules[static_cast<std::size_t>(pair.first)];
-      const Capsule& b = capsules[static_cast<std::size_t>(pair.second)];
-      if (a.body == b.body) fail(path, "both capsules move with the same body: their distance never changes");
-      pairs.push_back(pair);
-    }
+    capsules.push_back(capsule);
   }
-
-private:
-  const Model& model_;
-  std::string source_;
-};
+  auto capsule_index = [&](const YamlReader& node) {
+    const std::string link = link_of(node);
+    for (std::size_t c = 0; c < capsules.size(); ++c) {
+      if (capsules[c].link == link) return static_cast<int>(c);
+    }
+    throw node.error("", "link '" + link + "' has no capsule");
+  };
+  const YamlReader pair_list = root.at("pairs");
+  pair_list.expect_sequence();
+  for (std::size_t i = 0; i < pair_list.size(); ++i) {
+    const YamlReader item = pair_list.at(i);
+    item.expect_sequence();
+    if (item.size() != 2) throw item.error("", "expected [link_a, link_b]");
+    CapsulePair pair;
+    pair.first = capsule_index(item.at(std::size_t{0}));
+    pair.second = capsule_index(item.at(std::size_t{1}));
+    if (capsules[static_cast<std::size_t>(pair.first)].body == capsules[static_cast<std::size_t>(pair.second)].body) {
+      throw item.error("", "both capsules move with the same body: their distance never changes");
+    }
+    pairs.push_back(pair);
+  }
+}
 
 }  // namespace
 
 CollisionModel CollisionModel::from_yaml_string(const std::string& yaml, const Model& model,
                                                 const std::string& source_name) {
-  YAML::Node root;
-  try {
-    root = YAML::Load(yaml);
-  } catch (const YAML::Exception& e) {
-    throw ConfigError(source_name, "line " + std::to_string(e.mark.line + 1), std::string("not valid YAML: ") + e.msg);
-  }
   CollisionModel out;
-  CollisionYamlReader(model, source_name).read(root, out.capsules_, out.pairs_);
+  read_collision_yaml(YamlReader::load_string(yaml, source_name), model, out.capsules_, out.pairs_);
   return out;
 }
 
 CollisionModel CollisionModel::from_yaml_file(const std::string& path, const Model& model) {
-  std::ifstream file(path);
-  if (!file) throw ConfigError(path, "", "cannot open the file");
-  std::stringstream contents;
-  contents << file.rdbuf();
-  return from_yaml_string(contents.str(), model, path);
+  CollisionModel out;
+  read_collision_yaml(YamlReader::load_file(path), model, out.capsules_, out.pairs_);
+  return out;
 }
 
 // ---------------------------------------------------------------------------------- distances
