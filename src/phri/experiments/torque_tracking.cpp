@@ -192,6 +192,7 @@ TorqueTrackingRun run_one(const TorqueTrackingOptions& o, TrackingScenario scena
   ee_errors.reserve(static_cast<std::size_t>(test_cycles));
   Eigen::VectorXd tau_desired_prev = Eigen::VectorXd::Zero(n);
   Eigen::VectorXd error(n), error_true(n);
+  Eigen::VectorXd error_sum = Eigen::VectorXd::Zero(n);
   Eigen::Isometry3d start = Eigen::Isometry3d::Identity();
   long fallbacks = 0;
 
@@ -213,6 +214,7 @@ TorqueTrackingRun run_one(const TorqueTrackingOptions& o, TrackingScenario scena
       csv << ',' << format_fixed(1e3 * ee_error, 4) << '\n';
       if (after - 1 >= skip) {
         norms.push_back(error.norm());
+        error_sum += error;
         norms_true.push_back(error_true.norm());
         ee_errors.push_back(ee_error);
       }
@@ -245,6 +247,7 @@ TorqueTrackingRun run_one(const TorqueTrackingOptions& o, TrackingScenario scena
   run.rms_Nm = rms(norms);
   run.p95_Nm = percentile(norms, 0.95);
   run.max_Nm = norms.empty() ? 0.0 : *std::max_element(norms.begin(), norms.end());
+  run.bias_Nm = norms.empty() ? 0.0 : error_sum.norm() / static_cast<double>(norms.size());
   run.rms_true_Nm = rms(norms_true);
   run.p95_true_Nm = percentile(norms_true, 0.95);
   run.ee_position_rms_mm = 1e3 * rms(ee_errors);
@@ -317,10 +320,11 @@ TorqueTrackingResult run_torque_tracking(const TorqueTrackingOptions& o, std::os
   result.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   if (!o.output_dir.empty()) {
     std::ostringstream summary;
-    summary << "scenario,loop,rms_Nm,p95_Nm,max_Nm,rms_true_Nm,p95_true_Nm,window_start_s,samples\n";
+    summary << "scenario,loop,rms_Nm,p95_Nm,max_Nm,bias_Nm,rms_true_Nm,p95_true_Nm,window_start_s,samples\n";
     for (const TorqueTrackingRun& run : result.runs) {
       summary << to_string(run.scenario) << ',' << loop_name(run.loop) << ',' << format_fixed(run.rms_Nm, 6) << ','
-              << format_fixed(run.p95_Nm, 6) << ',' << format_fixed(run.max_Nm, 6) << ',' << format_fixed(run.rms_true_Nm, 6)
+              << format_fixed(run.p95_Nm, 6) << ',' << format_fixed(run.max_Nm, 6) << ',' << format_fixed(run.bias_Nm, 6) << ','
+              << format_fixed(run.rms_true_Nm, 6)
               << ',' << format_fixed(run.p95_true_Nm, 6) << ',' << format_fixed(o.transient_s, 3) << ',' << run.samples << '\n';
     }
     const std::string csv = output_path(o.output_dir, "torque_tracking_summary.csv");
@@ -335,11 +339,13 @@ TorqueTrackingResult run_torque_tracking(const TorqueTrackingOptions& o, std::os
 
 std::string torque_tracking_table(const TorqueTrackingResult& r, const TorqueTrackingOptions& o) {
   std::ostringstream s;
-  s << "| scenario | loop | RMS [N.m] | p95 [N.m] | max [N.m] | RMS true [N.m] | p95 true [N.m] | EE RMS [mm] | EE max [mm] |\n";
-  s << "|---|---|---|---|---|---|---|---|---|\n";
+  s << "| scenario | loop | RMS [N.m] | p95 [N.m] | max [N.m] | bias [N.m] | RMS true [N.m] | p95 true [N.m] | EE RMS [mm] | "
+       "EE max [mm] |\n";
+  s << "|---|---|---|---|---|---|---|---|---|---|\n";
   for (const TorqueTrackingRun& run : r.runs) {
     s << "| " << to_string(run.scenario) << " | " << loop_name(run.loop) << " | " << format_fixed(run.rms_Nm, 4) << " | "
-      << format_fixed(run.p95_Nm, 4) << " | " << format_fixed(run.max_Nm, 3) << " | " << format_fixed(run.rms_true_Nm, 4)
+      << format_fixed(run.p95_Nm, 4) << " | " << format_fixed(run.max_Nm, 3) << " | " << format_fixed(run.bias_Nm, 4) << " | "
+      << format_fixed(run.rms_true_Nm, 4)
       << " | " << format_fixed(run.p95_true_Nm, 4) << " | " << format_fixed(run.ee_position_rms_mm, 2) << " | "
       << format_fixed(run.ee_position_max_mm, 2) << " |\n";
   }
@@ -355,7 +361,8 @@ std::string torque_tracking_table(const TorqueTrackingResult& r, const TorqueTra
   }
   s << "\nError: ||tau_d[k] - tau_s[k+1]|| over the 7 joints, from " << o.transient_s
     << " s after the switch from position control; measured = the plant's torque sensors (noise "
-       "0.05 N.m, zero offsets), true = the noise-free transmitted torque. Custom loop: lambda "
+       "0.05 N.m, zero offsets), true = the noise-free transmitted torque; bias = norm of the per-joint mean error. "
+       "Custom loop: lambda "
     << o.custom_torque.transfer_gain << ", K_I " << o.custom_torque.integral_gain << " 1/s, theta "
     << o.custom_torque.integral_leak << " 1/s, friction compensation thresholds "
     << (o.friction_velocity_threshold_rad_s > 0.0 ? format_fixed(o.friction_velocity_threshold_rad_s, 3) + " rad/s"

@@ -102,6 +102,8 @@ struct TorqueTrackingRun {
   double rms_Nm = 0.0;        ///< of ||tau_d - tau_s|| (measured)
   double p95_Nm = 0.0;
   double max_Nm = 0.0;
+  /// Norm of the per-joint time-mean error: the steady part of the error, without the noise.
+  double bias_Nm = 0.0;
   double rms_true_Nm = 0.0;   ///< of ||tau_d - tau_s|| with the plant's true transmitted torque
   double p95_true_Nm = 0.0;
   double ee_position_rms_mm = 0.0;  ///< end-effector position error (task target vs plant)
