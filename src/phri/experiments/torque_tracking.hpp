@@ -22,6 +22,17 @@
 // the norm) are taken from `transient_s` after the switch to the loop under test to the end.
 //
 // Each run builds a fresh plant (same seed: same noise and mismatch) and a fresh ControlCycle.
+//
+// What to expect from the static scenario in this framework: the inverse dynamics subtracts the
+// momentum observer's tau_ext, which at rest converges to g - tau_s, so tau_d = M qdd_d + tau_s
+// (low-passed) whatever low-level loop runs. An arm that stays at rest therefore has a torque
+// error made of sensor and controller noise only, with either loop (with the plant's sensor noise
+// switched off it is exactly zero for both); the loops differ only once the arm moves, and then
+// through friction: Kinova's loop leaves it uncompensated, the custom loop pre-compensates it.
+// In the dynamic scenario the custom loop's residual error is dominated by its friction model's
+// switching: a joint sliding slower than the velocity threshold gets static sign(qdd_d) or nothing
+// depending on whether |qdd_d| crosses the acceleration threshold, which noise makes chatter
+// (friction_velocity_threshold_rad_s lets a run try other thresholds).
 #include <phri/control/compliance_mode.hpp>
 #include <phri/lowlevel/custom_torque_controller.hpp>
 #include <phri/lowlevel/low_level_controller.hpp>
