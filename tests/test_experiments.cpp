@@ -1,0 +1,110 @@
+// ctest-labels: physics
+// The paper's experiments (src/phri/experiments) in shortened form: friction identification on two
+// joints with few current levels must find the plant's friction within 5 % when the plant's friction
+// differs from actuators.yaml by a random 20 %; a short torque-tracking run must show the custom
+// loop tracking the moving task's torque better than Kinova's high-velocity loop. The numbers of
+// the full runs come from the commands (run_*_command).
+#include <phri/experiments/friction_identification.hpp>
+#include <phri/experiments/torque_tracking.hpp>
+
+#include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+namespace {
+
+const std::string kRoot = PHRI_SOURCE_DIR;
+
+TEST(FrictionIdentification, FindsAPerturbedPlantsFrictionWithinFivePercent) {
+  phri::FrictionIdentificationOptions o;
+  o.plant_config_path = kRoot + "/configs/plant_gen3.yaml";
+  o.urdf_path = kRoot + "/robots/kinova_gen3/gen3.urdf";
+  o.output_dir.clear();  // no files
+  o.joints = {3, 6};     // a continuous large joint and a limited small one
+  o.speed_levels = 5;
+  o.static_bisection_steps = 9;
+  o.friction_perturbation = 0.2;
+  o.seed = 3;
+  std::ostringstream progress;
+  const phri::FrictionIdentificationResult r = phri::identify_friction(o, &progress);
+  ASSERT_EQ(r.joints.size(), 2u);
+  for (const auto& e : r.joints) {
+    std::printf("joint %d: Coulomb %.4f (plant %.4f, %+.2f %%), viscous %.4f (%.4f, %+.2f %%), static %.4f (%.4f, %+.2f %%), "
+                "%d/%d steady levels\n",
+                e.joint, e.identified.coulomb_Nm, e.plant.coulomb_Nm, 100 * e.coulomb_error(), e.identified.viscous_Nms_per_rad,
+                e.plant.viscous_Nms_per_rad, 100 * e.viscous_error(), e.identified.static_Nm, e.plant.static_Nm,
+                100 * e.static_error(), e.levels_used, e.levels_total);
+    // The plant really differs from the nominal table, or the check would prove nothing.
+    EXPECT_GT(std::abs(e.plant.coulomb_Nm - e.nominal.coulomb_Nm) + std::abs(e.plant.viscous_Nms_per_rad - e.nominal.viscous_Nms_per_rad),
+              0.01);
+    EXPECT_LT(std::abs(e.coulomb_error()), 0.05);
+    EXPECT_LT(std::abs(e.viscous_error()), 0.05);
+    EXPECT_LT(std::abs(e.static_error()), 0.05);
+    EXPECT_GE(e.levels_used, 8);
+    // The fit's intercept is minus the torque sensor's zero offset.
+    EXPECT_NEAR(e.offset_Nm, -e.plant_sensor_offset_Nm, 0.02);
+  }
+  std::printf("simulated %.1f s in %.2f s\n", r.simulated_s, r.wall_s);
+
+  // The YAML carries actuators.yaml's friction keys for each joint.
+  const YAML::Node yaml = YAML::Load(phri::friction_identification_yaml(r, o));
+  ASSERT_EQ(yaml["joints"].size(), 2u);
+  const YAML::Node f = yaml["joints"][0]["friction"];
+  EXPECT_EQ(yaml["joints"][0]["name"].as<std::string>(), "joint_3");
+  EXPECT_NEAR(f["coulomb_Nm"].as<double>(), r.joints[0].identified.coulomb_Nm, 1e-4);
+  EXPECT_NEAR(f["viscous_Nms_per_rad"].as<double>(), r.joints[0].identified.viscous_Nms_per_rad, 1e-4);
+  EXPECT_GE(f["static_Nm"].as<double>(), f["coulomb_Nm"].as<double>());
+  EXPECT_TRUE(f["velocity_threshold_rad_s"].IsScalar());
+  EXPECT_TRUE(f["acceleration_threshold_rad_s2"].IsScalar());
+}
+
+phri::TorqueTrackingOptions short_tracking() {
+  phri::TorqueTrackingOptions o;
+  o.plant_config_path = kRoot + "/configs/plant_gen3.yaml";
+  o.urdf_path = kRoot + "/robots/kinova_gen3/gen3.urdf";
+  o.actuators_path = kRoot + "/robots/kinova_gen3/actuators.yaml";
+  o.collision_path = kRoot + "/robots/kinova_gen3/collision.yaml";
+  o.output_dir.clear();
+  o.position_phase_s = 0.5;
+  o.static_duration_s = 1.5;
+  o.dynamic_duration_s = 2.5;  // 0.5 s hold, then the sine fades in over 1 s with the triangle under way
+  return o;
+}
+
+TEST(TorqueTracking, CustomLoopTracksTheMovingTaskBetterThanTheHighVelocityLoop) {
+  phri::TorqueTrackingOptions o = short_tracking();
+  o.scenarios = {phri::TrackingScenario::kDynamic};
+  const phri::TorqueTrackingResult r = phri::run_torque_tracking(o);
+  const auto* custom = r.find(phri::TrackingScenario::kDynamic, phri::LowLevelLoop::kCustom);
+  const auto* hv = r.find(phri::TrackingScenario::kDynamic, phri::LowLevelLoop::kKinovaTorqueHighVelocity);
+  ASSERT_NE(custom, nullptr);
+  ASSERT_NE(hv, nullptr);
+  std::printf("dynamic (2.5 s): RMS custom %.3f, high-velocity %.3f N.m (ratio %.2f); p95 %.3f / %.3f; EE RMS %.2f / %.2f mm\n",
+              custom->rms_Nm, hv->rms_Nm, r.rms_ratio(phri::TrackingScenario::kDynamic), custom->p95_Nm, hv->p95_Nm,
+              custom->ee_position_rms_mm, hv->ee_position_rms_mm);
+  EXPECT_LT(custom->rms_Nm, 0.5 * hv->rms_Nm);
+  EXPECT_LT(custom->p95_Nm, hv->p95_Nm);
+  EXPECT_EQ(custom->qp_fallbacks, 0);
+  EXPECT_EQ(hv->qp_fallbacks, 0);
+}
+
+TEST(TorqueTracking, StaticHoldIsAtTheSensorNoiseFloorWithEitherLoop) {
+  // With the arm at rest the observer's external torque makes tau_d follow the sensed torque for
+  // both loops (the weight is compensated through it), so what is left is the sensors' and the
+  // controller's noise: sqrt(7) x 0.05 N.m of torque-sensor noise alone is 0.13 N.m.
+  phri::TorqueTrackingOptions o = short_tracking();
+  o.scenarios = {phri::TrackingScenario::kStatic};
+  const phri::TorqueTrackingResult r = phri::run_torque_tracking(o);
+  for (const auto& run : r.runs) {
+    std::printf("static (1.5 s, 1.25 kg): %s RMS %.3f N.m, p95 %.3f N.m, EE RMS %.3f mm\n",
+                std::string(phri::to_string(run.loop)).c_str(), run.rms_Nm, run.p95_Nm, run.ee_position_rms_mm);
+    EXPECT_GT(run.rms_Nm, 0.13);
+    EXPECT_LT(run.rms_Nm, 0.35);
+    EXPECT_LT(run.ee_position_rms_mm, 0.5);
+  }
+}
+
+}  // namespace
