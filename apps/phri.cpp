@@ -1,12 +1,19 @@
 // phri: the command-line entry point.
+//   phri info --urdf FILE                      model summary of a robot description
+//   phri identify-friction [options]           the paper's friction identification (simulated arm)
+//   phri experiment torque-tracking [options]  the paper's torque-tracking comparison
+// Every bad argument or file gives one line naming what is wrong and a non-zero exit status.
 #include <phri/core/config_error.hpp>
 #include <phri/core/version.hpp>
+#include <phri/experiments/friction_identification.hpp>
+#include <phri/experiments/torque_tracking.hpp>
 #include <phri/model/algorithms.hpp>
 #include <phri/model/model.hpp>
 
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
+#include <iostream>
 #include <string>
 
 namespace {
@@ -32,13 +39,22 @@ int print_model_summary(const std::string& urdf_path, const std::string& tip, co
   const int frame = model.frame_id(frame_name.empty() ? model.tip_link() : frame_name);
   const Eigen::VectorXd q0 = Eigen::VectorXd::Zero(model.nq());
   phri::compute_all_terms(model, data, q0, q0);
-  phri::compute_gravity(model, data, q0);
   const Eigen::Vector3d p = data.frame_placements[static_cast<std::size_t>(frame)].translation();
   std::printf("\nat q = 0: %s at (%.6f, %.6f, %.6f) m; |g(q)| = %.4f N.m; M diagonal:",
               model.frame(frame).name.c_str(), p.x(), p.y(), p.z(), data.gravity_torque.norm());
   for (int i = 0; i < model.nq(); ++i) std::printf(" %.4f", data.mass_matrix(i, i));
   std::printf("\n");
   return 0;
+}
+
+// Files of the experiments are found from the working directory; when run from elsewhere, from
+// the source tree the program was built from.
+std::string locate(const std::string& relative) {
+  if (std::FILE* f = std::fopen(relative.c_str(), "r")) {
+    std::fclose(f);
+    return relative;
+  }
+  return std::string(PHRI_SOURCE_DIR) + "/" + relative;
 }
 
 }  // namespace
@@ -49,17 +65,60 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
 
   auto* info = app.add_subcommand("info", "Load a robot description and print a summary of its model");
-  std::string urdf_path;
-  std::string tip;
-  std::string frame;
+  std::string urdf_path, tip, frame;
   info->add_option("--urdf", urdf_path, "URDF file")->required();
   info->add_option("--tip", tip, "tip link of the chain (default: end of the movable chain)");
   info->add_option("--frame", frame, "frame whose position is printed (default: the tip)");
 
-  CLI11_PARSE(app, argc, argv);
+  phri::FrictionIdentificationOptions friction;
+  auto* identify = app.add_subcommand("identify-friction",
+                                      "Identify joint friction on the simulated arm (paper: friction identification)");
+  identify->add_option("--out", friction.output_dir, "output folder")->capture_default_str();
+  identify->add_option("--seed", friction.seed, "seed of the plant's friction perturbation and noise")->capture_default_str();
+  identify->add_option("--perturbation", friction.friction_perturbation,
+                       "plant friction off actuators.yaml by up to this fraction")
+      ->check(CLI::Range(0.0, 0.9))
+      ->capture_default_str();
+  identify->add_option("--joints", friction.joints, "joints to identify (1-based)")->check(CLI::Range(1, 7));
+  identify->add_option("--plant", friction.plant_config_path, "plant configuration")->check(CLI::ExistingFile);
+
+  auto* experiment = app.add_subcommand("experiment", "Run one of the paper's experiments on the simulated arm");
+  experiment->require_subcommand(1);
+  auto* tracking = experiment->add_subcommand("torque-tracking", "Custom vs Kinova high-velocity torque loop");
+  phri::TorqueTrackingOptions torque;
+  tracking->add_option("--out", torque.output_dir, "output folder")->capture_default_str();
+  tracking->add_option("--seed", torque.seed, "seed of the plant's noise")->capture_default_str();
+  tracking->add_option("--static-s", torque.static_duration_s, "static scenario duration")->check(CLI::Range(1.0, 600.0));
+  tracking->add_option("--dynamic-s", torque.dynamic_duration_s, "dynamic scenario duration")->check(CLI::Range(1.0, 600.0));
+  tracking->add_option("--plant", torque.plant_config_path, "plant configuration")->check(CLI::ExistingFile);
+  auto* friction_alias = experiment->add_subcommand("friction-identification", "Same as 'phri identify-friction'");
+  friction_alias->add_option("--out", friction.output_dir, "output folder");
+  friction_alias->add_option("--seed", friction.seed, "seed");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  }
   try {
     if (info->parsed()) return print_model_summary(urdf_path, tip, frame);
+    if (identify->parsed() || friction_alias->parsed()) {
+      for (std::string* path : {&friction.plant_config_path, &friction.urdf_path, &friction.figure_script}) {
+        *path = locate(*path);
+      }
+      return phri::run_friction_identification_command(friction, std::cout);
+    }
+    if (tracking->parsed()) {
+      for (std::string* path : {&torque.plant_config_path, &torque.urdf_path, &torque.actuators_path,
+                                &torque.collision_path, &torque.figure_script}) {
+        *path = locate(*path);
+      }
+      return phri::run_torque_tracking_command(torque, std::cout);
+    }
   } catch (const phri::ConfigError& e) {
+    std::fprintf(stderr, "phri: error: %s\n", e.what());
+    return 2;
+  } catch (const std::exception& e) {
     std::fprintf(stderr, "phri: error: %s\n", e.what());
     return 2;
   }
