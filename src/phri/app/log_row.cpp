@@ -1,6 +1,7 @@
 #include <phri/app/log_row.hpp>
 
 #include <phri/app/control_cycle.hpp>
+#include <phri/app/fsm.hpp>
 #include <phri/robot/robot_state.hpp>
 
 #include <algorithm>
@@ -51,6 +52,12 @@ void fill_log_row(LogRow& row, const RobotState& state, const ControlCycle& cycl
   row.qp_status = static_cast<std::int32_t>(qp.qp_status());
   row.qp_iterations = qp.qp_iterations();
   row.stiffness_scale = cycle.compliance().stiffness_scale();
+}
+
+void fill_log_row(LogRow& row, const RobotState& state, const ControlCycle& cycle, const Fsm& fsm) {
+  fill_log_row(row, state, cycle);
+  row.fsm_state = static_cast<std::int32_t>(fsm.state());
+  row.event = fsm.last_event_code();
 }
 
 }  // namespace phri

@@ -28,6 +28,7 @@
 namespace phri {
 
 class ControlCycle;
+class Fsm;
 struct RobotState;
 
 inline constexpr int kLogMaxJoints = 7;
@@ -119,5 +120,7 @@ void visit_log_columns(const LogRow& r, int dof, Visitor&& v) {
 /// Fills every field the robot state and the control cycle give (after cycle.step()): all but
 /// fsm_state, event and cycle_time_s. No allocation.
 void fill_log_row(LogRow& row, const RobotState& state, const ControlCycle& cycle);
+/// ... and fsm_state and event from the FSM (event: the last one its last update handled).
+void fill_log_row(LogRow& row, const RobotState& state, const ControlCycle& cycle, const Fsm& fsm);
 
 }  // namespace phri

@@ -2,6 +2,7 @@
 
 #include <phri/app/control_cycle.hpp>
 #include <phri/app/event.hpp>
+#include <phri/app/fsm.hpp>
 #include <phri/core/config_error.hpp>
 #include <phri/qp/qp_status.hpp>
 
@@ -79,6 +80,10 @@ std::string Logger::legend_yaml() {
   out += "touched:\n  0: free\n  1: touched\n";
   legend_entry(out, "low_level_loop", {LowLevelLoop::kPosition, LowLevelLoop::kKinovaTorque,
                                        LowLevelLoop::kKinovaTorqueHighVelocity, LowLevelLoop::kCustom});
+  out += "fsm_state:\n  -1: none\n";
+  for (FsmState st : {FsmState::kStartup, FsmState::kStatic, FsmState::kDynamic, FsmState::kStopped}) {
+    out += "  " + std::to_string(static_cast<int>(st)) + ": " + std::string(to_string(st)) + "\n";
+  }
   out += "event:\n  -1: none\n";
   for (int i = 0; i < kEventCount; ++i) {
     out += "  " + std::to_string(i) + ": " + std::string(kEventNames[static_cast<std::size_t>(i)]) + "\n";
