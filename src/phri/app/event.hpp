@@ -1,0 +1,99 @@
+#pragma once
+// phri::Event: what an operator (DS4 gamepad, app/gamepad.hpp) or a scripted timeline (the
+// `events:` list of a run config, app/config.hpp) asks of the FSM (app/fsm.hpp). One flat
+// enumeration: an event is a plain value, copied through lock-free queues and logged as its
+// integer code (the enumerator's value, stable: append new events at the end).
+//
+// Names (timeline YAML, log legend) and meaning:
+//   stiff_compliance, null_space_compliance, full_body_compliance, dual_compliance
+//                          compliance mode (ControlCycle::set_compliance_mode)
+//   position_loop, kinova_torque_loop, kinova_torque_high_velocity_loop, custom_loop
+//                          low-level loop (ControlCycle::set_low_level_loop)
+//   toggle_loop            position <-> the last torque loop used (custom at first)
+//   static_scenario, dynamic_scenario
+//                          start a scenario (the FSM brakes the current motion first)
+//   toggle_scenario        static <-> dynamic
+//   stop_scenario          brake to rest and hold, wait for the next scenario
+//   stiffness_up, stiffness_down
+//                          scale the end-effector stiffness by the FSM's stiffness step
+//   stop                   brake to rest and hold; the session is over (Fsm::finished())
+#include <phri/control/compliance_mode.hpp>
+#include <phri/lowlevel/low_level_controller.hpp>
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <string_view>
+
+namespace phri {
+
+enum class Event : std::uint8_t {
+  kStiffCompliance = 0,
+  kNullSpaceCompliance = 1,
+  kFullBodyCompliance = 2,
+  kDualCompliance = 3,
+  kPositionLoop = 4,
+  kKinovaTorqueLoop = 5,
+  kKinovaTorqueHighVelocityLoop = 6,
+  kCustomLoop = 7,
+  kToggleLoop = 8,
+  kStaticScenario = 9,
+  kDynamicScenario = 10,
+  kToggleScenario = 11,
+  kStopScenario = 12,
+  kStiffnessUp = 13,
+  kStiffnessDown = 14,
+  kStop = 15,
+};
+
+inline constexpr int kEventCount = 16;
+
+inline constexpr std::array<std::string_view, kEventCount> kEventNames = {
+    "stiff_compliance", "null_space_compliance", "full_body_compliance", "dual_compliance",
+    "position_loop",    "kinova_torque_loop",    "kinova_torque_high_velocity_loop", "custom_loop",
+    "toggle_loop",      "static_scenario",       "dynamic_scenario",     "toggle_scenario",
+    "stop_scenario",    "stiffness_up",          "stiffness_down",       "stop"};
+
+constexpr int code(Event e) { return static_cast<int>(e); }
+
+constexpr std::string_view to_string(Event e) {
+  const int i = code(e);
+  return i >= 0 && i < kEventCount ? kEventNames[static_cast<std::size_t>(i)] : std::string_view("unknown");
+}
+
+constexpr std::optional<Event> event_from_string(std::string_view name) {
+  for (int i = 0; i < kEventCount; ++i) {
+    if (kEventNames[static_cast<std::size_t>(i)] == name) return static_cast<Event>(i);
+  }
+  return std::nullopt;
+}
+
+/// The compliance mode an event selects, if it is a compliance event.
+constexpr std::optional<ComplianceMode> compliance_of(Event e) {
+  switch (e) {
+    case Event::kStiffCompliance: return ComplianceMode::kStiff;
+    case Event::kNullSpaceCompliance: return ComplianceMode::kNullSpace;
+    case Event::kFullBodyCompliance: return ComplianceMode::kFullBody;
+    case Event::kDualCompliance: return ComplianceMode::kDual;
+    default: return std::nullopt;
+  }
+}
+
+/// The low-level loop an event selects, if it selects one (toggle_loop does not: the FSM decides).
+constexpr std::optional<LowLevelLoop> loop_of(Event e) {
+  switch (e) {
+    case Event::kPositionLoop: return LowLevelLoop::kPosition;
+    case Event::kKinovaTorqueLoop: return LowLevelLoop::kKinovaTorque;
+    case Event::kKinovaTorqueHighVelocityLoop: return LowLevelLoop::kKinovaTorqueHighVelocity;
+    case Event::kCustomLoop: return LowLevelLoop::kCustom;
+    default: return std::nullopt;
+  }
+}
+
+/// An event of a scripted timeline: `at` seconds of robot time (RobotState::time_s).
+struct TimedEvent {
+  double time_s = 0.0;
+  Event event = Event::kStop;
+};
+
+}  // namespace phri

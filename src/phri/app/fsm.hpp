@@ -1,0 +1,162 @@
+#pragma once
+// phri::Fsm: the demo's state machine (paper, "Framework overview": the operator switches
+// compliance modes, low-level loops and scenarios live). It sits between the estimator and the
+// QP (DESIGN.md section 2) and drives a ControlCycle each period:
+//
+//   phri::Fsm fsm(settings, cycle);
+//   for (;;) {
+//     const phri::RobotState& s = robot.read();
+//     for (phri::Event e; gamepad.poll(e);) fsm.post(e);    // operator events
+//     fsm.update(s.time_s, s, cycle);                       // timeline events, state, targets
+//     cycle.step(s, command);
+//     robot.write(command);
+//   }
+//
+// States:
+//   startup  Position loop. A minimum-jerk joint move from where the arm is to the home posture
+//            (posture task target, end-effector target = its forward kinematics, so the two tasks
+//            agree), peak joint speed bounded. Once the move is over and the posture error norm
+//            is below `tolerance_rad` (paper: 0.05 rad) — or `timeout_s` later — the low-level
+//            loop switches to the torque loop (bumpless, LowLevelController) and the FSM enters
+//            the first scenario.
+//   static   Minimum-jerk move of the EE target to the static pose (and of the posture target to
+//            the static posture), then hold: the FSM no longer writes the EE target, so dual
+//            compliance can leave it where the hand put it.
+//   dynamic  Streams DynamicTrajectory around the target pose held at entry.
+//   stopped  The reference brought to rest and held. After `stop` (not `stop_scenario`),
+//            finished() turns true once the arm is at rest.
+// Leaving a state whose reference moves (startup's move, static's move, dynamic) goes through a
+// brake: the reference decelerates to rest at a bounded rate (PoseBrake, JointBrake) before the
+// next state starts from it, so no transition steps the reference velocity.
+//
+// Events (app/event.hpp) come from post() (the gamepad) and from the timeline (handled when the
+// robot time reaches them), and act at once: compliance modes (ControlCycle::set_compliance_mode),
+// stiffness up/down (x or / stiffness_step, ComplianceController clamps to [0.1, 4]), low-level
+// loops (during start-up: the loop to hand over to), scenarios, stops.
+//
+// update() allocates nothing and never throws; construction checks the settings (ConfigError).
+#include <phri/app/control_cycle.hpp>
+#include <phri/app/event.hpp>
+#include <phri/app/scenario.hpp>
+#include <phri/app/spsc_ring.hpp>
+#include <phri/model/data.hpp>
+
+#include <cstdint>
+#include <string_view>
+#include <vector>
+
+namespace phri {
+
+enum class FsmState : std::uint8_t { kStartup, kStatic, kDynamic, kStopped };
+constexpr std::string_view to_string(FsmState s) {
+  switch (s) {
+    case FsmState::kStartup: return "startup";
+    case FsmState::kStatic: return "static";
+    case FsmState::kDynamic: return "dynamic";
+    case FsmState::kStopped: return "stopped";
+  }
+  return "unknown";
+}
+
+struct StartupSettings {
+  bool enabled = true;  ///< false: the first scenario starts at once, in the torque loop
+  std::vector<double> home_q_rad = paper_posture_target();  ///< one per joint
+  double max_joint_speed_rad_s = 0.3;  ///< peak joint speed of the move
+  double min_duration_s = 1.0;
+  double tolerance_rad = 0.05;  ///< posture error norm allowing the switch (paper: 0.05)
+  double timeout_s = 5.0;       ///< after the move: switch anyway (startup_timed_out())
+};
+
+struct FsmSettings {
+  StartupSettings startup;
+  StaticScenarioSettings static_scenario;
+  DynamicScenarioSettings dynamic_scenario;
+  BrakeSettings brake;
+  Scenario first_scenario = Scenario::kStatic;    ///< entered after start-up
+  LowLevelLoop torque_loop = LowLevelLoop::kCustom;  ///< start-up hands over to it; toggle_loop's torque side
+  double stiffness_step = 1.25;  ///< factor of stiffness_up / stiffness_down
+  double rest_speed_rad_s = 0.01;  ///< |qd| below which the arm is at rest (finished())
+  std::vector<TimedEvent> timeline;  ///< scripted events (sorted here by time)
+  std::size_t queue_capacity = 64;   ///< posted events waiting for update()
+};
+
+class Fsm {
+public:
+  /// `cycle`: the controller this FSM will drive (its model gives the forward kinematics).
+  Fsm(const FsmSettings& settings, const ControlCycle& cycle);
+
+  /// Queues an event for the next update (one producer thread; false when the queue is full).
+  bool post(Event event) noexcept;
+  /// Once per period, before cycle.step(state, ...). `time_s`: robot time (the timeline's clock).
+  void update(double time_s, const RobotState& state, ControlCycle& cycle);
+
+  FsmState state() const { return state_; }
+  /// The reference is being brought to rest before the next state.
+  bool braking() const { return motion_ == Motion::kPoseBrake || motion_ == Motion::kJointBrake; }
+  /// `stop` was handled and the arm is at rest: the session may end.
+  bool finished() const { return finished_; }
+  bool stop_requested() const { return stop_requested_; }
+  bool startup_complete() const { return startup_complete_; }
+  bool startup_timed_out() const { return startup_timed_out_; }
+  /// Code of the last event handled by the last update (-1: none), for the log.
+  int last_event_code() const { return last_event_; }
+  std::uint64_t events_handled() const { return events_handled_; }
+  std::uint64_t events_dropped() const { return events_dropped_; }
+  /// Time the current state was entered (robot time).
+  double state_entry_time() const { return state_entry_time_; }
+  /// The torque loop toggle_loop returns to and start-up hands over to.
+  LowLevelLoop torque_loop() const { return torque_loop_; }
+  /// The static scenario's end-effector pose (forward kinematics of its posture).
+  const Eigen::Isometry3d& static_pose() const { return static_pose_; }
+  const FsmSettings& settings() const { return settings_; }
+
+private:
+  enum class Motion { kHold, kJointMove, kPoseMove, kTrajectory, kPoseBrake, kJointBrake };
+
+  void handle(Event event, double t, const RobotState& state, ControlCycle& cycle);
+  void request(FsmState next, double t, ControlCycle& cycle);
+  void enter(FsmState next, double t, ControlCycle& cycle);
+  void enter_startup(double t, const RobotState& state, ControlCycle& cycle);
+  void finish_startup(double t, ControlCycle& cycle, bool timed_out);
+  void run_motion(double t, ControlCycle& cycle);
+  void stream_joint_reference(ControlCycle& cycle);
+  void stream_pose_reference(ControlCycle& cycle);
+  double joint_speed(const RobotState& state) const;
+
+  FsmSettings settings_;
+  const Model& model_;
+  Data data_;  // forward kinematics of joint references (start-up)
+  int ee_frame_;
+  SpscRing<Event> queue_;
+  std::size_t next_timed_ = 0;
+
+  FsmState state_ = FsmState::kStartup;
+  FsmState pending_ = FsmState::kStatic;  // entered when the brake ends
+  Scenario after_startup_;
+  LowLevelLoop torque_loop_;
+  LowLevelLoop startup_handover_;
+  Motion motion_ = Motion::kHold;
+  double motion_start_ = 0.0;
+  double state_entry_time_ = 0.0;
+  bool initialised_ = false;
+  bool posture_braking_ = false;  // the posture target brakes with the end effector
+  bool startup_complete_ = false;
+  bool startup_timed_out_ = false;
+  bool stop_requested_ = false;
+  bool finished_ = false;
+  int last_event_ = -1;
+  std::uint64_t events_handled_ = 0;
+  std::uint64_t events_dropped_ = 0;
+
+  JointMove joint_move_;
+  JointBrake joint_brake_;
+  PoseMove pose_move_;
+  PoseBrake pose_brake_;
+  DynamicTrajectory dynamic_;
+  PoseReference pose_ref_;
+  Eigen::VectorXd home_q_, static_q_;
+  Eigen::VectorXd q_ref_, qd_ref_, qdd_ref_, scratch_;
+  Eigen::Isometry3d static_pose_ = Eigen::Isometry3d::Identity();
+};
+
+}  // namespace phri

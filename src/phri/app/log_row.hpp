@@ -1,0 +1,126 @@
+#pragma once
+// phri::LogRow: one control cycle as the logger records it (app/logger.hpp): a fixed-size,
+// trivially copyable record, so that the control thread copies it into a preallocated ring slot
+// with no allocation. Joint vectors hold up to kLogMaxJoints joints (the Gen3 has 7); the logger
+// writes the first `dof` of them.
+//
+// CSV columns, in order (visit_log_columns is the one definition the header and the rows share):
+//   time_s, cycle                         robot time [s], control cycle count
+//   q_i, qd_i                             measured joint position [rad], velocity [rad/s]
+//   qdd_d_i, tau_d_i                      QP's desired acceleration [rad/s^2], torque [N.m]
+//   tau_s_i, tau_ext_i                    joint torque sensors, observer's external torque [N.m]
+//   current_i                             measured motor current [A]
+//   ee_x ee_y ee_z, ee_qw ee_qx ee_qy ee_qz           end effector (controller's model) [m], unit quaternion
+//   target_x ..., target_qw ...                       end-effector target the task tracks
+//   err_x err_y err_z, err_rx err_ry err_rz           target - pose [m], log(R* R^T) [rad]
+//   err_pos_m, err_ori_rad                            their norms
+//   wrench_fx wrench_fy wrench_fz wrench_mx wrench_my wrench_mz, wrench_norm
+//                                         operator wrench at the EE, world axes [N, N.m] (F/T)
+//   compliance_mode, touched, low_level_loop, fsm_state, event,
+//   cycle_status, controller_status, qp_status, qp_iterations
+//                                         integer codes; the legend is the sidecar
+//                                         <log>.legend.yaml (Logger::legend_yaml())
+//   stiffness_scale                       live end-effector stiffness scale [-]
+//   cycle_time_s                          wall-clock time of the cycle's computation [s]
+#include <array>
+#include <cstdint>
+
+namespace phri {
+
+class ControlCycle;
+class Fsm;
+struct RobotState;
+
+inline constexpr int kLogMaxJoints = 7;
+
+struct LogRow {
+  using Joints = std::array<double, kLogMaxJoints>;
+
+  double time_s = 0.0;
+  std::int64_t cycle = 0;
+  Joints q{}, qd{}, qdd_d{}, tau_d{}, tau_s{}, tau_ext{}, current{};
+  std::array<double, 3> ee_position{};
+  std::array<double, 4> ee_quaternion{1.0, 0.0, 0.0, 0.0};  ///< w, x, y, z
+  std::array<double, 3> target_position{};
+  std::array<double, 4> target_quaternion{1.0, 0.0, 0.0, 0.0};
+  std::array<double, 6> error{};  ///< position (3), orientation log (3)
+  double error_position_m = 0.0;
+  double error_orientation_rad = 0.0;
+  std::array<double, 6> wrench{};  ///< force (3), moment (3)
+  double wrench_norm = 0.0;
+  std::int32_t compliance_mode = 0;    ///< ComplianceMode
+  std::int32_t touched = 0;            ///< dual compliance: 1 while the end effector is touched
+  std::int32_t low_level_loop = 0;     ///< LowLevelLoop running
+  std::int32_t fsm_state = -1;         ///< FsmState; -1: no FSM
+  std::int32_t event = -1;             ///< Event handled in this cycle (the last one); -1: none
+  std::int32_t cycle_status = 0;       ///< CycleStatus
+  std::int32_t controller_status = 0;  ///< ControllerStatus of the whole-body QP
+  std::int32_t qp_status = 0;          ///< QpStatus of the solver
+  std::int32_t qp_iterations = 0;
+  double stiffness_scale = 1.0;
+  double cycle_time_s = 0.0;
+};
+
+/// Calls, in column order, v.number(name, value) for each real column, v.integer(name, value) for
+/// each integer column and v.joints(name, values, dof) for each per-joint group (columns name_1 ..
+/// name_dof).
+template <class Visitor>
+void visit_log_columns(const LogRow& r, int dof, Visitor&& v) {
+  v.number("time_s", r.time_s);
+  v.integer("cycle", r.cycle);
+  v.joints("q", r.q, dof);
+  v.joints("qd", r.qd, dof);
+  v.joints("qdd_d", r.qdd_d, dof);
+  v.joints("tau_d", r.tau_d, dof);
+  v.joints("tau_s", r.tau_s, dof);
+  v.joints("tau_ext", r.tau_ext, dof);
+  v.joints("current", r.current, dof);
+  v.number("ee_x", r.ee_position[0]);
+  v.number("ee_y", r.ee_position[1]);
+  v.number("ee_z", r.ee_position[2]);
+  v.number("ee_qw", r.ee_quaternion[0]);
+  v.number("ee_qx", r.ee_quaternion[1]);
+  v.number("ee_qy", r.ee_quaternion[2]);
+  v.number("ee_qz", r.ee_quaternion[3]);
+  v.number("target_x", r.target_position[0]);
+  v.number("target_y", r.target_position[1]);
+  v.number("target_z", r.target_position[2]);
+  v.number("target_qw", r.target_quaternion[0]);
+  v.number("target_qx", r.target_quaternion[1]);
+  v.number("target_qy", r.target_quaternion[2]);
+  v.number("target_qz", r.target_quaternion[3]);
+  v.number("err_x", r.error[0]);
+  v.number("err_y", r.error[1]);
+  v.number("err_z", r.error[2]);
+  v.number("err_rx", r.error[3]);
+  v.number("err_ry", r.error[4]);
+  v.number("err_rz", r.error[5]);
+  v.number("err_pos_m", r.error_position_m);
+  v.number("err_ori_rad", r.error_orientation_rad);
+  v.number("wrench_fx", r.wrench[0]);
+  v.number("wrench_fy", r.wrench[1]);
+  v.number("wrench_fz", r.wrench[2]);
+  v.number("wrench_mx", r.wrench[3]);
+  v.number("wrench_my", r.wrench[4]);
+  v.number("wrench_mz", r.wrench[5]);
+  v.number("wrench_norm", r.wrench_norm);
+  v.integer("compliance_mode", r.compliance_mode);
+  v.integer("touched", r.touched);
+  v.integer("low_level_loop", r.low_level_loop);
+  v.integer("fsm_state", r.fsm_state);
+  v.integer("event", r.event);
+  v.integer("cycle_status", r.cycle_status);
+  v.integer("controller_status", r.controller_status);
+  v.integer("qp_status", r.qp_status);
+  v.integer("qp_iterations", r.qp_iterations);
+  v.number("stiffness_scale", r.stiffness_scale);
+  v.number("cycle_time_s", r.cycle_time_s);
+}
+
+/// Fills every field the robot state and the control cycle give (after cycle.step()): all but
+/// fsm_state, event and cycle_time_s. No allocation.
+void fill_log_row(LogRow& row, const RobotState& state, const ControlCycle& cycle);
+/// ... and fsm_state and event from the FSM (event: the last one its last update handled).
+void fill_log_row(LogRow& row, const RobotState& state, const ControlCycle& cycle, const Fsm& fsm);
+
+}  // namespace phri
