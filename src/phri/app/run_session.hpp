@@ -1,0 +1,65 @@
+#pragma once
+// phri::run_session: the control loop of `phri run` — read -> FSM -> ControlCycle -> write -> log,
+// once per period, in lockstep (as fast as possible) or paced by the real-time clock, with the
+// same code path. It measures every cycle's compute time, reports a status line (~5 Hz on a
+// terminal, plain progress lines otherwise) and, at the end, cycle-time statistics and a table per
+// phase (phases are named spans of the run, e.g. the scripted demo's steps).
+//
+// Safety: two consecutive overruns of the real-time period, or stale/invalid sensor data (the
+// ControlCycle holds the previous command then), post a stop to the FSM (brake to rest, hold) and
+// are reported once, clearly.
+#include <phri/app/control_cycle.hpp>
+#include <phri/app/fsm.hpp>
+#include <phri/app/gamepad.hpp>
+#include <phri/app/logger.hpp>
+#include <phri/robot/robot_interface.hpp>
+
+#include <iosfwd>
+#include <string>
+#include <vector>
+
+namespace phri {
+
+struct PhaseMark {
+  double start_s = 0.0;
+  std::string name;
+};
+
+struct RunOptions {
+  double duration_s = 30.0;
+  bool real_time = false;           ///< false: lockstep
+  bool status_line = true;          ///< a refreshed line on a terminal, progress lines otherwise
+  std::vector<PhaseMark> phases;    ///< sorted by start; empty: one phase "run"
+};
+
+struct PhaseSummary {
+  std::string name;
+  double start_s = 0.0, end_s = 0.0;
+  double ee_position_error_max_mm = 0.0, ee_position_error_rms_mm = 0.0;
+  double ee_orientation_error_max_deg = 0.0, ee_orientation_error_rms_deg = 0.0;
+  double wrench_norm_max = 0.0;
+  int compliance_switches = 0;   ///< compliance mode changes and dual-compliance touches
+  int loop_switches = 0;
+  double cycle_median_us = 0.0, cycle_p999_us = 0.0;
+};
+
+struct RunSummary {
+  std::uint64_t cycles = 0;
+  double simulated_s = 0.0, wall_s = 0.0;
+  double cycle_median_us = 0.0, cycle_p99_us = 0.0, cycle_p999_us = 0.0, cycle_max_us = 0.0;
+  std::uint64_t overruns = 0;
+  long held_cycles = 0;
+  bool safe_hold = false;
+  std::string safe_hold_reason;
+  std::vector<PhaseSummary> phases;
+};
+
+/// Runs the loop for options.duration_s of robot time (or until the FSM has stopped and the arm
+/// is at rest after a stop event). `gamepad` and `logger` may be null.
+RunSummary run_session(RobotInterface& robot, ControlCycle& cycle, Fsm& fsm, Gamepad* gamepad, Logger* logger,
+                       const RunOptions& options, std::ostream& out);
+
+/// The end-of-run report: cycle statistics and the per-phase table (markdown).
+void print_run_summary(const RunSummary& summary, std::ostream& out);
+
+}  // namespace phri
