@@ -5,6 +5,7 @@
 // the static and dynamic scenarios, compliance modes, loops, stiffness and stops; the reference
 // never steps; the loop (plant + FSM + cycle) allocates nothing; the whole run logged through
 // phri::Logger and read back.
+#include <phri/app/config.hpp>
 #include <phri/app/control_cycle.hpp>
 #include <phri/app/fsm.hpp>
 #include <phri/app/log_row.hpp>
@@ -382,6 +383,76 @@ TEST(Fsm, BadSettingsAreConfigErrors) {
   expect_error([](auto& s) { s.torque_loop = phri::LowLevelLoop::kPosition; }, "torque_loop");
   expect_error([](auto& s) { s.stiffness_step = 0.5; }, "stiffness_step");
   expect_error([](auto& s) { s.timeline = {{-1.0, phri::Event::kStop}}; }, "timeline[0].at");
+}
+
+// configs/demo.yaml end to end, as the CLI wires it (lockstep): Config -> SimRobot + ControlCycle
+// + Fsm (+ Logger); the scripted session runs through every state and mode it announces.
+TEST(Fsm, DemoYamlSession) {
+  const phri::Config config = phri::Config::from_yaml_file(kRoot + "/configs/demo.yaml");
+  phri::SimRobot robot(config.plant);
+  phri::ControlCycle cycle(config.controller);
+  phri::Fsm fsm(config.fsm, cycle);
+  phri::LoggerSettings log_settings = config.logging;
+  log_settings.path = temp_path("demo.csv");
+  phri::Logger logger(log_settings);
+  phri::RobotCommand command(robot.dof());
+  phri::LogRow row;
+
+  std::vector<Transition> transitions;
+  double elbow_ee_error = 0.0, dynamic_error = 0.0, position_loop_error = 0.0;
+  bool all_ok = true, saw_position = false, saw_dual_touch = false;
+  Eigen::Vector3d before_hand = Eigen::Vector3d::Zero(), after_hand = Eigen::Vector3d::Zero();
+  Eigen::Vector3d ee_before_push = Eigen::Vector3d::Zero();
+  double full_body_yield = 0.0;
+  while (robot.state().time_s < config.run.duration_s && !fsm.finished()) {
+    const phri::RobotState& state = robot.read();
+    fsm.update(state.time_s, state, cycle);
+    cycle.step(state, command);
+    robot.write(command);
+    phri::fill_log_row(row, state, cycle, fsm);
+    logger.push(row);
+
+    const double t = state.time_s;
+    all_ok &= cycle.status() == phri::CycleStatus::kOk;
+    if (transitions.empty() || transitions.back().state != fsm.state()) transitions.push_back({t, fsm.state()});
+    const double error = cycle.qp().end_effector().error().head<3>().norm();
+    if (t > 3.5 && t < 7.5) elbow_ee_error = std::max(elbow_ee_error, error);
+    if (std::abs(t - 8.9) < 5e-4) ee_before_push = cycle.qp().end_effector().pose().translation();
+    if (t > 9.0 && t < 11.0) {
+      full_body_yield = std::max(full_body_yield, (cycle.qp().end_effector().pose().translation() - ee_before_push).norm());
+    }
+    if (std::abs(t - 12.9) < 5e-4) before_hand = cycle.qp().end_effector().target_pose().translation();
+    if (std::abs(t - 15.0) < 5e-4) after_hand = cycle.qp().end_effector().target_pose().translation();
+    saw_dual_touch |= cycle.compliance().touched();
+    if (t > 22.0 && t < 25.0) dynamic_error = std::max(dynamic_error, error);
+    if (t > 25.0 && t < 27.0) {
+      position_loop_error = std::max(position_loop_error, error);
+      saw_position |= cycle.low_level().loop() == phri::LowLevelLoop::kPosition;
+    }
+  }
+  const phri::LoggerStats stats = logger.close();
+  std::printf("demo.yaml: %s; finished at %.3f s\n", describe(transitions).c_str(), robot.state().time_s);
+  std::printf("demo.yaml: EE error under the elbow pushes %.2f mm; full-body push moved the EE %.1f mm; the hand moved "
+              "the held pose %.1f mm; dynamic EE error %.2f mm (custom), %.2f mm (position); log %llu rows, %llu "
+              "dropped\n",
+              1e3 * elbow_ee_error, 1e3 * full_body_yield, 1e3 * (after_hand - before_hand).norm(), 1e3 * dynamic_error,
+              1e3 * position_loop_error, static_cast<unsigned long long>(stats.written),
+              static_cast<unsigned long long>(stats.dropped));
+  using S = phri::FsmState;
+  const std::vector<S> expected = {S::kStartup, S::kStatic, S::kDynamic, S::kStatic, S::kStopped};
+  ASSERT_EQ(transitions.size(), expected.size()) << describe(transitions);
+  for (std::size_t i = 0; i < expected.size(); ++i) EXPECT_EQ(transitions[i].state, expected[i]) << i;
+  EXPECT_NEAR(transitions[2].time, 20.0, 2e-3);  // the static pose was reached again before 20 s
+  EXPECT_TRUE(fsm.finished());
+  EXPECT_TRUE(all_ok);
+  EXPECT_LT(elbow_ee_error, 0.003);
+  EXPECT_GT(full_body_yield, 0.01);
+  EXPECT_TRUE(saw_dual_touch);
+  EXPECT_GT((after_hand - before_hand).norm(), 0.02);
+  EXPECT_LT(dynamic_error, 0.005);
+  EXPECT_TRUE(saw_position);
+  EXPECT_LT(position_loop_error, 0.01);
+  EXPECT_EQ(stats.dropped, 0u);
 }
 
 }  // namespace

@@ -1,0 +1,423 @@
+#include <phri/app/config.hpp>
+
+#include <phri/core/yaml_reader.hpp>
+#include <phri/robot/actuator_table.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace phri {
+namespace {
+
+constexpr double kHuge = 1e9;
+
+std::string resolve(const std::string& base_dir, const std::string& file) {
+  const std::filesystem::path p(file);
+  if (p.is_absolute() || base_dir.empty()) return p.lexically_normal().string();
+  return (std::filesystem::path(base_dir) / p).lexically_normal().string();
+}
+
+// An input file named under `key`, relative to base_dir; it must exist. Empty text: "" when
+// allowed (e.g. no collision model).
+std::string input_file(const YamlReader& r, std::string_view key, const std::string& base_dir, bool allow_empty) {
+  const std::string text = r.text(key);
+  if (text.empty()) {
+    if (allow_empty) return "";
+    throw r.error(key, "empty file name");
+  }
+  const std::string path = resolve(base_dir, text);
+  if (!std::filesystem::is_regular_file(path)) throw r.error(key, "file not found: " + path);
+  return path;
+}
+
+// A number > 0 (finite, at most `max`), or the fallback when absent.
+double positive_or(const YamlReader& r, std::string_view key, double fallback, double max) {
+  if (!r.has(key)) return fallback;
+  const double v = r.number(key, 0.0, max);
+  if (!(v > 0.0)) throw r.error(key, "must be > 0");
+  return v;
+}
+
+double non_negative_or(const YamlReader& r, std::string_view key, double fallback, double max) {
+  return r.number_or(key, fallback, 0.0, max);
+}
+
+Eigen::Vector3d vector3(const YamlReader& r, std::string_view key, double min, double max) {
+  const auto v = r.numbers(key, 3, min, max);
+  return Eigen::Vector3d(v[0], v[1], v[2]);
+}
+
+Eigen::VectorXd per_joint(const YamlReader& r, std::string_view key, int dof, double min, double max) {
+  const auto v = r.numbers(key, dof, min, max);
+  return Eigen::Map<const Eigen::VectorXd>(v.data(), dof);
+}
+
+ComplianceMode compliance_mode(const YamlReader& r, std::string_view key) {
+  return *compliance_mode_from_string(r.choice(key, {"stiff", "null_space", "full_body", "dual"}));
+}
+
+// ------------------------------------------------------------------------------------ robot
+void parse_robot(const YamlReader& r, const std::string& base_dir, ControlCycleSettings& c) {
+  r.allow_keys({"urdf", "actuators", "collision", "end_effector_frame", "ft_sensor_offset_m", "payloads"});
+  c.urdf_path = input_file(r, "urdf", base_dir, false);
+  c.actuators_path = input_file(r, "actuators", base_dir, false);
+  c.collision_path = r.has("collision") ? input_file(r, "collision", base_dir, true) : "";
+  c.end_effector_frame = r.text_or("end_effector_frame", c.end_effector_frame);
+  c.ft_sensor_offset_m = r.number_or("ft_sensor_offset_m", c.ft_sensor_offset_m, 0.0, 1.0);
+  if (r.has("payloads")) {
+    const YamlReader list = r.at("payloads");
+    list.expect_sequence();
+    c.payloads.clear();
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      const YamlReader p = list.at(i);
+      p.allow_keys({"name", "frame", "mass_kg", "com_m", "inertia_kgm2"});
+      Payload payload;
+      payload.name = p.text("name");
+      payload.frame = p.text_or("frame", "");  // empty: the end-effector frame
+      payload.inertia.mass = p.number("mass_kg", 0.0, 100.0);
+      payload.inertia.com = p.has("com_m") ? vector3(p, "com_m", -2.0, 2.0) : Eigen::Vector3d::Zero();
+      payload.inertia.inertia_com =
+          (p.has("inertia_kgm2") ? vector3(p, "inertia_kgm2", 0.0, 10.0) : Eigen::Vector3d::Zero()).asDiagonal();
+      c.payloads.push_back(payload);
+    }
+  }
+}
+
+// ------------------------------------------------------------------------------------ plant
+// Input files inside a plant `robot:` map, made absolute against the folder of the file naming them.
+void absolutize_robot(YAML::Node plant, const std::string& dir) {
+  const YAML::Node& view = plant;
+  if (!view.IsMap() || !view["robot"] || !view["robot"].IsMap()) return;
+  YAML::Node robot = plant["robot"];
+  for (const char* key : {"mjcf", "actuators"}) {
+    const YAML::Node& robot_view = robot;
+    if (robot_view[key] && robot_view[key].IsScalar()) robot[key] = resolve(dir, robot_view[key].Scalar());
+  }
+}
+
+// Maps merged key by key (recursively); anything else in `over` replaces what `base` has.
+void merge(YAML::Node base, const YAML::Node& over) {
+  for (const auto& item : over) {
+    const std::string key = item.first.as<std::string>();
+    const YAML::Node& base_view = base;
+    if (item.second.IsMap() && base_view[key] && base_view[key].IsMap()) {
+      merge(base[key], item.second);
+    } else {
+      base[key] = YAML::Clone(item.second);
+    }
+  }
+}
+
+SimRobotConfig parse_plant(const YamlReader& r, const YAML::Node& raw, const std::string& source,
+                           const std::string& base_dir) {
+  r.expect_map();
+  YAML::Node plant;
+  if (r.has("file")) {
+    const std::string file = input_file(r, "file", base_dir, false);
+    YAML::Node loaded;
+    try {
+      loaded = YAML::LoadFile(file);
+    } catch (const YAML::Exception& e) {
+      throw ConfigError(file, "", std::string("invalid YAML: ") + e.what());
+    }
+    if (!loaded.IsMap() || !loaded["plant"] || !loaded["plant"].IsMap()) {
+      throw ConfigError(file, "plant", "expected a map under the key 'plant'");
+    }
+    plant = YAML::Clone(loaded["plant"]);
+    absolutize_robot(plant, std::filesystem::path(file).parent_path().string());
+    YAML::Node overrides = YAML::Clone(raw);
+    overrides.remove("file");
+    absolutize_robot(overrides, base_dir);
+    merge(plant, overrides);
+  } else {
+    plant = YAML::Clone(raw);
+    absolutize_robot(plant, base_dir);
+  }
+  YAML::Node document;
+  document["plant"] = plant;
+  YAML::Emitter out;
+  out << document;
+  // Key paths in errors stay "plant.<...>", as in this file.
+  return SimRobotConfig::from_yaml_string(out.c_str(), source, base_dir);
+}
+
+// ------------------------------------------------------------------------------------ controller
+void parse_controller(const YamlReader& r, int dof, ControlCycleSettings& c) {
+  r.allow_keys({"period_s", "observer_gain", "compliance_deadband", "compliance", "qp", "wrench"});
+  c.period_s = positive_or(r, "period_s", c.period_s, 0.1);
+  c.observer_gain = positive_or(r, "observer_gain", c.observer_gain, 1e4);
+
+  if (r.has("compliance_deadband")) {
+    const YamlReader d = r.at("compliance_deadband");
+    d.allow_keys({"large_Nm", "small_Nm", "per_joint_Nm"});
+    c.deadband_large_Nm = non_negative_or(d, "large_Nm", c.deadband_large_Nm, 100.0);
+    c.deadband_small_Nm = non_negative_or(d, "small_Nm", c.deadband_small_Nm, 100.0);
+    if (d.has("per_joint_Nm")) c.qp.compliance_deadband = per_joint(d, "per_joint_Nm", dof, 0.0, 100.0);
+  }
+
+  if (r.has("compliance")) {
+    const YamlReader m = r.at("compliance");
+    m.allow_keys({"initial_mode", "ee_position_stiffness", "ee_orientation_stiffness", "ee_weight",
+                  "full_body_ee_stiffness", "posture_stiffness", "posture_damping", "posture_weight",
+                  "touch_threshold", "release_threshold", "touched_ee_damping", "touched_posture_damping"});
+    ComplianceSettings& s = c.compliance;
+    if (m.has("initial_mode")) c.initial_compliance = compliance_mode(m, "initial_mode");
+    s.ee_position_stiffness = non_negative_or(m, "ee_position_stiffness", s.ee_position_stiffness, 1e5);
+    s.ee_orientation_stiffness = non_negative_or(m, "ee_orientation_stiffness", s.ee_orientation_stiffness, 1e5);
+    s.ee_weight = non_negative_or(m, "ee_weight", s.ee_weight, 1e9);
+    s.full_body_ee_stiffness = non_negative_or(m, "full_body_ee_stiffness", s.full_body_ee_stiffness, 1e5);
+    s.posture_stiffness = non_negative_or(m, "posture_stiffness", s.posture_stiffness, 1e5);
+    s.posture_damping = non_negative_or(m, "posture_damping", s.posture_damping, 1e4);
+    s.posture_weight = positive_or(m, "posture_weight", s.posture_weight, 1e9);
+    s.touch_threshold = non_negative_or(m, "touch_threshold", s.touch_threshold, 1e4);
+    s.release_threshold = non_negative_or(m, "release_threshold", s.release_threshold, 1e4);
+    s.touched_ee_damping = non_negative_or(m, "touched_ee_damping", s.touched_ee_damping, 1e4);
+    s.touched_posture_damping = non_negative_or(m, "touched_posture_damping", s.touched_posture_damping, 1e4);
+    if (!(s.release_threshold < s.touch_threshold)) {
+      throw m.error("release_threshold", "must be below touch_threshold (the Schmitt trigger's hysteresis)");
+    }
+  }
+
+  if (r.has("qp")) {
+    const YamlReader q = r.at("qp");
+    q.allow_keys({"torque_limit_Nm", "velocity_limit_rad_s", "velocity_limit_fraction", "joint_limits",
+                  "velocity_limit_gain", "collision", "regularization", "brake_damping", "smoothing_time_constant_s"});
+    WholeBodyQpSettings& s = c.qp;
+    if (q.has("torque_limit_Nm")) s.torque_limit = per_joint(q, "torque_limit_Nm", dof, 1e-3, 1e4);
+    if (q.has("velocity_limit_rad_s")) s.velocity_limit = per_joint(q, "velocity_limit_rad_s", dof, 1e-3, 100.0);
+    s.velocity_limit_fraction = positive_or(q, "velocity_limit_fraction", s.velocity_limit_fraction, 1.0);
+    if (q.has("joint_limits")) {
+      const YamlReader j = q.at("joint_limits");
+      j.allow_keys({"influence_fraction", "safety_fraction", "amortization"});
+      s.joint_influence_fraction = positive_or(j, "influence_fraction", s.joint_influence_fraction, 0.49);
+      s.joint_safety_fraction = non_negative_or(j, "safety_fraction", s.joint_safety_fraction, 0.49);
+      s.joint_damper_amortization = j.number_or("amortization", s.joint_damper_amortization, 1.0, 100.0);
+      if (!(s.joint_safety_fraction < s.joint_influence_fraction)) {
+        throw j.error("safety_fraction", "must be below influence_fraction (d_s < d_i)");
+      }
+    }
+    s.velocity_limit_gain = positive_or(q, "velocity_limit_gain", s.velocity_limit_gain, 1e4);
+    if (q.has("collision")) {
+      const YamlReader k = q.at("collision");
+      k.allow_keys({"influence_distance_m", "safety_distance_m", "approach_speed_m_s", "amortization"});
+      VelocityDamperSettings& d = s.collision;
+      d.influence_distance = positive_or(k, "influence_distance_m", d.influence_distance, 1.0);
+      d.safety_distance = non_negative_or(k, "safety_distance_m", d.safety_distance, 1.0);
+      d.xi = positive_or(k, "approach_speed_m_s", d.xi, 10.0);
+      d.amortization = k.number_or("amortization", d.amortization, 1.0, 100.0);
+      if (!(d.safety_distance < d.influence_distance)) {
+        throw k.error("safety_distance_m", "must be below influence_distance_m (d_s < d_i)");
+      }
+    }
+    s.regularization = non_negative_or(q, "regularization", s.regularization, 1.0);
+    s.brake_damping = positive_or(q, "brake_damping", s.brake_damping, 1e4);
+    s.smoothing_time_constant = non_negative_or(q, "smoothing_time_constant_s", s.smoothing_time_constant, 10.0);
+  }
+
+  if (r.has("wrench")) {
+    const YamlReader w = r.at("wrench");
+    w.allow_keys({"tool_mass_kg", "tool_com_m", "bias_samples"});
+    c.wrench.tool_mass_kg = non_negative_or(w, "tool_mass_kg", c.wrench.tool_mass_kg, 100.0);
+    if (w.has("tool_com_m")) c.wrench.tool_com_m = vector3(w, "tool_com_m", -2.0, 2.0);
+    c.wrench.bias_samples = static_cast<int>(w.integer_or("bias_samples", c.wrench.bias_samples, 0, 1000000));
+  }
+}
+
+// ------------------------------------------------------------------------------------ low level
+void parse_low_level(const YamlReader& r, ControlCycleSettings& c, FsmSettings& fsm) {
+  r.allow_keys({"torque_loop", "custom"});
+  if (r.has("torque_loop")) {
+    fsm.torque_loop = *low_level_loop_from_string(
+        r.choice("torque_loop", {"kinova_torque", "kinova_torque_high_velocity", "custom"}));
+  }
+  if (r.has("custom")) {
+    const YamlReader k = r.at("custom");
+    k.allow_keys({"transfer_gain", "integral_gain", "integral_leak", "integral_limit_fraction",
+                  "friction_compensation", "rotor_inertia_compensation"});
+    CustomTorqueSettings& s = c.custom_torque;
+    s.transfer_gain = non_negative_or(k, "transfer_gain", s.transfer_gain, 1e3);
+    s.integral_gain = non_negative_or(k, "integral_gain", s.integral_gain, 1e4);
+    s.integral_leak = non_negative_or(k, "integral_leak", s.integral_leak, 1e4);
+    s.integral_limit_fraction = non_negative_or(k, "integral_limit_fraction", s.integral_limit_fraction, 1.0);
+    s.friction_compensation = k.boolean_or("friction_compensation", s.friction_compensation);
+    s.rotor_inertia_compensation = k.boolean_or("rotor_inertia_compensation", s.rotor_inertia_compensation);
+  }
+}
+
+// ------------------------------------------------------------------------------------ fsm
+void parse_fsm(const YamlReader& r, int dof, FsmSettings& f) {
+  r.allow_keys({"first_scenario", "stiffness_step", "rest_speed_rad_s", "startup", "static", "dynamic", "brake"});
+  if (r.has("first_scenario")) {
+    f.first_scenario = r.choice("first_scenario", {"static", "dynamic"}) == "static" ? Scenario::kStatic
+                                                                                   : Scenario::kDynamic;
+  }
+  f.stiffness_step = r.number_or("stiffness_step", f.stiffness_step, 1.0, 10.0);
+  f.rest_speed_rad_s = positive_or(r, "rest_speed_rad_s", f.rest_speed_rad_s, 10.0);
+  if (r.has("startup")) {
+    const YamlReader s = r.at("startup");
+    s.allow_keys({"enabled", "home_q_rad", "max_joint_speed_rad_s", "min_duration_s", "tolerance_rad", "timeout_s"});
+    StartupSettings& st = f.startup;
+    st.enabled = s.boolean_or("enabled", st.enabled);
+    if (s.has("home_q_rad")) st.home_q_rad = s.numbers("home_q_rad", dof, -100.0, 100.0);
+    st.max_joint_speed_rad_s = positive_or(s, "max_joint_speed_rad_s", st.max_joint_speed_rad_s, 5.0);
+    st.min_duration_s = non_negative_or(s, "min_duration_s", st.min_duration_s, 1000.0);
+    st.tolerance_rad = positive_or(s, "tolerance_rad", st.tolerance_rad, 10.0);
+    st.timeout_s = non_negative_or(s, "timeout_s", st.timeout_s, 1000.0);
+  }
+  if (r.has("static")) {
+    const YamlReader s = r.at("static");
+    s.allow_keys({"posture_q_rad", "move_speed_m_s", "move_angular_speed_rad_s", "min_move_duration_s"});
+    StaticScenarioSettings& st = f.static_scenario;
+    if (s.has("posture_q_rad")) st.posture_q_rad = s.numbers("posture_q_rad", dof, -100.0, 100.0);
+    st.move_speed_m_s = positive_or(s, "move_speed_m_s", st.move_speed_m_s, 2.0);
+    st.move_angular_speed_rad_s = positive_or(s, "move_angular_speed_rad_s", st.move_angular_speed_rad_s, 10.0);
+    st.min_move_duration_s = non_negative_or(s, "min_move_duration_s", st.min_move_duration_s, 1000.0);
+  }
+  if (r.has("dynamic")) {
+    const YamlReader d = r.at("dynamic");
+    d.allow_keys({"vertical_amplitude_m", "vertical_angular_frequency_rad_s", "horizontal_speed_m_s",
+                  "horizontal_min_offset_m", "horizontal_max_offset_m", "horizontal_turn_acceleration_m_s2", "ramp_s",
+                  "compliance"});
+    DynamicScenarioSettings& dy = f.dynamic_scenario;
+    dy.vertical_amplitude_m = non_negative_or(d, "vertical_amplitude_m", dy.vertical_amplitude_m, 1.0);
+    dy.vertical_angular_frequency_rad_s =
+        non_negative_or(d, "vertical_angular_frequency_rad_s", dy.vertical_angular_frequency_rad_s, 100.0);
+    dy.horizontal_speed_m_s = non_negative_or(d, "horizontal_speed_m_s", dy.horizontal_speed_m_s, 2.0);
+    dy.horizontal_min_offset_m = d.number_or("horizontal_min_offset_m", dy.horizontal_min_offset_m, -2.0, 0.0);
+    dy.horizontal_max_offset_m = d.number_or("horizontal_max_offset_m", dy.horizontal_max_offset_m, 0.0, 2.0);
+    dy.horizontal_turn_acceleration_m_s2 =
+        positive_or(d, "horizontal_turn_acceleration_m_s2", dy.horizontal_turn_acceleration_m_s2, 100.0);
+    dy.ramp_s = non_negative_or(d, "ramp_s", dy.ramp_s, 100.0);
+    if (d.has("compliance")) {
+      const std::string mode = d.choice("compliance", {"keep", "stiff", "null_space", "full_body", "dual"});
+      dy.compliance = mode == "keep" ? std::nullopt : compliance_mode_from_string(mode);
+    }
+    const double span = dy.horizontal_max_offset_m - dy.horizontal_min_offset_m;
+    if (dy.horizontal_speed_m_s * dy.horizontal_speed_m_s > dy.horizontal_turn_acceleration_m_s2 * span + 1e-12) {
+      throw d.error("horizontal_speed_m_s",
+                    "too fast for the span: the two turns need speed^2 / horizontal_turn_acceleration_m_s2 <= "
+                    "horizontal_max_offset_m - horizontal_min_offset_m");
+    }
+  }
+  if (r.has("brake")) {
+    const YamlReader b = r.at("brake");
+    b.allow_keys({"linear_deceleration_m_s2", "angular_deceleration_rad_s2", "joint_deceleration_rad_s2",
+                  "min_duration_s"});
+    BrakeSettings& br = f.brake;
+    br.linear_deceleration_m_s2 = positive_or(b, "linear_deceleration_m_s2", br.linear_deceleration_m_s2, 100.0);
+    br.angular_deceleration_rad_s2 = positive_or(b, "angular_deceleration_rad_s2", br.angular_deceleration_rad_s2, 100.0);
+    br.joint_deceleration_rad_s2 = positive_or(b, "joint_deceleration_rad_s2", br.joint_deceleration_rad_s2, 100.0);
+    br.min_duration_s = positive_or(b, "min_duration_s", br.min_duration_s, 10.0);
+  }
+}
+
+std::vector<TimedEvent> parse_events(const YamlReader& list, double duration_s) {
+  list.expect_sequence();
+  std::vector<TimedEvent> out;
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    const YamlReader e = list.at(i);
+    e.allow_keys({"at", "event"});
+    TimedEvent timed;
+    timed.time_s = e.number("at", 0.0, kHuge);
+    // An event after the end of the run is most likely a typo in `at` or in run.duration_s.
+    if (timed.time_s > duration_s) throw e.error("at", "after the end of the run (run.duration_s)");
+    const std::string name = e.text("event");
+    const auto event = event_from_string(name);
+    if (!event) {
+      std::string names;
+      for (std::string_view n : kEventNames) names += (names.empty() ? "" : ", ") + std::string(n);
+      throw e.error("event", "unknown event '" + name + "' (one of " + names + ")");
+    }
+    timed.event = *event;
+    out.push_back(timed);
+  }
+  std::stable_sort(out.begin(), out.end(), [](const TimedEvent& a, const TimedEvent& b) { return a.time_s < b.time_s; });
+  return out;
+}
+
+Config parse(const YAML::Node& raw, const std::string& source, const std::string& base_dir) {
+  const YamlReader root(raw, source, "");
+  root.allow_keys({"robot", "plant", "controller", "low_level", "fsm", "events", "logging", "gamepad", "run"});
+  Config c;
+  c.source = source;
+
+  parse_robot(root.at("robot"), base_dir, c.controller);
+  const int dof = ActuatorTable::from_yaml_file(c.controller.actuators_path).size();
+
+  const YamlReader plant = root.at("plant");
+  c.plant = parse_plant(plant, raw["plant"], source, base_dir);
+  if (c.plant.dof() != dof) {
+    throw ConfigError(source, "plant.robot.actuators",
+                      "the plant has " + std::to_string(c.plant.dof()) + " joints, the controller's robot.actuators " +
+                          std::to_string(dof));
+  }
+
+  if (root.has("controller")) parse_controller(root.at("controller"), dof, c.controller);
+  if (std::abs(c.controller.period_s - c.plant.control_period_s) > 1e-12) {
+    throw ConfigError(source, "controller.period_s",
+                      "must equal the plant's control period (plant.timing.control_period_s)");
+  }
+  if (root.has("low_level")) parse_low_level(root.at("low_level"), c.controller, c.fsm);
+  if (root.has("fsm")) parse_fsm(root.at("fsm"), dof, c.fsm);
+  // The FSM's start-up runs in Position; without it the run starts in the torque loop.
+  c.controller.initial_loop = c.fsm.startup.enabled ? LowLevelLoop::kPosition : c.fsm.torque_loop;
+
+  if (root.has("logging")) {
+    const YamlReader l = root.at("logging");
+    l.allow_keys({"enabled", "path", "buffer_rows", "legend"});
+    c.logging_enabled = l.boolean_or("enabled", c.logging_enabled);
+    c.logging.path = l.text_or("path", c.logging.path);
+    if (c.logging.path.empty()) throw l.error("path", "empty file name");
+    c.logging.capacity_rows = static_cast<std::size_t>(
+        l.integer_or("buffer_rows", static_cast<long long>(c.logging.capacity_rows), 16, 1 << 22));
+    c.logging.write_legend = l.boolean_or("legend", c.logging.write_legend);
+  }
+  c.logging.dof = std::min(dof, kLogMaxJoints);
+
+  if (root.has("gamepad")) {
+    const YamlReader g = root.at("gamepad");
+    g.allow_keys({"enabled", "poll_interval_ms", "trigger_press", "trigger_release"});
+    c.gamepad.enabled = g.boolean_or("enabled", c.gamepad.enabled);
+    c.gamepad.poll_interval_ms = static_cast<int>(g.integer_or("poll_interval_ms", c.gamepad.poll_interval_ms, 1, 1000));
+    GamepadMapping& m = c.gamepad.mapping;
+    m.trigger_press = positive_or(g, "trigger_press", m.trigger_press, 1.0);
+    m.trigger_release = non_negative_or(g, "trigger_release", m.trigger_release, 1.0);
+    if (!(m.trigger_release < m.trigger_press)) throw g.error("trigger_release", "must be below trigger_press");
+  }
+
+  if (root.has("run")) {
+    const YamlReader r = root.at("run");
+    r.allow_keys({"duration_s", "pacing"});
+    c.run.duration_s = positive_or(r, "duration_s", c.run.duration_s, kHuge);
+    if (r.has("pacing")) {
+      c.run.pacing = r.choice("pacing", {"real_time", "lockstep"}) == "real_time" ? LoopClock::Pacing::kRealTime
+                                                                                  : LoopClock::Pacing::kLockstep;
+    }
+  }
+  if (root.has("events")) c.fsm.timeline = parse_events(root.at("events"), c.run.duration_s);
+  return c;
+}
+
+}  // namespace
+
+Config Config::from_yaml_file(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw ConfigError(path, "", "cannot open the file");
+  std::stringstream text;
+  text << in.rdbuf();
+  return from_yaml_string(text.str(), path, std::filesystem::path(path).parent_path().string());
+}
+
+Config Config::from_yaml_string(const std::string& yaml, const std::string& source_name, const std::string& base_dir) {
+  YAML::Node raw;
+  try {
+    raw = YAML::Load(yaml);
+  } catch (const YAML::Exception& e) {
+    throw ConfigError(source_name, "", std::string("invalid YAML: ") + e.what());
+  }
+  return parse(raw, source_name, base_dir);
+}
+
+}  // namespace phri

@@ -1,0 +1,86 @@
+#pragma once
+// phri::Config: ONE YAML file per run (configs/demo.yaml is the reference, every key commented),
+// turned into the settings of every piece of the run:
+//
+//   const phri::Config config = phri::Config::from_yaml_file("configs/demo.yaml");  // throws phri::ConfigError
+//   phri::SimRobot robot(config.plant);
+//   phri::ControlCycle cycle(config.controller);
+//   phri::Fsm fsm(config.fsm, cycle);                    // config.fsm.timeline: the `events:` list
+//   phri::Gamepad gamepad(config.gamepad);  gamepad.start();
+//   std::optional<phri::Logger> logger;  if (config.logging_enabled) logger.emplace(config.logging);
+//   phri::LoopClock clock(robot.period_s(), config.run.pacing);
+//   phri::RobotCommand command(robot.dof());
+//   phri::LogRow row;
+//   while (robot.state().time_s < config.run.duration_s && !fsm.finished()) {
+//     const phri::RobotState& state = robot.read();
+//     for (phri::Event e; gamepad.poll(e);) fsm.post(e);
+//     fsm.update(state.time_s, state, cycle);
+//     cycle.step(state, command);
+//     robot.write(command);
+//     if (logger) { phri::fill_log_row(row, state, cycle, fsm); row.cycle_time_s = ...; logger->push(row); }
+//     clock.wait_next();
+//   }
+//
+// Schema (top-level sections; all but `robot` and `plant` optional, absent keys keep the defaults
+// of the settings structs, which follow the paper where it gives a value):
+//   robot:       urdf, actuators, collision ('' for none), end_effector_frame, ft_sensor_offset_m,
+//                payloads [{name, frame, mass_kg, com_m, inertia_kgm2}]       -> ControlCycleSettings
+//   plant:       either `file: plant_gen3.yaml` plus any keys of that file's `plant:` section to
+//                override (maps merged key by key, lists replaced), or the whole section inline
+//                                                                             -> SimRobotConfig
+//   controller:  period_s, observer_gain, compliance_deadband {large_Nm, small_Nm, per_joint_Nm},
+//                compliance {initial_mode, stiffness/damping/weights, touch/release thresholds},
+//                qp {limits, joint_limits {influence_fraction, safety_fraction, amortization},
+//                collision {influence_distance_m, safety_distance_m, approach_speed_m_s, amortization},
+//                ...}, wrench {tool_mass_kg, tool_com_m, bias_samples}       -> ControlCycleSettings
+//   low_level:   torque_loop (start-up hands over to it), custom {transfer_gain, integral_gain,
+//                integral_leak, integral_limit_fraction, friction_compensation,
+//                rotor_inertia_compensation}                                 -> ControlCycleSettings
+//   fsm:         first_scenario, stiffness_step, rest_speed_rad_s, startup {...}, static {...},
+//                dynamic {...}, brake {...}                                 -> FsmSettings
+//   events:      [{at: seconds, event: name}] (names: app/event.hpp)          -> FsmSettings::timeline
+//   logging:     enabled, path, buffer_rows, legend                           -> LoggerSettings
+//   gamepad:     enabled, poll_interval_ms, trigger_press, trigger_release    -> GamepadSettings
+//   run:         duration_s, pacing (real_time | lockstep)                    -> RunSettings
+//
+// Validation at load: unknown keys, wrong types, out-of-range values and inconsistent pairs are a
+// phri::ConfigError naming the file and the key path, e.g. "controller.qp.collision.safety_distance_m"
+// (d_s must be < d_i), "controller.compliance.release_threshold" (must be < touch_threshold),
+// "events[3].event". Input files (urdf, actuators, collision, plant file) are relative to the
+// folder of the YAML that names them and must exist; the log path (an output) is relative to the
+// working directory, so that a run never writes into configs/.
+//
+// The compliance modes fix the gammas (0 or 1 per task, control/compliance_controller.hpp), so the
+// file has no gamma keys.
+#include <phri/app/control_cycle_settings.hpp>
+#include <phri/app/fsm.hpp>
+#include <phri/app/gamepad.hpp>
+#include <phri/app/logger.hpp>
+#include <phri/app/loop_clock.hpp>
+#include <phri/robot/sim_robot_config.hpp>
+
+#include <string>
+
+namespace phri {
+
+struct RunSettings {
+  double duration_s = 30.0;  ///< robot time after which the run ends (if `stop` has not ended it)
+  LoopClock::Pacing pacing = LoopClock::Pacing::kRealTime;
+};
+
+struct Config {
+  static Config from_yaml_file(const std::string& path);
+  /// `base_dir` resolves relative input files; `source_name` stands for the file in errors.
+  static Config from_yaml_string(const std::string& yaml, const std::string& source_name, const std::string& base_dir);
+
+  std::string source;              ///< the file it came from
+  ControlCycleSettings controller;
+  SimRobotConfig plant;
+  FsmSettings fsm;                 ///< with the `events:` timeline, sorted by time
+  bool logging_enabled = true;
+  LoggerSettings logging;
+  GamepadSettings gamepad;
+  RunSettings run;
+};
+
+}  // namespace phri

@@ -1,0 +1,229 @@
+// ctest-labels: unit
+// phri::Config: configs/demo.yaml loads into the settings of every piece (paths resolved, plant
+// file merged with the overrides, the timeline sorted), and each class of mistake is a
+// phri::ConfigError naming the key path.
+#include <phri/app/config.hpp>
+#include <phri/core/config_error.hpp>
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace {
+
+const std::string kRoot = PHRI_SOURCE_DIR;
+const std::string kDemo = kRoot + "/configs/demo.yaml";
+
+std::string read_file(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+phri::Config load_edited(const std::string& from, const std::string& to) {
+  std::string yaml = read_file(kDemo);
+  const auto pos = yaml.find(from);
+  if (pos == std::string::npos) throw std::runtime_error("test bug: '" + from + "' not in demo.yaml");
+  yaml.replace(pos, from.size(), to);
+  return phri::Config::from_yaml_string(yaml, "test.yaml", kRoot + "/configs");
+}
+
+// demo.yaml with `from` replaced by `to` must fail with a ConfigError on key path `key`.
+void expect_error(const std::string& from, const std::string& to, const std::string& key,
+                  const std::string& reason_part = "") {
+  SCOPED_TRACE(to);
+  try {
+    load_edited(from, to);
+    ADD_FAILURE() << "no ConfigError for '" << to << "'";
+  } catch (const phri::ConfigError& e) {
+    EXPECT_EQ(e.element(), key) << e.what();
+    EXPECT_EQ(e.file(), "test.yaml") << e.what();
+    if (!reason_part.empty()) {
+      EXPECT_NE(std::string(e.what()).find(reason_part), std::string::npos) << e.what();
+    }
+  }
+}
+
+TEST(Config, LoadsTheDemo) {
+  const phri::Config c = phri::Config::from_yaml_file(kDemo);
+  EXPECT_EQ(c.source, kDemo);
+  // Robot files: resolved against configs/, and they exist.
+  for (const std::string& path : {c.controller.urdf_path, c.controller.actuators_path, c.controller.collision_path,
+                                  c.plant.mjcf_path, c.plant.actuators_path}) {
+    EXPECT_TRUE(std::filesystem::path(path).is_absolute()) << path;
+    EXPECT_TRUE(std::filesystem::is_regular_file(path)) << path;
+  }
+  EXPECT_EQ(std::filesystem::path(c.controller.urdf_path).filename(), "gen3.urdf");
+  ASSERT_EQ(c.controller.payloads.size(), 2u);
+  EXPECT_DOUBLE_EQ(c.controller.payloads[1].inertia.com.z(), 0.115);
+  // Plant: plant_gen3.yaml (initial posture, noise) + the overrides (mismatch, disturbances).
+  EXPECT_EQ(c.plant.dof(), 7);
+  EXPECT_NEAR(c.plant.initial_q_rad[3], -2.26892803, 1e-12);
+  EXPECT_DOUBLE_EQ(c.plant.noise.torque_sensor_std_Nm, 0.05);
+  EXPECT_TRUE(c.plant.mismatch.enabled);
+  EXPECT_EQ(c.plant.mismatch.seed, 7u);  // kept from the file: maps merge key by key
+  ASSERT_EQ(c.plant.disturbances.size(), 4u);
+  EXPECT_EQ(c.plant.disturbances[0].body, "forearm_link");
+  EXPECT_EQ(c.plant.disturbances[3].force_N.y(), 10.0);
+  // Controller.
+  EXPECT_DOUBLE_EQ(c.controller.observer_gain, 50.0);
+  EXPECT_EQ(c.controller.initial_compliance, phri::ComplianceMode::kNullSpace);
+  EXPECT_EQ(c.controller.initial_loop, phri::LowLevelLoop::kPosition);  // the start-up runs in Position
+  EXPECT_DOUBLE_EQ(c.controller.compliance.touch_threshold, 8.0);
+  EXPECT_DOUBLE_EQ(c.controller.qp.collision.safety_distance, 0.015);
+  EXPECT_DOUBLE_EQ(c.controller.qp.joint_influence_fraction, 0.1);
+  EXPECT_DOUBLE_EQ(c.controller.custom_torque.transfer_gain, 5.0);
+  // FSM and timeline.
+  EXPECT_EQ(c.fsm.torque_loop, phri::LowLevelLoop::kCustom);
+  EXPECT_EQ(c.fsm.first_scenario, phri::Scenario::kStatic);
+  EXPECT_EQ(c.fsm.static_scenario.posture_q_rad, phri::paper_posture_target());
+  EXPECT_DOUBLE_EQ(c.fsm.dynamic_scenario.vertical_angular_frequency_rad_s, 3.0);
+  EXPECT_FALSE(c.fsm.dynamic_scenario.compliance.has_value());
+  ASSERT_EQ(c.fsm.timeline.size(), 10u);
+  EXPECT_EQ(c.fsm.timeline.front().event, phri::Event::kFullBodyCompliance);
+  EXPECT_EQ(c.fsm.timeline.back().event, phri::Event::kStop);
+  for (std::size_t i = 1; i < c.fsm.timeline.size(); ++i) EXPECT_LE(c.fsm.timeline[i - 1].time_s, c.fsm.timeline[i].time_s);
+  // Logging, gamepad, run.
+  EXPECT_TRUE(c.logging_enabled);
+  EXPECT_EQ(c.logging.path, "phri_demo.csv");
+  EXPECT_EQ(c.logging.dof, 7);
+  EXPECT_TRUE(c.gamepad.enabled);
+  EXPECT_DOUBLE_EQ(c.gamepad.mapping.trigger_release, 0.3);
+  EXPECT_EQ(c.run.pacing, phri::LoopClock::Pacing::kRealTime);
+  EXPECT_GT(c.run.duration_s, 32.0);
+}
+
+TEST(Config, EveryDemoKeyIsCommented) {
+  // The reference file documents each key on its line (or, for list items, on the list's line).
+  std::istringstream in(read_file(kDemo));
+  std::string line;
+  int number = 0;
+  while (std::getline(in, line)) {
+    ++number;
+    const auto first = line.find_first_not_of(' ');
+    if (first == std::string::npos || line[first] == '#') continue;
+    if (line[first] == '-' ) continue;  // list items: documented by their list's comment
+    EXPECT_NE(line.find('#'), std::string::npos) << "demo.yaml:" << number << " has no comment: " << line;
+  }
+}
+
+TEST(Config, MinimalFileTakesTheDefaults) {
+  const std::string yaml =
+      "robot: {urdf: ../robots/kinova_gen3/gen3.urdf, actuators: ../robots/kinova_gen3/actuators.yaml}\n"
+      "plant: {file: plant_gen3.yaml}\n";
+  const phri::Config c = phri::Config::from_yaml_string(yaml, "minimal.yaml", kRoot + "/configs");
+  EXPECT_TRUE(c.controller.collision_path.empty());  // no collision key: no self-collision constraint
+  EXPECT_FALSE(c.plant.mismatch.enabled);
+  EXPECT_TRUE(c.fsm.timeline.empty());
+  EXPECT_DOUBLE_EQ(c.controller.observer_gain, phri::ControlCycleSettings{}.observer_gain);
+  EXPECT_EQ(c.controller.payloads.size(), 2u);
+  EXPECT_EQ(c.fsm.startup.home_q_rad, phri::paper_posture_target());
+}
+
+TEST(Config, InlinePlantResolvesItsPathsAgainstThisFile) {
+  std::string plant_file = read_file(kRoot + "/configs/plant_gen3.yaml");
+  // Indent the plant file's section under our own `plant:` key.
+  const std::string body = plant_file.substr(plant_file.find("plant:\n") + 7);
+  const std::string yaml =
+      "robot: {urdf: ../robots/kinova_gen3/gen3.urdf, actuators: ../robots/kinova_gen3/actuators.yaml}\n"
+      "plant:\n" + body;
+  const phri::Config c = phri::Config::from_yaml_string(yaml, "inline.yaml", kRoot + "/configs");
+  EXPECT_TRUE(std::filesystem::is_regular_file(c.plant.mjcf_path)) << c.plant.mjcf_path;
+  EXPECT_NEAR(c.plant.noise.torque_sensor_offset_Nm[0], 0.15, 1e-12);
+}
+
+TEST(Config, UnknownKeysNameTheirPath) {
+  expect_error("robot:                                   # the controller's",
+               "colour: red\nrobot:                                   # the controller's", "colour", "unknown key");
+  expect_error("    collision:                           # the same damper",
+               "    collision:\n      flavour: 1\n    # ", "controller.qp.collision.flavour", "unknown key");
+  expect_error("  seed: 1 ", "  colour: 1\n  seed: 1 ", "plant.colour", "unknown key");
+  expect_error("  - {at: 8.0, event: full_body_compliance}", "  - {at: 8.0, event: full_body_compliance, when: now}",
+               "events[0].when", "unknown key");
+}
+
+TEST(Config, WrongTypesNameTheirPath) {
+  expect_error("observer_gain: 50.0", "observer_gain: fast", "controller.observer_gain", "expected a number");
+  expect_error("  enabled: true                          # no pad", "  enabled: maybe  #", "gamepad.enabled",
+               "true or false");
+  expect_error("home_q_rad: [0.0, 0.58, 3.14, -1.84, 0.0, 0.85, 1.57]", "home_q_rad: 0.58", "fsm.startup.home_q_rad");
+  expect_error("initial_mode: null_space", "initial_mode: floppy", "controller.compliance.initial_mode", "one of");
+  expect_error("{at: 12.0, event: dual_compliance}", "{at: 12.0, event: double_compliance}", "events[1].event",
+               "unknown event");
+}
+
+TEST(Config, SectionOfTheWrongKind) {
+  const std::string head =
+      "robot: {urdf: ../robots/kinova_gen3/gen3.urdf, actuators: ../robots/kinova_gen3/actuators.yaml}\n"
+      "plant: {file: plant_gen3.yaml}\n";
+  for (const auto& [text, key] : {std::pair<std::string, std::string>{"controller: {compliance: 3}", "controller.compliance"},
+                                  {"events: {at: 1}", "events"},
+                                  {"fsm: [1, 2]", "fsm"}}) {
+    try {
+      phri::Config::from_yaml_string(head + text + "\n", "t.yaml", kRoot + "/configs");
+      ADD_FAILURE() << text;
+    } catch (const phri::ConfigError& e) {
+      EXPECT_EQ(e.element(), key) << e.what();
+    }
+  }
+}
+
+TEST(Config, OutOfRangeValuesNameTheirPath) {
+  expect_error("posture_damping: 9.0", "posture_damping: -9.0", "controller.compliance.posture_damping", "must be in");
+  expect_error("observer_gain: 50.0", "observer_gain: 0", "controller.observer_gain", "> 0");
+  expect_error("velocity_limit_fraction: 0.9", "velocity_limit_fraction: 1.5", "controller.qp.velocity_limit_fraction");
+  expect_error("      amortization: 1.8                  # [-] M >= 1 (overdamped)", "      amortization: 0.5",
+               "controller.qp.joint_limits.amortization");
+  expect_error("transfer_gain: 5.0", "transfer_gain: -1", "low_level.custom.transfer_gain");
+  expect_error("integral_limit_fraction: 0.05", "integral_limit_fraction: 2", "low_level.custom.integral_limit_fraction");
+  expect_error("stiffness_step: 1.25", "stiffness_step: 0.8", "fsm.stiffness_step");
+  expect_error("buffer_rows: 16384", "buffer_rows: 4", "logging.buffer_rows");
+  expect_error("{at: 32.0, event: stop}", "{at: 99.0, event: stop}", "events[9].at", "after the end of the run");
+  expect_error("{at: 8.0, event: full_body_compliance}", "{at: -1, event: full_body_compliance}", "events[0].at");
+  expect_error("torque_loop: custom", "torque_loop: position", "low_level.torque_loop", "one of");
+  expect_error("pacing: real_time", "pacing: leisurely", "run.pacing");
+  // ... inside the plant file's section, through the override.
+  expect_error("  seed: 1 ", "  noise: {torque_sensor_std_Nm: -1}\n  seed: 1 ", "plant.noise.torque_sensor_std_Nm");
+}
+
+TEST(Config, InconsistentPairsNameTheKeyThatMustChange) {
+  expect_error("safety_distance_m: 0.015", "safety_distance_m: 0.03", "controller.qp.collision.safety_distance_m",
+               "d_s < d_i");
+  expect_error("safety_fraction: 0.01", "safety_fraction: 0.2", "controller.qp.joint_limits.safety_fraction", "d_s < d_i");
+  expect_error("release_threshold: 4.0", "release_threshold: 8.0", "controller.compliance.release_threshold",
+               "touch_threshold");
+  expect_error("trigger_release: 0.3", "trigger_release: 0.6", "gamepad.trigger_release");
+  expect_error("horizontal_turn_acceleration_m_s2: 0.5", "horizontal_turn_acceleration_m_s2: 0.01",
+               "fsm.dynamic.horizontal_speed_m_s", "span");
+  expect_error("posture_q_rad: [0.0, 0.58, 3.14, -1.84, 0.0, 0.85, 1.57]", "posture_q_rad: [0.0, 0.58, 3.14]",
+               "fsm.static.posture_q_rad", "expected 7 numbers");
+  expect_error("period_s: 0.001", "period_s: 0.002", "controller.period_s", "plant");
+}
+
+TEST(Config, FilesAndSyntax) {
+  expect_error("urdf: ../robots/kinova_gen3/gen3.urdf", "urdf: ../robots/kinova_gen3/nothing.urdf", "robot.urdf",
+               "file not found");
+  expect_error("file: plant_gen3.yaml", "file: no_plant.yaml", "plant.file", "file not found");
+  expect_error("robot:                                   # the controller's model",
+               "robots:                                  # typo", "robots", "unknown key");
+  try {
+    phri::Config::from_yaml_string("robot: [unclosed", "broken.yaml", kRoot + "/configs");
+    ADD_FAILURE();
+  } catch (const phri::ConfigError& e) {
+    EXPECT_EQ(e.file(), "broken.yaml");
+    EXPECT_NE(std::string(e.what()).find("invalid YAML"), std::string::npos);
+  }
+  EXPECT_THROW(phri::Config::from_yaml_file(kRoot + "/configs/absent.yaml"), phri::ConfigError);
+  // A missing required section.
+  try {
+    phri::Config::from_yaml_string("plant: {file: plant_gen3.yaml}\n", "t.yaml", kRoot + "/configs");
+    ADD_FAILURE();
+  } catch (const phri::ConfigError& e) {
+    EXPECT_EQ(e.element(), "robot");
+  }
+}
+
+}  // namespace
