@@ -1,9 +1,14 @@
 // phri: the command-line entry point.
+//   phri run --config FILE [--lockstep|--realtime] [--duration S] [--out DIR]
+//                                              a session: simulated arm, FSM, gamepad, log, figure
 //   phri info --urdf FILE                      model summary of a robot description
 //   phri identify-friction [options]           the paper's friction identification (simulated arm)
 //   phri experiment torque-tracking [options]  the paper's torque-tracking comparison
 // Every bad argument or file gives one line naming what is wrong and a non-zero exit status.
+#include <phri/app/config.hpp>
+#include <phri/app/run_session.hpp>
 #include <phri/core/config_error.hpp>
+#include <phri/robot/sim_robot.hpp>
 #include <phri/core/version.hpp>
 #include <phri/experiments/friction_identification.hpp>
 #include <phri/experiments/torque_tracking.hpp>
@@ -13,7 +18,11 @@
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <iostream>
+#include <memory>
+#include <optional>
 #include <string>
 
 namespace {
@@ -57,12 +66,90 @@ std::string locate(const std::string& relative) {
   return std::string(PHRI_SOURCE_DIR) + "/" + relative;
 }
 
+struct RunArguments {
+  std::string config_path;
+  bool lockstep = false;
+  bool real_time = false;
+  double duration_s = -1.0;
+  std::string out_dir = "out";
+  bool figure = true;
+};
+
+// `phri run`: loads the configuration, runs the session, writes the log, summary and figure.
+int run_command(const RunArguments& args) {
+  phri::Config config = phri::Config::from_yaml_file(args.config_path);
+  if (args.lockstep) config.run.pacing = phri::LoopClock::Pacing::kLockstep;
+  if (args.real_time) config.run.pacing = phri::LoopClock::Pacing::kRealTime;
+  if (args.duration_s > 0.0) config.run.duration_s = args.duration_s;
+  std::error_code ec;
+  std::filesystem::create_directories(args.out_dir, ec);
+  if (ec) throw phri::ConfigError(args.out_dir, "--out", "cannot create the folder: " + ec.message());
+  const std::filesystem::path out(args.out_dir);
+  config.logging.path = (out / std::filesystem::path(config.logging.path).filename()).string();
+
+  std::printf("phri run: %s, %.1f s, %s\n", args.config_path.c_str(), config.run.duration_s,
+              config.run.pacing == phri::LoopClock::Pacing::kLockstep ? "lockstep" : "real time");
+  phri::SimRobot robot(config.plant);
+  phri::ControlCycle cycle(config.controller);
+  phri::Fsm fsm(config.fsm, cycle);
+  std::unique_ptr<phri::Gamepad> gamepad;
+  if (config.gamepad.enabled) {
+    gamepad = std::make_unique<phri::Gamepad>(config.gamepad);
+    gamepad->start();
+  }
+  std::optional<phri::Logger> logger;
+  if (config.logging_enabled) logger.emplace(config.logging);
+
+  phri::RunOptions options;
+  options.duration_s = config.run.duration_s;
+  options.real_time = config.run.pacing == phri::LoopClock::Pacing::kRealTime;
+  options.phases.push_back({0.0, "startup"});
+  for (const phri::TimedEvent& e : config.fsm.timeline) options.phases.push_back({e.time_s, std::string(phri::to_string(e.event))});
+  const phri::RunSummary summary = phri::run_session(robot, cycle, fsm, gamepad.get(), logger ? &*logger : nullptr, options, std::cout);
+  if (gamepad) gamepad->stop();
+  std::printf("\n");
+  phri::print_run_summary(summary, std::cout);
+  {
+    std::ofstream md(out / "summary.md");
+    md << "# phri run: " << args.config_path << "\n\n";
+    phri::print_run_summary(summary, md);
+  }
+  std::printf("\nwrote %s\n", (out / "summary.md").c_str());
+  if (logger) {
+    const phri::LoggerStats stats = logger->close();
+    std::printf("%s\n", logger->summary().c_str());
+    if (stats.dropped > 0 || stats.write_error) std::fprintf(stderr, "phri: warning: log incomplete\n");
+    const std::string script = locate("tools/report/demo_figure.py");
+    const std::string png = (out / "demo.png").string();
+    if (args.figure && std::filesystem::exists("/usr/bin/python3") && std::filesystem::exists(script)) {
+      const std::string command = "/usr/bin/python3 '" + script + "' '" + logger->path() + "' '" + png + "' --touch " +
+                                  std::to_string(config.controller.compliance.touch_threshold) + " --release " +
+                                  std::to_string(config.controller.compliance.release_threshold);
+      if (std::system(command.c_str()) != 0) std::fprintf(stderr, "phri: warning: the figure script failed\n");
+    } else if (args.figure) {
+      std::printf("no figure: /usr/bin/python3 or %s missing\n", script.c_str());
+    }
+  }
+  return summary.safe_hold ? 3 : 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"phri: control framework for physical human-robot interaction"};
   app.set_version_flag("--version", std::string("phri ") + phri::version());
   app.require_subcommand(1);
+
+  RunArguments run_args;
+  auto* run = app.add_subcommand("run", "Run a session on the simulated arm from one configuration file");
+  run->add_option("--config", run_args.config_path, "configuration YAML (e.g. configs/demo.yaml)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  auto* lockstep = run->add_flag("--lockstep", run_args.lockstep, "as fast as possible (same code path)");
+  run->add_flag("--realtime", run_args.real_time, "paced by the 1 ms real-time clock")->excludes(lockstep);
+  run->add_option("--duration", run_args.duration_s, "robot time to run [s]")->check(CLI::Range(0.001, 86400.0));
+  run->add_option("--out", run_args.out_dir, "output folder (log, summary, figure)")->capture_default_str();
+  run->add_flag("!--no-figure", run_args.figure, "skip the figure");
 
   auto* info = app.add_subcommand("info", "Load a robot description and print a summary of its model");
   std::string urdf_path, tip, frame;
@@ -101,6 +188,7 @@ int main(int argc, char** argv) {
     return app.exit(e);
   }
   try {
+    if (run->parsed()) return run_command(run_args);
     if (info->parsed()) return print_model_summary(urdf_path, tip, frame);
     if (identify->parsed() || friction_alias->parsed()) {
       for (std::string* path : {&friction.plant_config_path, &friction.urdf_path, &friction.figure_script}) {

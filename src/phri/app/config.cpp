@@ -15,8 +15,10 @@ constexpr double kHuge = 1e9;
 
 std::string resolve(const std::string& base_dir, const std::string& file) {
   const std::filesystem::path p(file);
-  if (p.is_absolute() || base_dir.empty()) return p.lexically_normal().string();
-  return (std::filesystem::path(base_dir) / p).lexically_normal().string();
+  // Absolute, so that a second resolution (the plant's own loader, against its base folder)
+  // cannot prefix it again when the configuration was named by a relative path.
+  if (p.is_absolute()) return p.lexically_normal().string();
+  return std::filesystem::absolute(std::filesystem::path(base_dir) / p).lexically_normal().string();
 }
 
 // An input file named under `key`, relative to base_dir; it must exist. Empty text: "" when

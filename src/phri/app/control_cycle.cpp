@@ -137,7 +137,13 @@ CycleStatus ControlCycle::step(const RobotState& state, RobotCommand& command) {
     compliance_.set_mode(*pending_mode_, qp_, data_);
     pending_mode_.reset();
   }
-  compliance_.update(wrench_.calibrated() ? wrench_.norm() : 0.0, qp_, data_);
+  // The trigger sees the wrench norm through a short low-pass (settings.wrench_trigger_filter_s):
+  // single-sample spikes of the F/T signal (tool inertia during stick-slip jolts, noise) must not
+  // free the end effector for a few milliseconds.
+  const double raw_norm = wrench_.calibrated() ? wrench_.norm() : 0.0;
+  const double alpha = dt / (settings_.wrench_trigger_filter_s + dt);
+  trigger_wrench_norm_ += alpha * (raw_norm - trigger_wrench_norm_);
+  compliance_.update(trigger_wrench_norm_, qp_, data_);
 
   // ---- QP and inverse dynamics. Under the robot's position loop the external torque is not fed
   // back: the stiff servo rejects it and the observer would only see servo effort.

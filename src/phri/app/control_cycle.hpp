@@ -70,6 +70,8 @@ public:
   long held_cycles() const { return held_cycles_; }
   const ControlCycleSettings& settings() const { return settings_; }
   bool started() const { return started_; }
+  /// The wrench norm the dual-compliance trigger sees (low-passed).
+  double trigger_wrench_norm() const { return trigger_wrench_norm_; }
 
 private:
   static Model load_model(const ControlCycleSettings& settings);
@@ -96,6 +98,7 @@ private:
   std::optional<ComplianceMode> pending_mode_;
   CycleStatus status_ = CycleStatus::kOk;
   long held_cycles_ = 0;
+  double trigger_wrench_norm_ = 0.0;
 };
 
 }  // namespace phri

@@ -48,6 +48,9 @@ struct ControlCycleSettings {
   double deadband_large_Nm = 1.0;
   double deadband_small_Nm = 0.4;
   ComplianceSettings compliance;
+  /// Time constant of the low-pass on the wrench norm that drives the dual-compliance trigger [s]
+  /// (0: none). A hand's push builds up over tens of milliseconds; 10 ms rejects one-sample spikes.
+  double wrench_trigger_filter_s = 0.01;
   WrenchEstimatorSettings wrench;
   CustomTorqueSettings custom_torque;
   ComplianceMode initial_compliance = ComplianceMode::kNullSpace;
