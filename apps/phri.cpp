@@ -139,6 +139,8 @@ int main(int argc, char** argv) {
   CLI::App app{"phri: control framework for physical human-robot interaction"};
   app.set_version_flag("--version", std::string("phri ") + phri::version());
   app.require_subcommand(1);
+  // One line per error, naming what is wrong.
+  app.failure_message([](const CLI::App*, const CLI::Error& e) { return std::string("phri: error: ") + e.what() + "\n"; });
 
   RunArguments run_args;
   auto* run = app.add_subcommand("run", "Run a session on the simulated arm from one configuration file");
