@@ -165,10 +165,20 @@ phri::ExternalForce push(const std::string& body, const Eigen::Vector3d& force, 
   return f;
 }
 
+// Files of this test process, in a folder removed when the process ends.
+struct TempDir {
+  std::filesystem::path path =
+      std::filesystem::temp_directory_path() / ("phri_test_fsm_" + std::to_string(::getpid()));
+  TempDir() { std::filesystem::create_directories(path); }
+  ~TempDir() {
+    std::error_code ignored;
+    std::filesystem::remove_all(path, ignored);
+  }
+};
+
 std::string temp_path(const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() / ("phri_test_fsm_" + std::to_string(::getpid()));
-  std::filesystem::create_directories(dir);
-  return (dir / name).string();
+  static TempDir dir;
+  return (dir.path / name).string();
 }
 
 // A 24 s session from a timeline, as configs/demo.yaml scripts one: start-up, dual compliance and a

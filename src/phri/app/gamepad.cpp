@@ -141,11 +141,15 @@ bool SdlGamepadSource::open() {
 }
 
 void SdlGamepadSource::close() {
-  if (!opened_) return;
-  for (Controller& c : controllers_) SDL_GameControllerClose(static_cast<SDL_GameController*>(c.handle));
-  controllers_.clear();
-  SDL_QuitSubSystem(kSubsystems);
-  opened_ = false;
+  if (opened_) {
+    for (Controller& c : controllers_) SDL_GameControllerClose(static_cast<SDL_GameController*>(c.handle));
+    controllers_.clear();
+    SDL_QuitSubSystem(kSubsystems);
+    opened_ = false;
+  }
+  // SDL keeps per-thread data (its error message buffer) that a thread it did not create would
+  // leak on exit; this frees the calling thread's.
+  SDL_TLSCleanup();
 }
 
 bool SdlGamepadSource::poll(GamepadInput& out) {
@@ -261,13 +265,12 @@ void Gamepad::start() {
   if (running_.exchange(true)) return;
   thread_ = std::thread([this] {
     open_source();
-    if (!available()) return;  // nothing will ever come
     const auto period = std::chrono::milliseconds(settings_.poll_interval_ms);
-    while (running_.load(std::memory_order_relaxed)) {
+    while (available() && running_.load(std::memory_order_relaxed)) {  // unavailable: nothing will ever come
       drain_source();
       std::this_thread::sleep_for(period);
     }
-    source_->close();
+    source_->close();  // in the thread that opened it
   });
 }
 

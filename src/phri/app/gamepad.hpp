@@ -98,7 +98,7 @@ private:
 
 /// SDL2 GameController input. open() initialises SDL's events and game-controller subsystems
 /// (reference counted: SDL_InitSubSystem / SDL_QuitSubSystem) in the calling thread, which must
-/// then be the only one to poll and close.
+/// then be the only one to poll and close (close() also frees SDL's data for that thread).
 class SdlGamepadSource final : public GamepadSource {
 public:
   SdlGamepadSource() = default;

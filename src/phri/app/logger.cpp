@@ -6,6 +6,7 @@
 #include <phri/core/config_error.hpp>
 #include <phri/qp/qp_status.hpp>
 
+#include <cerrno>
 #include <charconv>
 #include <chrono>
 #include <cstring>
