@@ -73,6 +73,7 @@ TEST(Config, LoadsTheDemo) {
   EXPECT_EQ(c.controller.initial_compliance, phri::ComplianceMode::kNullSpace);
   EXPECT_EQ(c.controller.initial_loop, phri::LowLevelLoop::kPosition);  // the start-up runs in Position
   EXPECT_DOUBLE_EQ(c.controller.compliance.touch_threshold, 8.0);
+  EXPECT_DOUBLE_EQ(c.controller.wrench_trigger_filter_s, 0.01);
   EXPECT_DOUBLE_EQ(c.controller.qp.collision.safety_distance, 0.015);
   EXPECT_DOUBLE_EQ(c.controller.qp.joint_influence_fraction, 0.1);
   EXPECT_DOUBLE_EQ(c.controller.custom_torque.transfer_gain, 5.0);
@@ -108,6 +109,23 @@ TEST(Config, EveryDemoKeyIsCommented) {
     if (line[first] == '-' ) continue;  // list items: documented by their list's comment
     EXPECT_NE(line.find('#'), std::string::npos) << "demo.yaml:" << number << " has no comment: " << line;
   }
+}
+
+// Named by a path relative to the working directory, as `phri run --config configs/demo.yaml`
+// does: every input file (the plant's too, resolved twice: here and by the plant's loader) exists.
+TEST(Config, RelativeConfigPathFromTheWorkingDirectory) {
+  const std::filesystem::path before = std::filesystem::current_path();
+  std::filesystem::current_path(kRoot);
+  try {
+    const phri::Config c = phri::Config::from_yaml_file("configs/demo.yaml");
+    for (const std::string& path : {c.controller.urdf_path, c.controller.actuators_path, c.controller.collision_path,
+                                    c.plant.mjcf_path, c.plant.actuators_path}) {
+      EXPECT_TRUE(std::filesystem::is_regular_file(path)) << path;
+    }
+  } catch (const phri::ConfigError& e) {
+    ADD_FAILURE() << e.what();
+  }
+  std::filesystem::current_path(before);
 }
 
 TEST(Config, MinimalFileTakesTheDefaults) {
@@ -178,6 +196,7 @@ TEST(Config, OutOfRangeValuesNameTheirPath) {
   expect_error("      amortization: 1.8                  # [-] M >= 1 (overdamped)", "      amortization: 0.5",
                "controller.qp.joint_limits.amortization");
   expect_error("transfer_gain: 5.0", "transfer_gain: -1", "low_level.custom.transfer_gain");
+  expect_error("trigger_filter_s: 0.01", "trigger_filter_s: -0.01", "controller.compliance.trigger_filter_s");
   expect_error("integral_limit_fraction: 0.05", "integral_limit_fraction: 2", "low_level.custom.integral_limit_fraction");
   expect_error("stiffness_step: 1.25", "stiffness_step: 0.8", "fsm.stiffness_step");
   expect_error("buffer_rows: 16384", "buffer_rows: 4", "logging.buffer_rows");

@@ -163,7 +163,8 @@ void parse_controller(const YamlReader& r, int dof, ControlCycleSettings& c) {
     const YamlReader m = r.at("compliance");
     m.allow_keys({"initial_mode", "ee_position_stiffness", "ee_orientation_stiffness", "ee_weight",
                   "full_body_ee_stiffness", "posture_stiffness", "posture_damping", "posture_weight",
-                  "touch_threshold", "release_threshold", "touched_ee_damping", "touched_posture_damping"});
+                  "touch_threshold", "release_threshold", "touched_ee_damping", "touched_posture_damping",
+                  "trigger_filter_s"});
     ComplianceSettings& s = c.compliance;
     if (m.has("initial_mode")) c.initial_compliance = compliance_mode(m, "initial_mode");
     s.ee_position_stiffness = non_negative_or(m, "ee_position_stiffness", s.ee_position_stiffness, 1e5);
@@ -177,6 +178,7 @@ void parse_controller(const YamlReader& r, int dof, ControlCycleSettings& c) {
     s.release_threshold = non_negative_or(m, "release_threshold", s.release_threshold, 1e4);
     s.touched_ee_damping = non_negative_or(m, "touched_ee_damping", s.touched_ee_damping, 1e4);
     s.touched_posture_damping = non_negative_or(m, "touched_posture_damping", s.touched_posture_damping, 1e4);
+    c.wrench_trigger_filter_s = non_negative_or(m, "trigger_filter_s", c.wrench_trigger_filter_s, 1.0);
     if (!(s.release_threshold < s.touch_threshold)) {
       throw m.error("release_threshold", "must be below touch_threshold (the Schmitt trigger's hysteresis)");
     }
