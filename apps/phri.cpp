@@ -180,6 +180,10 @@ int main(int argc, char** argv) {
   tracking->add_option("--static-s", torque.static_duration_s, "static scenario duration")->check(CLI::Range(1.0, 600.0));
   tracking->add_option("--dynamic-s", torque.dynamic_duration_s, "dynamic scenario duration")->check(CLI::Range(1.0, 600.0));
   tracking->add_option("--plant", torque.plant_config_path, "plant configuration")->check(CLI::ExistingFile);
+  bool static_ft = false;
+  tracking->add_flag("--static-ft", static_ft,
+                     "static scenario as in the paper: the weight is hung after the switch and compensated through the "
+                     "F/T sensor (J^T F), not the joint-torque observer");
   auto* friction_alias = experiment->add_subcommand("friction-identification", "Same as 'phri identify-friction'");
   friction_alias->add_option("--out", friction.output_dir, "output folder");
   friction_alias->add_option("--seed", friction.seed, "seed");
@@ -199,6 +203,10 @@ int main(int argc, char** argv) {
       return phri::run_friction_identification_command(friction, std::cout);
     }
     if (tracking->parsed()) {
+      if (static_ft) {
+        torque.static_external_torque = phri::ExternalTorqueSource::kForceTorqueSensor;
+        torque.payload_mode = phri::PayloadMode::kHungAfterSwitch;
+      }
       for (std::string* path : {&torque.plant_config_path, &torque.urdf_path, &torque.actuators_path,
                                 &torque.collision_path, &torque.figure_script}) {
         *path = locate(*path);

@@ -360,4 +360,35 @@ TEST(SimControl, LowLevelLoopSwitchesBetweenEveryPairWhileMoving) {
   EXPECT_LT(worst_tracking, 0.015);
 }
 
+TEST(SimControl, ExternalTorqueSourcesAgreeOnAPushOnTheTool) {
+  // A steady 10 N push on the tool: the observer (joint torque sensors), the F/T sensor (J^T F) and
+  // the paper's complementary fusion must all find J^T F of the push, within the sensors' errors.
+  const Eigen::Vector3d force(6.0, -5.0, 6.0);
+  double errors[3] = {0, 0, 0};
+  double reference_norm = 0.0;
+  int index = 0;
+  for (phri::ExternalTorqueSource source : {phri::ExternalTorqueSource::kObserver, phri::ExternalTorqueSource::kForceTorqueSensor,
+                                            phri::ExternalTorqueSource::kFused}) {
+    phri::SimRobotConfig config = Rig::make_config({push("tool", Eigen::Vector3d(0, 0, 0), force, 1.0, 5.0)});
+    phri::SimRobot robot(config);
+    phri::ControlCycleSettings settings = Rig::make_settings(phri::ComplianceMode::kStiff, phri::LowLevelLoop::kCustom);
+    settings.external_torque_source = source;
+    phri::ControlCycle cycle(settings);
+    phri::RobotCommand command(7);
+    for (int k = 0; k < 3000; ++k) {
+      cycle.step(robot.read(), command);
+      robot.write(command);
+    }
+    // J^T F at the tool origin (the F/T frame) on the controller's model, the arm at rest.
+    Eigen::MatrixXd jacobian(6, 7);
+    phri::frame_jacobian(cycle.model(), cycle.data(), cycle.sensor_frame(), phri::ReferenceFrame::kLocalWorldAligned, jacobian);
+    const Eigen::VectorXd expected = jacobian.topRows<3>().transpose() * force;
+    reference_norm = expected.norm();
+    errors[index++] = (cycle.external_torque() - expected).norm();
+  }
+  std::printf("external torque of a 10 N push on the tool (|J^T F| = %.2f N.m): error observer %.3f, F/T %.3f, fused %.3f N.m\n",
+              reference_norm, errors[0], errors[1], errors[2]);
+  for (double e : errors) EXPECT_LT(e, 0.2 * reference_norm);
+}
+
 }  // namespace

@@ -3,6 +3,8 @@
 #include <phri/core/config_error.hpp>
 #include <phri/model/algorithms.hpp>
 
+#include <cmath>
+
 namespace phri {
 
 Model ControlCycle::load_model(const ControlCycleSettings& settings) {
@@ -79,7 +81,11 @@ ControlCycle::ControlCycle(const ControlCycleSettings& settings)
       sensor_frame_(model_.frame_id("ft_sensor")),
       q_(Eigen::VectorXd::Zero(model_.nq())),
       qd_(Eigen::VectorXd::Zero(model_.nv())),
-      zero_torque_(Eigen::VectorXd::Zero(model_.nv())) {
+      zero_torque_(Eigen::VectorXd::Zero(model_.nv())),
+      ee_jacobian_(Eigen::MatrixXd::Zero(6, model_.nv())),
+      ft_torque_(Eigen::VectorXd::Zero(model_.nv())),
+      ft_torque_low_(Eigen::VectorXd::Zero(model_.nv())),
+      tau_ext_(Eigen::VectorXd::Zero(model_.nv())) {
   if (!(settings.period_s > 0)) throw ConfigError("ControlCycleSettings", "period_s", "must be > 0");
   if (!(settings.observer_gain > 0)) throw ConfigError("ControlCycleSettings", "observer_gain", "must be > 0");
 }
@@ -148,8 +154,22 @@ CycleStatus ControlCycle::step(const RobotState& state, RobotCommand& command) {
   // ---- QP and inverse dynamics. Under the robot's position loop the external torque is not fed
   // back: the stiff servo rejects it and the observer would only see servo effort.
   const bool torque_loop = low_level_.requested() != LowLevelLoop::kPosition;
-  const ControllerStatus qp_status =
-      qp_.update(model_, data_, q_, qd_, torque_loop ? observer_.external_torque() : zero_torque_, dt);
+  if (settings_.external_torque_source == ExternalTorqueSource::kObserver) {
+    tau_ext_ = observer_.external_torque();
+  } else {
+    // J^T of the operator's wrench at the end effector (world axes, about its origin).
+    frame_jacobian(model_, data_, end_effector_frame_, ReferenceFrame::kLocalWorldAligned, ee_jacobian_);
+    ft_torque_.noalias() = ee_jacobian_.transpose() * wrench_.wrench_world();
+    if (settings_.external_torque_source == ExternalTorqueSource::kForceTorqueSensor) {
+      tau_ext_ = ft_torque_;
+    } else {
+      // Complementary filter: the F/T's fast part on top of the observer's (pole K_O).
+      ft_torque_low_ += (1.0 - std::exp(-settings_.observer_gain * dt)) * (ft_torque_ - ft_torque_low_);
+      tau_ext_ = observer_.external_torque() + ft_torque_ - ft_torque_low_;
+    }
+  }
+  if (!torque_loop) tau_ext_.setZero();
+  const ControllerStatus qp_status = qp_.update(model_, data_, q_, qd_, tau_ext_, dt);
 
   // ---- low level
   low_level_.update(state, qp_.desired_torque(), qp_.desired_acceleration(), command);

@@ -61,6 +61,8 @@ public:
   const WholeBodyQp& qp() const { return qp_; }
   const ComplianceController& compliance() const { return compliance_; }
   const MomentumObserver& observer() const { return observer_; }
+  /// The external joint torque the QP used in the last step (see ExternalTorqueSource).
+  const Eigen::VectorXd& external_torque() const { return tau_ext_; }
   const WrenchEstimator& wrench() const { return wrench_; }
   const LowLevelController& low_level() const { return low_level_; }
   const ActuatorTable& actuators() const { return actuators_; }
@@ -99,6 +101,8 @@ private:
   CycleStatus status_ = CycleStatus::kOk;
   long held_cycles_ = 0;
   double trigger_wrench_norm_ = 0.0;
+  Eigen::MatrixXd ee_jacobian_;              // 6 x nv, for J^T F
+  Eigen::VectorXd ft_torque_, ft_torque_low_, tau_ext_;
 };
 
 }  // namespace phri

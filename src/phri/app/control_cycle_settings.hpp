@@ -15,6 +15,14 @@
 
 namespace phri {
 
+/// Where the external joint torque of the QP (and of tau_d = M qdd + h - tau_ext) comes from.
+enum class ExternalTorqueSource {
+  kObserver,          ///< the momentum observer on the joint torque sensors (default)
+  kForceTorqueSensor, ///< J_ee^T of the F/T sensor's operator wrench only (the paper's static
+                      ///< torque-tracking experiment: "the weight measured by the F/T sensor is compensated")
+  kFused,             ///< the paper's code: observer + high-pass of J^T F/T (complementary filter, pole K_O)
+};
+
 struct ControlCycleSettings {
   std::string urdf_path;       ///< the controller's (link-side) model
   std::string actuators_path;  ///< actuators.yaml: limits, rotor inertia, friction model
@@ -42,6 +50,7 @@ struct ControlCycleSettings {
   /// faster, which the stiff tasks need to hold the end effector within millimetres, at the cost
   /// of 5x more torque-sensor noise in tau_ext (about 0.05 N.m rms with the plant's sensor noise).
   double observer_gain = 50.0;
+  ExternalTorqueSource external_torque_source = ExternalTorqueSource::kObserver;
   WholeBodyQpSettings qp;  ///< torque/velocity limits default to actuators.yaml's
   /// Dead band of tau_ext in the compliant tasks when qp.compliance_deadband is empty, by actuator
   /// size [N.m]: above the estimate's bias (5 % mismatch, sensor offsets), far below a push.

@@ -103,7 +103,8 @@ std::string controller_actuators(const TorqueTrackingOptions& o) {
   return path;
 }
 
-ControlCycleSettings cycle_settings(const TorqueTrackingOptions& o, ComplianceMode mode, const std::string& actuators) {
+ControlCycleSettings cycle_settings(const TorqueTrackingOptions& o, TrackingScenario scenario, ComplianceMode mode,
+                                   const std::string& actuators) {
   ControlCycleSettings s;
   s.urdf_path = o.urdf_path;
   s.actuators_path = actuators;
@@ -111,6 +112,7 @@ ControlCycleSettings cycle_settings(const TorqueTrackingOptions& o, ComplianceMo
   s.initial_compliance = mode;
   s.initial_loop = LowLevelLoop::kPosition;
   s.custom_torque = o.custom_torque;
+  if (scenario == TrackingScenario::kStatic) s.external_torque_source = o.static_external_torque;
   return s;
 }
 
@@ -166,7 +168,7 @@ TorqueTrackingRun run_one(const TorqueTrackingOptions& o, TrackingScenario scena
                           const std::string& actuators, std::ostream* progress, double& simulated) {
   const ComplianceMode mode = scenario == TrackingScenario::kStatic ? o.static_compliance : o.dynamic_compliance;
   SimRobot robot(plant_config(o, scenario));
-  ControlCycle cycle(cycle_settings(o, mode, actuators));
+  ControlCycle cycle(cycle_settings(o, scenario, mode, actuators));
   const int n = robot.dof();
   RobotCommand command(n);
   Data truth_data(cycle.model());  // FK of the plant's true joint angles (same kinematics)

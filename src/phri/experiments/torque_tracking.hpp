@@ -33,6 +33,7 @@
 // switching: a joint sliding slower than the velocity threshold gets static sign(qdd_d) or nothing
 // depending on whether |qdd_d| crosses the acceleration threshold, which noise makes chatter
 // (friction_velocity_threshold_rad_s lets a run try other thresholds).
+#include <phri/app/control_cycle_settings.hpp>
 #include <phri/control/compliance_mode.hpp>
 #include <phri/lowlevel/custom_torque_controller.hpp>
 #include <phri/lowlevel/low_level_controller.hpp>
@@ -95,6 +96,11 @@ struct TorqueTrackingOptions {
   double triangle_max_m = 0.05;
   double trajectory_delay_s = 0.5;  ///< after the switch, before the trajectory starts
   double fade_in_s = 1.0;           ///< the sine's amplitude rises smoothly over this time
+
+  /// External torque of the static scenario's controller: the observer (default), or, as in the
+  /// paper's static experiment, the F/T sensor only (use with PayloadMode::kHungAfterSwitch so the
+  /// sensor, zeroed without the weight, measures it).
+  ExternalTorqueSource static_external_torque = ExternalTorqueSource::kObserver;
 
   // ---- the custom loop's gains (lambda, K_I, theta, ...)
   CustomTorqueSettings custom_torque;
