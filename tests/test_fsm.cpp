@@ -16,6 +16,9 @@
 
 #include "allocation_counter.hpp"
 
+#include "hand_push.hpp"
+#include "temp_dir.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -26,6 +29,8 @@
 #include <vector>
 
 namespace {
+
+std::string temp_path(const std::string& name) { return phri::test::temp_path("phri_test_fsm", name); }
 
 const std::string kRoot = PHRI_SOURCE_DIR;
 
@@ -154,32 +159,10 @@ TEST(Fsm, StartupMovesHomeInPositionThenHandsOverToTheTorqueLoopWithoutAJump) {
 }
 
 phri::ExternalForce push(const std::string& body, const Eigen::Vector3d& force, double start, double duration) {
-  phri::ExternalForce f;
-  f.body = body;
-  f.point_m = body == "tool" ? Eigen::Vector3d(0, 0, 0.05) : Eigen::Vector3d::Zero();
-  f.force_N = force;
-  f.profile = phri::ExternalForce::Profile::kRamp;  // a hand: 50 ms rise, hold, release
-  f.rise_s = 0.05;
-  f.start_s = start;
-  f.duration_s = duration;
-  return f;
+  return phri::test::hand_push(body, body == "tool" ? Eigen::Vector3d(0, 0, 0.05) : Eigen::Vector3d::Zero(), force, start,
+                               duration);
 }
 
-// Files of this test process, in a folder removed when the process ends.
-struct TempDir {
-  std::filesystem::path path =
-      std::filesystem::temp_directory_path() / ("phri_test_fsm_" + std::to_string(::getpid()));
-  TempDir() { std::filesystem::create_directories(path); }
-  ~TempDir() {
-    std::error_code ignored;
-    std::filesystem::remove_all(path, ignored);
-  }
-};
-
-std::string temp_path(const std::string& name) {
-  static TempDir dir;
-  return (dir.path / name).string();
-}
 
 // A 24 s session from a timeline, as configs/demo.yaml scripts one: start-up, dual compliance and a
 // hand guiding the end effector, back to the static pose, the dynamic scenario, live loop switches

@@ -10,6 +10,8 @@
 
 #include "allocation_counter.hpp"
 
+#include "temp_dir.hpp"
+
 #include <gtest/gtest.h>
 
 #include <charconv>
@@ -26,21 +28,8 @@
 
 namespace {
 
-// Files of this test process, in a folder removed when the process ends.
-struct TempDir {
-  std::filesystem::path path =
-      std::filesystem::temp_directory_path() / ("phri_test_logger_" + std::to_string(::getpid()));
-  TempDir() { std::filesystem::create_directories(path); }
-  ~TempDir() {
-    std::error_code ignored;
-    std::filesystem::remove_all(path, ignored);
-  }
-};
+std::string temp_path(const std::string& name) { return phri::test::temp_path("phri_test_logger", name); }
 
-std::string temp_path(const std::string& name) {
-  static TempDir dir;
-  return (dir.path / name).string();
-}
 
 std::vector<std::string> split(const std::string& line) {
   std::vector<std::string> out;

@@ -9,6 +9,7 @@
 #include <phri/robot/sim_robot.hpp>
 
 #include "allocation_counter.hpp"
+#include "hand_push.hpp"
 
 #include <gtest/gtest.h>
 
@@ -19,18 +20,8 @@ namespace {
 
 const std::string kRoot = PHRI_SOURCE_DIR;
 
-phri::ExternalForce push(const std::string& body, const Eigen::Vector3d& point, const Eigen::Vector3d& force,
-                         double start, double duration) {
-  phri::ExternalForce f;
-  f.body = body;
-  f.point_m = point;
-  f.force_N = force;
-  f.profile = phri::ExternalForce::Profile::kRamp;  // a hand: 50 ms rise, hold, release
-  f.rise_s = 0.05;
-  f.start_s = start;
-  f.duration_s = duration;
-  return f;
-}
+using phri::test::hand_push;
+const auto& push = hand_push;  // a hand: 50 ms rise, hold, release
 
 class Rig {
 public:

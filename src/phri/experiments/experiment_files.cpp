@@ -49,6 +49,16 @@ std::string shell_quote(const std::string& s) {
 }
 }  // namespace
 
+void report_files_and_figure(const std::vector<std::string>& files, const std::string& output_dir,
+                             const std::string& figure_script, const std::string& figure_name, std::ostream& out) {
+  for (const std::string& f : files) out << "wrote " << f << "\n";
+  if (!output_dir.empty() && !figure_script.empty()) {
+    const std::string png = output_path(output_dir, figure_name);
+    if (run_figure_script(figure_script, {output_dir, png}, out)) out << "wrote " << png << "\n";
+  }
+  out.flush();
+}
+
 bool run_figure_script(const std::string& script, const std::vector<std::string>& args, std::ostream& out) {
   if (script.empty()) return false;
   if (!std::filesystem::exists(kSystemPython)) {

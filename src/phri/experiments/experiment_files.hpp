@@ -27,6 +27,11 @@ inline constexpr const char* kSystemPython = "/usr/bin/python3";
 /// script or the interpreter is missing or the script failed. Never throws.
 bool run_figure_script(const std::string& script, const std::vector<std::string>& args, std::ostream& out);
 
+/// The end of an experiment command: lists the files written and, when both an output folder and a
+/// figure script are set, draws `figure_name` (a PNG in output_dir) from the CSVs there.
+void report_files_and_figure(const std::vector<std::string>& files, const std::string& output_dir,
+                             const std::string& figure_script, const std::string& figure_name, std::ostream& out);
+
 /// Formats a double with `digits` decimals ("%.*f"), for tables and CSV.
 std::string format_fixed(double value, int digits);
 

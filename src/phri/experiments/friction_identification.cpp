@@ -528,12 +528,7 @@ int run_friction_identification_command(const FrictionIdentificationOptions& opt
     out << std::endl;
     const FrictionIdentificationResult r = identify_friction(options, &out);
     out << "\n" << friction_identification_table(r);
-    for (const std::string& f : r.files) out << "wrote " << f << "\n";
-    if (!options.output_dir.empty() && !options.figure_script.empty()) {
-      const std::string png = output_path(options.output_dir, "friction_identification.png");
-      if (run_figure_script(options.figure_script, {options.output_dir, png}, out)) out << "wrote " << png << "\n";
-    }
-    out.flush();
+    report_files_and_figure(r.files, options.output_dir, options.figure_script, "friction_identification.png", out);
     return 0;
   } catch (const ConfigError& e) {
     out << "error: " << e.what() << std::endl;

@@ -384,12 +384,7 @@ int run_torque_tracking_command(const TorqueTrackingOptions& options, std::ostre
     out << "torque tracking: plant " << options.plant_config_path << ", seed " << options.seed << std::endl;
     const TorqueTrackingResult r = run_torque_tracking(options, &out);
     out << "\n" << torque_tracking_table(r, options);
-    for (const std::string& f : r.files) out << "wrote " << f << "\n";
-    if (!options.output_dir.empty() && !options.figure_script.empty()) {
-      const std::string png = output_path(options.output_dir, "torque_tracking.png");
-      if (run_figure_script(options.figure_script, {options.output_dir, png}, out)) out << "wrote " << png << "\n";
-    }
-    out.flush();
+    report_files_and_figure(r.files, options.output_dir, options.figure_script, "torque_tracking.png", out);
     return 0;
   } catch (const ConfigError& e) {
     out << "error: " << e.what() << std::endl;
