@@ -12,6 +12,7 @@
 #include <phri/core/version.hpp>
 #include <phri/experiments/friction_identification.hpp>
 #include <phri/experiments/torque_tracking.hpp>
+#include <phri/experiments/torque_tracking_sweep.hpp>
 #include <phri/model/algorithms.hpp>
 #include <phri/model/model.hpp>
 
@@ -184,6 +185,23 @@ int main(int argc, char** argv) {
   tracking->add_flag("--static-ft", static_ft,
                      "static scenario as in the paper: the weight is hung after the switch and compensated through the "
                      "F/T sensor (J^T F), not the joint-torque observer");
+  tracking->add_option("--torque-constant-error", torque.torque_constant_error,
+                       "plant drive gain error: each joint's true K_T G_r off the nominal by up to this fraction "
+                       "(default: the plant file's mismatch.torque_constant_fraction)")
+      ->check(CLI::Range(0.0, 0.5));
+  std::uint64_t mismatch_seed = 0;
+  auto* mismatch_seed_option =
+      tracking->add_option("--mismatch-seed", mismatch_seed, "seed of the plant's inertial and drive-gain mismatch "
+                                                             "(default: the plant file's mismatch.seed)");
+  phri::StaticSweepOptions sweep;
+  bool static_sweep = false;
+  tracking->add_flag("--static-sweep", static_sweep,
+                     "instead: the static scenario at several drive gain errors x mismatch seeds (why the static "
+                     "ratio depends on the arm; see src/phri/experiments/torque_tracking_sweep.hpp)");
+  tracking->add_option("--sweep-errors", sweep.torque_constant_errors, "drive gain errors of the sweep")
+      ->check(CLI::Range(0.0, 0.5))
+      ->capture_default_str();
+  tracking->add_option("--sweep-seeds", sweep.mismatch_seeds, "mismatch seeds of the sweep")->capture_default_str();
   auto* friction_alias = experiment->add_subcommand("friction-identification", "Same as 'phri identify-friction'");
   friction_alias->add_option("--out", friction.output_dir, "output folder");
   friction_alias->add_option("--seed", friction.seed, "seed");
@@ -207,9 +225,15 @@ int main(int argc, char** argv) {
         torque.static_external_torque = phri::ExternalTorqueSource::kForceTorqueSensor;
         torque.payload_mode = phri::PayloadMode::kHungAfterSwitch;
       }
+      if (mismatch_seed_option->count() > 0) torque.mismatch_seed = mismatch_seed;
       for (std::string* path : {&torque.plant_config_path, &torque.urdf_path, &torque.actuators_path,
-                                &torque.collision_path, &torque.figure_script}) {
+                                &torque.collision_path, &torque.figure_script, &sweep.figure_script}) {
         *path = locate(*path);
+      }
+      if (static_sweep) {
+        sweep.tracking = torque;
+        if (tracking->get_option("--out")->count() > 0) sweep.output_dir = torque.output_dir;
+        return phri::run_static_sweep_command(sweep, std::cout);
       }
       return phri::run_torque_tracking_command(torque, std::cout);
     }

@@ -6,12 +6,17 @@
 // the full runs come from the commands (run_*_command).
 #include <phri/experiments/friction_identification.hpp>
 #include <phri/experiments/torque_tracking.hpp>
+#include <phri/experiments/torque_tracking_sweep.hpp>
+#include <phri/robot/actuator_table.hpp>
+
+#include "temp_dir.hpp"
 
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <sstream>
 
 namespace {
@@ -105,6 +110,40 @@ TEST(TorqueTracking, StaticHoldIsAtTheSensorNoiseFloorWithEitherLoop) {
     EXPECT_LT(run.rms_Nm, 0.35);
     EXPECT_LT(run.ee_position_rms_mm, 0.5);
   }
+}
+
+TEST(TorqueTracking, StaticSweepSeparatesTheLoopsOnlyBeyondTheFrictionBand) {
+  // At rest the error is fixed by where friction stops the joints (torque_tracking_sweep.hpp): a
+  // drive-gain error whose static imbalance |k - 1| tau_s stays below the static friction moves
+  // nothing, so both loops show the same error; a larger one makes the joints slide until the error
+  // reaches the loop's stick band, ~tau_st / 2 for Kinova's loop and ~tau_st / 26 for the custom one.
+  phri::StaticSweepOptions o;
+  o.tracking = short_tracking();
+  o.tracking.static_duration_s = 3.0;
+  o.torque_constant_errors = {0.0, 0.25};
+  o.mismatch_seeds = {4};  // a draw whose joint-2 gain error (about -20 %) exceeds the band
+  const phri::test::TempDir dir("phri_test_static_sweep");
+  o.output_dir = dir.path.string();
+  o.figure_script.clear();
+  const phri::StaticSweepResult r = phri::run_static_sweep(o);
+  ASSERT_EQ(r.rows.size(), 2u);
+  ASSERT_EQ(r.summary.size(), 2u);
+  for (const auto& row : r.rows) {
+    std::printf("static sweep: gain error %.2f: RMS custom %.3f, high-velocity %.3f N.m, ratio %.2f; bias %.3f / %.3f N.m\n",
+                row.torque_constant_error, row.custom_rms_Nm, row.high_velocity_rms_Nm, row.ratio, row.custom_bias_Nm,
+                row.high_velocity_bias_Nm);
+  }
+  EXPECT_LT(r.rows[0].ratio, 1.3);
+  EXPECT_GT(r.rows[1].ratio, 3.0);
+  // The high-velocity loop's steady error stays within its band: sqrt(sum (tau_st / 2)^2) = 2.5 N.m.
+  double band = 0.0;
+  const phri::ActuatorTable drives = phri::ActuatorTable::from_yaml_file(o.tracking.actuators_path);
+  for (int i = 0; i < drives.size(); ++i) band += std::pow(0.5 * drives[i].friction.static_Nm, 2);
+  EXPECT_LT(r.rows[1].high_velocity_bias_Nm, std::sqrt(band) + 0.3);  // + the sensors' zero offsets
+  // The custom loop's stays near its own band (and the offsets).
+  EXPECT_LT(r.rows[1].custom_bias_Nm, 0.35);
+  EXPECT_TRUE(std::filesystem::exists(o.output_dir + "/static_sweep.csv"));
+  EXPECT_TRUE(std::filesystem::exists(o.output_dir + "/static_sweep.md"));
 }
 
 }  // namespace

@@ -365,8 +365,14 @@ TEST(SimRobotVendorModes, PositionStepSettles) {
 //   Current (i = 0)       : b qd = tau_e - Fc
 //   KinovaTorque          : (B + b) qd = (1 + Kt) tau_e - Fc      (tau_m = -Kt tau_s - B qd)
 //   KinovaTorqueHighVel.  : b qd = 2 tau_e - Fc                    (H(1) = 1: tau_m = -tau_s)
-double spin_speed(LowLevelMode mode, double tau_e, double seconds) {
+double spin_speed(LowLevelMode mode, double tau_e, double seconds, double joint1_torque_constant_scale = 1.0) {
   SimRobotConfig c = load(false);
+  if (joint1_torque_constant_scale != 1.0) {
+    SimRobotConfig::ActuatorOverride o;
+    o.joint = c.actuators[0].joint_name;
+    o.torque_constant_scale = joint1_torque_constant_scale;
+    c.actuator_overrides.push_back(o);
+  }
   phri::ExternalForce f;
   f.body = "shoulder_link";  // its z axis is joint 1's axis
   f.frame = phri::ExternalForce::Frame::kLocal;
@@ -410,6 +416,47 @@ TEST(SimRobotVendorModes, TorqueLoopsClosedFormSpeeds) {
   EXPECT_NEAR(current, e_current, 0.02 * e_current);
   EXPECT_NEAR(torque, e_torque, 0.02 * e_torque);
   EXPECT_NEAR(high, e_high, 0.02 * e_high);
+}
+
+// The vendor's firmware converts torque to current with its stored (nominal) K_T G_r; a drive whose
+// true constant is k x nominal delivers k x what the loop asks. Closed forms as above with k:
+//   KinovaTorque          : (k B + b) qd = (1 + k Kt) tau_e - Fc
+//   KinovaTorqueHighVel.  : b qd = (1 + k) tau_e - Fc
+TEST(SimRobotVendorModes, VendorLoopsConvertWithTheNominalTorqueConstant) {
+  const SimRobotConfig c = load(false);
+  const double tau_e = 3.0, k = 0.8;
+  const double fc = c.actuators[0].friction.coulomb_Nm;
+  const double b = c.actuators[0].friction.viscous_Nms_per_rad;
+  const double kt = c.vendor.torque_feedback_gain[0];
+  const double damping = c.vendor.torque_velocity_damping_Nms_per_rad[0];
+  const double torque = spin_speed(LowLevelMode::kKinovaTorque, tau_e, 2.0, k);
+  const double high = spin_speed(LowLevelMode::kKinovaTorqueHighVelocity, tau_e, 6.0, k);
+  const double e_torque = ((1 + k * kt) * tau_e - fc) / (k * damping + b);
+  const double e_high = ((1 + k) * tau_e - fc) / b;
+  std::printf("joint 1, K_T x %.2f, steady speed (rad/s): kinova_torque %.4f (%.4f), high_velocity %.4f (%.4f)\n", k,
+              torque, e_torque, high, e_high);
+  EXPECT_NEAR(torque, e_torque, 0.02 * e_torque);
+  EXPECT_NEAR(high, e_high, 0.02 * e_high);
+}
+
+// Position mode starts at the exact holding torque even when the drives' true K_T differs from
+// the firmware's: the servo's integrator is set in the firmware's units.
+TEST(SimRobotVendorModes, PositionHoldStartsStillWithDriveGainError) {
+  SimRobotConfig c = load(false);
+  for (const auto& a : c.actuators.joints()) {
+    SimRobotConfig::ActuatorOverride o;
+    o.joint = a.joint_name;
+    o.torque_constant_scale = 0.85;
+    c.actuator_overrides.push_back(o);
+  }
+  SimRobot robot(c);
+  double drift = 0.0;
+  for (int k = 0; k < 500; ++k) {
+    robot.read();
+    drift = std::max(drift, (robot.truth().q_rad - to_vector(kTarget)).cwiseAbs().maxCoeff());
+  }
+  std::printf("position hold with K_T x 0.85: largest joint drift over 0.5 s %.2e rad\n", drift);
+  EXPECT_LT(drift, 1e-5);
 }
 
 // ------------------------------------------------------------------------------- disturbances
@@ -493,6 +540,28 @@ TEST(SimRobotDisturbances, RandomPushesHappenWithinTheirBounds) {
 }
 
 // ------------------------------------------------------------------------------ model mismatch
+TEST(SimRobotMismatch, DriveGainErrorIsDrawnWithinItsBoundDeterministically) {
+  SimRobotConfig c = load(false);
+  c.mismatch.torque_constant_fraction = 0.2;
+  const phri::ActuatorTable off = c.plant_actuators();  // mismatch disabled: nominal
+  c.mismatch.enabled = true;
+  const phri::ActuatorTable a = c.plant_actuators(), b = c.plant_actuators();
+  c.mismatch.seed += 1;
+  const phri::ActuatorTable other = c.plant_actuators();
+  int distinct = 0;
+  for (int i = 0; i < a.size(); ++i) {
+    const double nominal = c.actuators[i].torque_constant_Nm_per_A;
+    EXPECT_EQ(off[i].torque_constant_Nm_per_A, nominal);
+    const double ratio = a[i].torque_constant_Nm_per_A / nominal;
+    EXPECT_GE(ratio, 0.8);
+    EXPECT_LE(ratio, 1.2);
+    EXPECT_EQ(a[i].torque_constant_Nm_per_A, b[i].torque_constant_Nm_per_A);
+    distinct += a[i].torque_constant_Nm_per_A != other[i].torque_constant_Nm_per_A;
+    EXPECT_EQ(a[i].friction.coulomb_Nm, c.actuators[i].friction.coulomb_Nm);  // only the gain changes
+  }
+  EXPECT_EQ(distinct, a.size());
+}
+
 TEST(SimRobotMismatch, PerturbsLinksDeterministicallyAndPhysically) {
   SimRobotConfig c = load(false);
   SimRobot nominal(c);

@@ -124,6 +124,8 @@ SimRobotConfig plant_config(const TorqueTrackingOptions& o, TrackingScenario sce
   c.initial_q_rad = o.start_q_rad;
   c.seed = o.seed;
   c.mismatch.enabled = o.model_mismatch;
+  if (o.torque_constant_error >= 0.0) c.mismatch.torque_constant_fraction = o.torque_constant_error;
+  if (o.mismatch_seed) c.mismatch.seed = *o.mismatch_seed;
   if (o.friction_perturbation > 0.0) {
     c.actuator_overrides = perturbed_friction_overrides(c.actuators, o.friction_perturbation, o.seed);
   }
@@ -277,6 +279,7 @@ void validate(const TorqueTrackingOptions& o) {
     throw ConfigError(src, "static_duration_s/dynamic_duration_s", "must exceed transient_s >= 0");
   }
   if (!(o.payload_kg >= 0.0)) throw ConfigError(src, "payload_kg", "must be >= 0");
+  if (!(o.torque_constant_error <= 0.5)) throw ConfigError(src, "torque_constant_error", "must be <= 0.5");
   if (!(o.triangle_min_m < 0.0 && o.triangle_max_m > 0.0 && o.triangle_speed_m_s > 0.0)) {
     throw ConfigError(src, "triangle_min_m/triangle_max_m/triangle_speed_m_s", "need min < 0 < max and speed > 0");
   }
@@ -373,6 +376,9 @@ std::string torque_tracking_table(const TorqueTrackingResult& r, const TorqueTra
     << (o.friction_acceleration_threshold_rad_s2 > 0.0 ? format_fixed(o.friction_acceleration_threshold_rad_s2, 3) + " rad/s^2"
                                                         : std::string("from actuators.yaml"))
     << ". Plant: model mismatch " << (o.model_mismatch ? "on" : "off")
+    << (o.model_mismatch && o.torque_constant_error >= 0.0
+            ? " (drive gain error up to " + format_fixed(100.0 * o.torque_constant_error, 0) + " %)"
+            : std::string())
     << ", friction perturbation " << o.friction_perturbation << ", seed " << o.seed << ", static payload "
     << o.payload_kg << " kg. Simulated " << format_fixed(r.simulated_s, 1) << " s in " << format_fixed(r.wall_s, 1)
     << " s of wall time.\n";

@@ -40,6 +40,7 @@
 
 #include <cstdint>
 #include <iosfwd>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -110,6 +111,13 @@ struct TorqueTrackingOptions {
   /// 1 rad/s^2, the paper demo's runtime values).
   double friction_velocity_threshold_rad_s = 0.0;
   double friction_acceleration_threshold_rad_s2 = 0.0;
+
+  // ---- the plant's drive-gain error (used when model_mismatch is on)
+  /// Each drive's true K_T G_r off the nominal value by a uniform draw in [-f, f]
+  /// (SimRobotConfig::Mismatch::torque_constant_fraction); < 0: the plant file's value.
+  double torque_constant_error = -1.0;
+  /// Seed of the link-inertial and drive-gain draws; empty: the plant file's mismatch.seed.
+  std::optional<std::uint64_t> mismatch_seed;
 };
 
 /// Statistics of one run (scenario x loop) over its statistics window.

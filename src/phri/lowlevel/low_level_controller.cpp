@@ -16,7 +16,10 @@ LowLevelController::LowLevelController(const ActuatorTable& actuators, const Cus
       q_ref_(Eigen::VectorXd::Zero(actuators.size())),
       qd_ref_(Eigen::VectorXd::Zero(actuators.size())),
       torque_offset_(Eigen::VectorXd::Zero(actuators.size())),
-      offset_decay_(std::exp(-custom.period_s / kTorqueBlendTime)) {}
+      torque_per_amp_(Eigen::VectorXd::Zero(actuators.size())),
+      offset_decay_(std::exp(-custom.period_s / kTorqueBlendTime)) {
+  for (int i = 0; i < actuators.size(); ++i) torque_per_amp_[i] = actuators[i].torque_per_amp();
+}
 
 void LowLevelController::update(const RobotState& state, const Eigen::VectorXd& tau_desired,
                                 const Eigen::VectorXd& qdd_desired, RobotCommand& command) {
@@ -41,8 +44,18 @@ void LowLevelController::update(const RobotState& state, const Eigen::VectorXd& 
     case LowLevelLoop::kKinovaTorqueHighVelocity:
       command.mode = loop_ == LowLevelLoop::kKinovaTorque ? LowLevelMode::kKinovaTorque
                                                           : LowLevelMode::kKinovaTorqueHighVelocity;
-      // Bumpless: start from the torque the joints carry now, fade into tau_d.
-      if (entering) torque_offset_ = state.tau_sensor_Nm - tau_desired;
+      // Bumpless: start from the torque the motors produce now, fade into tau_d. That torque is
+      // the measured current in the vendor's own units (nominal K_T G_r, the constant its loop
+      // converts with), so the first command asks for the present current even when the drives'
+      // true constant differs; without a current reading, the joint torque sensors (which miss
+      // the friction and rotor torque between motor and sensor).
+      if (entering) {
+        if (state.current.valid) {
+          torque_offset_ = torque_per_amp_.cwiseProduct(state.current_A) - tau_desired;
+        } else {
+          torque_offset_ = state.tau_sensor_Nm - tau_desired;
+        }
+      }
       command.tau_Nm = tau_desired + torque_offset_;
       torque_offset_ *= offset_decay_;
       break;

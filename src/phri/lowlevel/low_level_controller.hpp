@@ -8,8 +8,9 @@
 //                             tracks q_ref); entered at the measured q, qd
 //   kKinovaTorque             tau_d to the vendor's torque loop
 //   kKinovaTorqueHighVelocity tau_d to the vendor's high-velocity torque loop
-//                             (both entered at the torque the joints carry: the set-point starts
-//                             at the measured tau_s and blends into tau_d, time constant 50 ms)
+//                             (both entered at the torque the motors produce: the set-point
+//                             starts at the measured current x K_T G_r, or at tau_s without a
+//                             current reading, and blends into tau_d, time constant 50 ms)
 //   kCustom                   CustomTorqueController: motor current (reset bumplessly on entry
 //                             from the current the drives carry)
 //
@@ -69,7 +70,8 @@ private:
   bool started_ = false;
   int switches_ = 0;
   Eigen::VectorXd q_ref_, qd_ref_;
-  Eigen::VectorXd torque_offset_;  // measured minus desired torque at a torque-loop entry, fading
+  Eigen::VectorXd torque_offset_;  // motor minus desired torque at a torque-loop entry, fading
+  Eigen::VectorXd torque_per_amp_; // nominal K_T G_r per joint
   double offset_decay_ = 0.0;
 };
 

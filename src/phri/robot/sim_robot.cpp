@@ -62,7 +62,7 @@ SimRobot::SimRobot(const SimRobotConfig& config)
     : config_(completed(config)),
       plant_actuators_(config_.plant_actuators()),
       n_(config_.dof()),
-      drive_(plant_actuators_, config_.vendor, config_.physics_step_s(), config_.control_period_s) {
+      drive_(config_.actuators, config_.vendor, config_.physics_step_s(), config_.control_period_s) {
   const std::string& src = config_.source;
   substeps_ = config_.substeps_per_cycle();
   filter_decimation_ = static_cast<int>(std::lround(config_.physics_rate_Hz / config_.vendor.high_velocity_rate_Hz));
@@ -85,6 +85,8 @@ SimRobot::SimRobot(const SimRobotConfig& config)
   lower_.resize(n_);
   upper_.resize(n_);
   torque_per_amp_.resize(n_);
+  nominal_torque_per_amp_.resize(n_);
+  vendor_torque_ = Eigen::VectorXd::Zero(n_);
   current_limit_.resize(n_);
   max_torque_.resize(n_);
   armature_.resize(n_);
@@ -108,6 +110,7 @@ SimRobot::SimRobot(const SimRobotConfig& config)
       upper_[i] = 100.0;
     }
     torque_per_amp_[i] = a.torque_per_amp();
+    nominal_torque_per_amp_[i] = config_.actuators[i].torque_per_amp();
     current_limit_[i] = a.current_limit_A;
     max_torque_[i] = a.max_motor_torque_Nm();
     armature_[i] = a.reflected_inertia_kgm2;
@@ -298,9 +301,9 @@ void SimRobot::reset() {
   command_.mode = LowLevelMode::kPosition;
   for (int i = 0; i < n_; ++i) command_.q_rad[i] = config_.initial_q_rad[static_cast<std::size_t>(i)];
   for (int i = 0; i < n_; ++i) q_meas_[i] = quantize(d_->qpos[qadr_[static_cast<std::size_t>(i)]]);
-  drive_ = KinovaDriveEmulator(plant_actuators_, config_.vendor, config_.physics_step_s(), config_.control_period_s);
-  drive_.begin_cycle(command_, false, q_meas_, tau_motor_);
-  drive_.set_position_integral(hold);
+  drive_ = KinovaDriveEmulator(config_.actuators, config_.vendor, config_.physics_step_s(), config_.control_period_s);
+  drive_.begin_cycle(command_, false, q_meas_, vendor_torque());
+  drive_.set_position_integral(vendor_torque());
 
   // Initial F/T sample with the arm held (qacc ~ 0) and the latch carrying the mass.
   for (int i = 0; i < n_; ++i) d_->qfrc_applied[dadr_[static_cast<std::size_t>(i)]] = hold[i];
@@ -391,7 +394,7 @@ const RobotState& SimRobot::read() {
     }
     has_pending_ = false;
   }
-  drive_.begin_cycle(command_, fresh, q_meas_, tau_motor_);
+  drive_.begin_cycle(command_, fresh, q_meas_, vendor_torque());
   for (int s = 0; s < substeps_; ++s) substep();
   if (d_->warning[mjWARN_BADQACC].number > 0 || d_->warning[mjWARN_BADQVEL].number > 0 ||
       d_->warning[mjWARN_BADQPOS].number > 0) {
@@ -547,6 +550,11 @@ void SimRobot::apply_drop_forces(double t) {
     ft[k] -= on_mass[k];
     ft[3 + k] += m[k];
   }
+}
+
+const Eigen::VectorXd& SimRobot::vendor_torque() {
+  vendor_torque_ = nominal_torque_per_amp_.cwiseProduct(current_);
+  return vendor_torque_;
 }
 
 void SimRobot::sample_state() {

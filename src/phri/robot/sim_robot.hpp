@@ -116,6 +116,11 @@ private:
                    const Eigen::Vector3d& torque);
   void apply_drop_forces(double t);
   void sample_state();
+  // The motor torque as the vendor firmware believes it: the drive current times its stored
+  // (nominal, actuators.yaml) K_T G_r. It differs from tau_motor_ when the plant's torque
+  // constant is off (actuator_overrides, mismatch.torque_constant_fraction): the firmware
+  // cannot know the true one, so its loops convert torque to current with the nominal value.
+  const Eigen::VectorXd& vendor_torque();
   WriteStatus validate(const RobotCommand& command) const;
   double quantize(double q) const;
 
@@ -132,6 +137,7 @@ private:
   // joint addressing and drive/friction constants (plant side)
   std::vector<int> qadr_, dadr_;
   Eigen::VectorXd lower_, upper_, torque_per_amp_, current_limit_, max_torque_, armature_;
+  Eigen::VectorXd nominal_torque_per_amp_, vendor_torque_;
   Eigen::VectorXd viscous_, offsets_;
   std::vector<StickSlipFriction> dry_;
   double quantum_ = 0.0;

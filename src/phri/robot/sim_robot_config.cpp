@@ -1,3 +1,4 @@
+#include <phri/core/random_generator.hpp>
 #include <phri/core/yaml_reader.hpp>
 #include <phri/robot/sim_robot_config.hpp>
 
@@ -6,6 +7,9 @@
 
 namespace phri {
 namespace {
+
+// Random stream of the drive-gain mismatch (SimRobot uses stream 3 of the same seed for the links).
+constexpr std::uint64_t kTorqueConstantMismatchStream = 4;
 
 constexpr double kHuge = 1e9;
 
@@ -131,12 +135,14 @@ SimRobotConfig parse(const YamlReader& root, const std::string& base_dir) {
 
   if (p.has("mismatch")) {
     const YamlReader m = p.at("mismatch");
-    m.allow_keys({"enabled", "seed", "mass_fraction", "com_fraction", "inertia_fraction"});
+    m.allow_keys({"enabled", "seed", "mass_fraction", "com_fraction", "inertia_fraction", "torque_constant_fraction"});
     c.mismatch.enabled = m.boolean_or("enabled", false);
     c.mismatch.seed = static_cast<std::uint64_t>(m.integer_or("seed", 7, 0, (1LL << 62)));
     c.mismatch.mass_fraction = m.number_or("mass_fraction", c.mismatch.mass_fraction, 0.0, 0.5);
     c.mismatch.com_fraction = m.number_or("com_fraction", c.mismatch.com_fraction, 0.0, 0.5);
     c.mismatch.inertia_fraction = m.number_or("inertia_fraction", c.mismatch.inertia_fraction, 0.0, 0.5);
+    c.mismatch.torque_constant_fraction =
+        m.number_or("torque_constant_fraction", c.mismatch.torque_constant_fraction, 0.0, 0.5);
   }
 
   if (p.has("vendor")) {
@@ -372,6 +378,12 @@ ActuatorTable SimRobotConfig::plant_actuators() const {
       a.rotor_inertia_kgm2 = a.reflected_inertia_kgm2 / (a.gear_ratio * a.gear_ratio);
     }
     if (o.torque_constant_scale) a.torque_constant_Nm_per_A *= *o.torque_constant_scale;
+  }
+  if (mismatch.enabled && mismatch.torque_constant_fraction > 0.0) {
+    RandomGenerator rng(mismatch.seed, kTorqueConstantMismatchStream);
+    for (int i = 0; i < out.size(); ++i) {
+      out[i].torque_constant_Nm_per_A *= 1.0 + rng.uniform(-mismatch.torque_constant_fraction, mismatch.torque_constant_fraction);
+    }
   }
   for (int i = 0; i < out.size(); ++i) {
     out[i].friction.coulomb_Nm *= friction_scale;

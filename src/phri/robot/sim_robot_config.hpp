@@ -111,13 +111,17 @@ struct SimRobotConfig {
     Eigen::Vector3d inertia_kgm2 = Eigen::Vector3d(3.4e-4, 7.3e-4, 8.9e-4);  ///< principal, sensor axes
   } tool;
 
-  // ---- link inertial mismatch relative to the URDF
+  // ---- link inertial and drive-gain mismatch relative to the URDF and actuators.yaml
   struct Mismatch {
     bool enabled = false;
     std::uint64_t seed = 7;
     double mass_fraction = 0.05;
     double com_fraction = 0.05;
     double inertia_fraction = 0.05;
+    /// Each drive's true torque per amp (K_T G_r, including the gear's efficiency) is the nominal
+    /// one x (1 + u), u uniform in [-f, f], drawn from `seed` (after actuator_overrides). The
+    /// vendor's loops keep converting with the nominal value, as real firmware does.
+    double torque_constant_fraction = 0.0;
   } mismatch;
 
   // ---- the vendor's actuator loops, emulated inside the plant (see KinovaDriveEmulator)
