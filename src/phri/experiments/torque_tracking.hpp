@@ -29,6 +29,10 @@
 // error made of sensor and controller noise only, with either loop (with the plant's sensor noise
 // switched off it is exactly zero for both); the loops differ only once the arm moves, and then
 // through friction: Kinova's loop leaves it uncompensated, the custom loop pre-compensates it.
+// What makes a resting arm move is a static torque error larger than the joints' static friction,
+// e.g. a drive whose true K_T G_r is off the value the controllers convert with (plant
+// mismatch.torque_constant_fraction, --torque-constant-error); torque_tracking_sweep.hpp works this
+// out and measures it (`phri experiment torque-tracking --static-sweep`).
 // In the dynamic scenario the custom loop's residual error is dominated by its friction model's
 // switching: a joint sliding slower than the velocity threshold gets static sign(qdd_d) or nothing
 // depending on whether |qdd_d| crosses the acceleration threshold, which noise makes chatter
