@@ -149,15 +149,6 @@ SimRobotConfig plant_config(const TorqueTrackingOptions& o, TrackingScenario sce
   return c;
 }
 
-double percentile(std::vector<double> values, double p) {
-  if (values.empty()) return 0.0;
-  std::sort(values.begin(), values.end());
-  const double rank = p * static_cast<double>(values.size() - 1);
-  const std::size_t lo = static_cast<std::size_t>(std::floor(rank));
-  const std::size_t hi = std::min(values.size() - 1, lo + 1);
-  return values[lo] + (rank - static_cast<double>(lo)) * (values[hi] - values[lo]);
-}
-
 double rms(const std::vector<double>& values) {
   double sum = 0.0;
   for (double v : values) sum += v * v;

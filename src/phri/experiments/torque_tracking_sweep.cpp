@@ -9,16 +9,6 @@
 #include <sstream>
 
 namespace phri {
-namespace {
-
-double median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  const std::size_t m = v.size() / 2;
-  return v.size() % 2 == 1 ? v[m] : 0.5 * (v[m - 1] + v[m]);
-}
-
-}  // namespace
 
 StaticSweepResult run_static_sweep(const StaticSweepOptions& o, std::ostream* progress) {
   const std::string src = "<static sweep options>";
@@ -67,11 +57,11 @@ StaticSweepResult run_static_sweep(const StaticSweepOptions& o, std::ostream* pr
     }
     StaticSweepSummary s;
     s.torque_constant_error = f;
-    s.median_ratio = median(ratios);
+    s.median_ratio = percentile(ratios, 0.5);
     s.min_ratio = *std::min_element(ratios.begin(), ratios.end());
     s.max_ratio = *std::max_element(ratios.begin(), ratios.end());
-    s.median_custom_rms_Nm = median(custom);
-    s.median_high_velocity_rms_Nm = median(hv);
+    s.median_custom_rms_Nm = percentile(custom, 0.5);
+    s.median_high_velocity_rms_Nm = percentile(hv, 0.5);
     result.summary.push_back(s);
   }
   result.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
