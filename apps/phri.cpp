@@ -7,8 +7,8 @@
 // Every bad argument or file gives one line naming what is wrong and a non-zero exit status.
 #include <phri/app/config.hpp>
 #include <phri/app/run_session.hpp>
-#include <phri/core/config_error.hpp>
-#include <phri/robot/sim_robot.hpp>
+#include <phri/core/error.hpp>
+#include <phri/sim/sim_robot.hpp>
 #include <phri/core/version.hpp>
 #include <phri/experiments/friction_identification.hpp>
 #include <phri/experiments/torque_tracking.hpp>
@@ -91,7 +91,7 @@ int run_command(const RunArguments& args) {
   std::printf("phri run: %s, %.1f s, %s\n", args.config_path.c_str(), config.run.duration_s,
               config.run.pacing == phri::LoopClock::Pacing::kLockstep ? "lockstep" : "real time");
   phri::SimRobot robot(config.plant);
-  phri::ControlCycle cycle(config.controller);
+  phri::Controller cycle(config.controller);
   phri::Fsm fsm(config.fsm, cycle);
   std::unique_ptr<phri::Gamepad> gamepad;
   if (config.gamepad.enabled) {

@@ -1,12 +1,12 @@
-// One full controller cycle, phri::ControlCycle::step — model terms, momentum observer, F/T
+// One full controller cycle, phri::Controller::step — model terms, momentum observer, F/T
 // wrench, compliance logic, QP build and solve, inverse dynamics, custom low-level torque loop —
 // timed cycle by cycle over 100,000 cycles of a closed-loop run on the simulated Gen3 (SimRobot
 // with its noise, friction and 5 % mismatch; pushes on the elbow and on the tool every few
 // seconds, dual compliance on so the trigger fires, self-collision rows in). The plant's own time
 // is not counted. Reports median, p99, p99.9 and max in microseconds:
 //   build/release/bench/phri_bench --benchmark_filter=ControllerCycle
-#include <phri/app/control_cycle.hpp>
-#include <phri/robot/sim_robot.hpp>
+#include <phri/control/controller.hpp>
+#include <phri/sim/sim_robot.hpp>
 
 #include <benchmark/benchmark.h>
 
@@ -37,12 +37,12 @@ void ControllerCycle(benchmark::State& state) {
     plant.disturbances.push_back(hand);
   }
   phri::SimRobot robot(plant);
-  phri::ControlCycleSettings settings;
+  phri::ControllerSettings settings;
   settings.urdf_path = root + "/robots/kinova_gen3/gen3.urdf";
   settings.actuators_path = root + "/robots/kinova_gen3/actuators.yaml";
   settings.collision_path = root + "/robots/kinova_gen3/collision.yaml";
   settings.initial_compliance = phri::ComplianceMode::kDual;
-  phri::ControlCycle cycle(settings);
+  phri::Controller cycle(settings);
   phri::RobotCommand command(robot.dof());
 
   std::vector<double> micros(kCycles);

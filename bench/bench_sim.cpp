@@ -3,7 +3,7 @@
 // sim_s_per_wall_s is the real-time factor (simulated seconds per wall-clock second). Run:
 //   build/release/bench/phri_bench --benchmark_filter=Sim --benchmark_repetitions=10
 //     --benchmark_report_aggregates_only=true   (one line)
-#include <phri/robot/sim_robot.hpp>
+#include <phri/sim/sim_robot.hpp>
 
 #include <benchmark/benchmark.h>
 

@@ -1,7 +1,7 @@
 // ctest-labels: unit
 // Capsule self-collision geometry: segment closest points against a brute-force minimisation,
 // distance Jacobians and J̇q̇ against finite differences, collision YAML validation.
-#include <phri/core/config_error.hpp>
+#include <phri/core/error.hpp>
 #include <phri/model/algorithms.hpp>
 #include <phri/model/capsule_distance.hpp>
 #include <phri/model/collision_model.hpp>

@@ -3,7 +3,7 @@
 // file merged with the overrides, the timeline sorted), and each class of mistake is a
 // phri::ConfigError naming the key path.
 #include <phri/app/config.hpp>
-#include <phri/core/config_error.hpp>
+#include <phri/core/error.hpp>
 
 #include <gtest/gtest.h>
 
@@ -71,14 +71,14 @@ TEST(Config, LoadsTheDemo) {
   // Controller.
   EXPECT_DOUBLE_EQ(c.controller.observer_gain, 50.0);
   EXPECT_EQ(c.controller.initial_compliance, phri::ComplianceMode::kNullSpace);
-  EXPECT_EQ(c.controller.initial_loop, phri::LowLevelLoop::kPosition);  // the start-up runs in Position
+  EXPECT_EQ(c.controller.initial_loop, phri::LowLevelMode::kPosition);  // the start-up runs in Position
   EXPECT_DOUBLE_EQ(c.controller.compliance.touch_threshold, 8.0);
   EXPECT_DOUBLE_EQ(c.controller.wrench_trigger_filter_s, 0.01);
   EXPECT_DOUBLE_EQ(c.controller.qp.collision.safety_distance, 0.015);
   EXPECT_DOUBLE_EQ(c.controller.qp.joint_influence_fraction, 0.1);
   EXPECT_DOUBLE_EQ(c.controller.custom_torque.transfer_gain, 5.0);
   // FSM and timeline.
-  EXPECT_EQ(c.fsm.torque_loop, phri::LowLevelLoop::kCustom);
+  EXPECT_EQ(c.fsm.torque_loop, phri::LowLevelMode::kCurrent);
   EXPECT_EQ(c.fsm.first_scenario, phri::Scenario::kStatic);
   EXPECT_EQ(c.fsm.static_scenario.posture_q_rad, phri::paper_posture_target());
   EXPECT_DOUBLE_EQ(c.fsm.dynamic_scenario.vertical_angular_frequency_rad_s, 3.0);
@@ -136,7 +136,7 @@ TEST(Config, MinimalFileTakesTheDefaults) {
   EXPECT_TRUE(c.controller.collision_path.empty());  // no collision key: no self-collision constraint
   EXPECT_FALSE(c.plant.mismatch.enabled);
   EXPECT_TRUE(c.fsm.timeline.empty());
-  EXPECT_DOUBLE_EQ(c.controller.observer_gain, phri::ControlCycleSettings{}.observer_gain);
+  EXPECT_DOUBLE_EQ(c.controller.observer_gain, phri::ControllerSettings{}.observer_gain);
   EXPECT_EQ(c.controller.payloads.size(), 2u);
   EXPECT_EQ(c.fsm.startup.home_q_rad, phri::paper_posture_target());
 }

@@ -83,8 +83,8 @@ TEST(TorqueTracking, CustomLoopTracksTheMovingTaskBetterThanTheHighVelocityLoop)
   phri::TorqueTrackingOptions o = short_tracking();
   o.scenarios = {phri::TrackingScenario::kDynamic};
   const phri::TorqueTrackingResult r = phri::run_torque_tracking(o);
-  const auto* custom = r.find(phri::TrackingScenario::kDynamic, phri::LowLevelLoop::kCustom);
-  const auto* hv = r.find(phri::TrackingScenario::kDynamic, phri::LowLevelLoop::kKinovaTorqueHighVelocity);
+  const auto* custom = r.find(phri::TrackingScenario::kDynamic, phri::LowLevelMode::kCurrent);
+  const auto* hv = r.find(phri::TrackingScenario::kDynamic, phri::LowLevelMode::kKinovaTorqueHighVelocity);
   ASSERT_NE(custom, nullptr);
   ASSERT_NE(hv, nullptr);
   std::printf("dynamic (2.5 s): RMS custom %.3f, high-velocity %.3f N.m (ratio %.2f); p95 %.3f / %.3f; EE RMS %.2f / %.2f mm\n",

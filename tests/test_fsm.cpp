@@ -1,18 +1,18 @@
 // ctest-labels: physics
-// phri::Fsm driving phri::ControlCycle on the simulated Gen3 (phri::SimRobot with 5 % model
+// phri::Fsm driving phri::Controller on the simulated Gen3 (phri::SimRobot with 5 % model
 // mismatch, friction and sensor noise): start-up from the plant's home posture to the static pose
 // in Position mode and the bumpless hand-over to the custom torque loop; scripted timelines through
 // the static and dynamic scenarios, compliance modes, loops, stiffness and stops; the reference
 // never steps; the loop (plant + FSM + cycle) allocates nothing; the whole run logged through
 // phri::Logger and read back.
 #include <phri/app/config.hpp>
-#include <phri/app/control_cycle.hpp>
+#include <phri/control/controller.hpp>
 #include <phri/app/fsm.hpp>
 #include <phri/app/log_row.hpp>
 #include <phri/app/logger.hpp>
 #include <phri/control/end_effector_task.hpp>
-#include <phri/core/config_error.hpp>
-#include <phri/robot/sim_robot.hpp>
+#include <phri/core/error.hpp>
+#include <phri/sim/sim_robot.hpp>
 
 #include "allocation_counter.hpp"
 
@@ -34,13 +34,13 @@ std::string temp_path(const std::string& name) { return phri::test::temp_path("p
 
 const std::string kRoot = PHRI_SOURCE_DIR;
 
-phri::ControlCycleSettings cycle_settings() {
-  phri::ControlCycleSettings s;
+phri::ControllerSettings cycle_settings() {
+  phri::ControllerSettings s;
   s.urdf_path = kRoot + "/robots/kinova_gen3/gen3.urdf";
   s.actuators_path = kRoot + "/robots/kinova_gen3/actuators.yaml";
   s.collision_path = kRoot + "/robots/kinova_gen3/collision.yaml";
   s.initial_compliance = phri::ComplianceMode::kNullSpace;
-  s.initial_loop = phri::LowLevelLoop::kPosition;
+  s.initial_loop = phri::LowLevelMode::kPosition;
   return s;
 }
 
@@ -95,7 +95,7 @@ public:
   double elapsed_in_state() const { return time() - fsm_.state_entry_time(); }
 
   phri::SimRobot robot_;
-  phri::ControlCycle cycle_;
+  phri::Controller cycle_;
   phri::Fsm fsm_;
   phri::RobotCommand command_;
   std::vector<Transition> transitions_;
@@ -127,7 +127,7 @@ TEST(Fsm, StartupMovesHomeInPositionThenHandsOverToTheTorqueLoopWithoutAJump) {
   double worst_step_around_switch = 0.0;
   rig.run(8.0, [&]() {
     max_speed = std::max(max_speed, rig.robot_.truth().qd_rad_s.cwiseAbs().maxCoeff());
-    if (switch_time < 0 && rig.cycle_.low_level().loop() == phri::LowLevelLoop::kCustom) {
+    if (switch_time < 0 && rig.cycle_.low_level().loop() == phri::LowLevelMode::kCurrent) {
       switch_time = rig.time();
       Eigen::VectorXd e(7);
       phri::JointMove(rig.cycle_.model()).difference(rig.robot_.state().q_rad,
@@ -218,10 +218,10 @@ TEST(Fsm, ScriptedSessionThroughEveryStateLoggedAndAllocationFree) {
     log();
     max_error_switching = std::max(max_error_switching, rig.ee_error());
     if (std::abs(rig.time() - 16.5) < 5e-4) {
-      EXPECT_EQ(rig.cycle_.low_level().loop(), phri::LowLevelLoop::kPosition);
+      EXPECT_EQ(rig.cycle_.low_level().loop(), phri::LowLevelMode::kPosition);
     }
     if (std::abs(rig.time() - 17.7) < 5e-4) {
-      EXPECT_EQ(rig.cycle_.low_level().loop(), phri::LowLevelLoop::kCustom);
+      EXPECT_EQ(rig.cycle_.low_level().loop(), phri::LowLevelMode::kCurrent);
       EXPECT_NEAR(rig.cycle_.compliance().stiffness_scale(), 0.8, 1e-12);
     }
   });
@@ -309,20 +309,20 @@ TEST(Fsm, EventsDuringStartupChooseTheHandOverAndAStopBrakesTheMove) {
     rig.run(0.001);
     EXPECT_EQ(rig.fsm_.last_event_code(), phri::code(phri::Event::kStiffnessUp));
     EXPECT_EQ(rig.fsm_.state(), phri::FsmState::kStartup);
-    EXPECT_EQ(rig.cycle_.low_level().loop(), phri::LowLevelLoop::kPosition) << "the move stays in Position";
+    EXPECT_EQ(rig.cycle_.low_level().loop(), phri::LowLevelMode::kPosition) << "the move stays in Position";
     EXPECT_NEAR(rig.cycle_.compliance().stiffness_scale(), 1.25, 1e-12);
     rig.run(5.0);
     std::printf("startup with events: %s\n", describe(rig.transitions_).c_str());
     EXPECT_EQ(rig.fsm_.state(), phri::FsmState::kDynamic);
-    EXPECT_EQ(rig.cycle_.low_level().loop(), phri::LowLevelLoop::kKinovaTorque);
-    EXPECT_EQ(rig.fsm_.torque_loop(), phri::LowLevelLoop::kKinovaTorque);
+    EXPECT_EQ(rig.cycle_.low_level().loop(), phri::LowLevelMode::kKinovaTorque);
+    EXPECT_EQ(rig.fsm_.torque_loop(), phri::LowLevelMode::kKinovaTorque);
     // Circle: to Position and back to the last torque loop.
     rig.fsm_.post(phri::Event::kToggleLoop);
     rig.run(0.1);
-    EXPECT_EQ(rig.cycle_.low_level().loop(), phri::LowLevelLoop::kPosition);
+    EXPECT_EQ(rig.cycle_.low_level().loop(), phri::LowLevelMode::kPosition);
     rig.fsm_.post(phri::Event::kToggleLoop);
     rig.run(0.1);
-    EXPECT_EQ(rig.cycle_.low_level().loop(), phri::LowLevelLoop::kKinovaTorque);
+    EXPECT_EQ(rig.cycle_.low_level().loop(), phri::LowLevelMode::kKinovaTorque);
     EXPECT_TRUE(rig.ok_);
   }
   {
@@ -339,7 +339,7 @@ TEST(Fsm, EventsDuringStartupChooseTheHandOverAndAStopBrakesTheMove) {
     EXPECT_LT(rig.transitions_[1].time, 1.6);
     EXPECT_FALSE(rig.fsm_.startup_complete());
     EXPECT_TRUE(rig.fsm_.finished());
-    EXPECT_EQ(rig.cycle_.low_level().loop(), phri::LowLevelLoop::kPosition);
+    EXPECT_EQ(rig.cycle_.low_level().loop(), phri::LowLevelMode::kPosition);
     EXPECT_LT(rig.max_reference_dv_, 0.005);
     EXPECT_LT(rig.robot_.truth().qd_rad_s.cwiseAbs().maxCoeff(), 0.01);
   }
@@ -355,12 +355,12 @@ TEST(Fsm, StartupTimesOutAndStillHandsOver) {
   EXPECT_TRUE(rig.fsm_.startup_complete());
   EXPECT_TRUE(rig.fsm_.startup_timed_out());
   EXPECT_EQ(rig.fsm_.state(), phri::FsmState::kStatic);
-  EXPECT_EQ(rig.cycle_.low_level().loop(), phri::LowLevelLoop::kCustom);
+  EXPECT_EQ(rig.cycle_.low_level().loop(), phri::LowLevelMode::kCurrent);
   EXPECT_NEAR(rig.transitions_[1].time, 2.684 + 0.5, 0.01);
 }
 
 TEST(Fsm, BadSettingsAreConfigErrors) {
-  phri::ControlCycle cycle(cycle_settings());
+  phri::Controller cycle(cycle_settings());
   auto expect_error = [&](const std::function<void(phri::FsmSettings&)>& edit, const std::string& key) {
     phri::FsmSettings s;
     edit(s);
@@ -375,17 +375,17 @@ TEST(Fsm, BadSettingsAreConfigErrors) {
   expect_error([](auto& s) { s.static_scenario.posture_q_rad[2] = NAN; }, "static.posture_q_rad");
   expect_error([](auto& s) { s.dynamic_scenario.horizontal_min_offset_m = 0.1; }, "dynamic.horizontal_min_offset_m");
   expect_error([](auto& s) { s.dynamic_scenario.horizontal_turn_acceleration_m_s2 = 0.01; }, "dynamic.horizontal_speed_m_s");
-  expect_error([](auto& s) { s.torque_loop = phri::LowLevelLoop::kPosition; }, "torque_loop");
+  expect_error([](auto& s) { s.torque_loop = phri::LowLevelMode::kPosition; }, "torque_loop");
   expect_error([](auto& s) { s.stiffness_step = 0.5; }, "stiffness_step");
   expect_error([](auto& s) { s.timeline = {{-1.0, phri::Event::kStop}}; }, "timeline[0].at");
 }
 
-// configs/demo.yaml end to end, as the CLI wires it (lockstep): Config -> SimRobot + ControlCycle
+// configs/demo.yaml end to end, as the CLI wires it (lockstep): Config -> SimRobot + Controller
 // + Fsm (+ Logger); the scripted session runs through every state and mode it announces.
 TEST(Fsm, DemoYamlSession) {
   const phri::Config config = phri::Config::from_yaml_file(kRoot + "/configs/demo.yaml");
   phri::SimRobot robot(config.plant);
-  phri::ControlCycle cycle(config.controller);
+  phri::Controller cycle(config.controller);
   phri::Fsm fsm(config.fsm, cycle);
   phri::LoggerSettings log_settings = config.logging;
   log_settings.path = temp_path("demo.csv");
@@ -422,7 +422,7 @@ TEST(Fsm, DemoYamlSession) {
     if (t > 22.0 && t < 25.0) dynamic_error = std::max(dynamic_error, error);
     if (t > 25.0 && t < 27.0) {
       position_loop_error = std::max(position_loop_error, error);
-      saw_position |= cycle.low_level().loop() == phri::LowLevelLoop::kPosition;
+      saw_position |= cycle.low_level().loop() == phri::LowLevelMode::kPosition;
     }
   }
   const phri::LoggerStats stats = logger.close();

@@ -5,8 +5,8 @@
 // accept, and every row has as many fields.
 #include <phri/app/log_row.hpp>
 #include <phri/app/logger.hpp>
-#include <phri/app/spsc_ring.hpp>
-#include <phri/core/config_error.hpp>
+#include <phri/core/spsc_ring.hpp>
+#include <phri/core/error.hpp>
 
 #include "allocation_counter.hpp"
 
@@ -132,7 +132,7 @@ TEST(Logger, HeaderNamesEveryColumnOnce) {
 
 TEST(Logger, LegendNamesTheCodes) {
   const std::string legend = phri::Logger::legend_yaml();
-  for (const char* expected : {"compliance_mode:", "1: null_space", "low_level_loop:", "3: custom", "event:",
+  for (const char* expected : {"compliance_mode:", "1: null_space", "low_level_loop:", "3: current", "event:",
                                "-1: none", "3: dual_compliance", "cycle_status:", "qp_status:"}) {
     EXPECT_NE(legend.find(expected), std::string::npos) << expected;
   }

@@ -2,7 +2,7 @@
 // The custom low-level torque loop against closed forms: the friction model's three cases at and
 // around its thresholds, the leaky integrator's ZOH response and leak, the whole current law, the
 // current saturation with anti-windup, bumpless entry, zero allocation.
-#include <phri/core/config_error.hpp>
+#include <phri/core/error.hpp>
 #include <phri/lowlevel/custom_torque_controller.hpp>
 #include <phri/lowlevel/low_level_controller.hpp>
 

@@ -1,7 +1,7 @@
 // ctest-labels: unit
 // phri::Model / algorithms: finite differences, identities of the equations of motion, the Gen3
 // forward-kinematics check from Kinova's numbers, URDF validation errors, zero heap allocation.
-#include <phri/core/config_error.hpp>
+#include <phri/core/error.hpp>
 #include <phri/model/algorithms.hpp>
 #include <phri/model/model.hpp>
 

@@ -5,15 +5,15 @@
 // the seeded random generator (moments, reproducibility), the stick-slip friction on a single
 // inertia (closed-form breakaway and sliding), the inertial perturbation, the force profiles and
 // the random-push geometry.
-#include <phri/core/config_error.hpp>
+#include <phri/core/error.hpp>
 #include <phri/core/random_generator.hpp>
-#include <phri/lowlevel/discrete_transfer_function.hpp>
+#include <phri/core/discrete_transfer_function.hpp>
 #include <phri/robot/actuator_table.hpp>
-#include <phri/robot/external_force.hpp>
-#include <phri/robot/link_inertial.hpp>
-#include <phri/robot/random_push_generator.hpp>
-#include <phri/robot/sim_robot_config.hpp>
-#include <phri/robot/stick_slip_friction.hpp>
+#include <phri/sim/external_force.hpp>
+#include <phri/sim/link_inertial.hpp>
+#include <phri/sim/random_push_generator.hpp>
+#include <phri/sim/sim_robot_config.hpp>
+#include <phri/sim/stick_slip_friction.hpp>
 
 #include <gtest/gtest.h>
 

@@ -1,12 +1,12 @@
 // ctest-labels: physics
-// The whole framework on the realistic plant: phri::ControlCycle (observer, F/T, compliance, QP,
+// The whole framework on the realistic plant: phri::Controller (observer, F/T, compliance, QP,
 // custom low-level torque loop) driving phri::SimRobot with 5 % link-inertial mismatch, friction,
 // rotor inertia and sensor noise. The paper's compliance behaviours and stiff safety constraints,
 // with the figures printed.
-#include <phri/app/control_cycle.hpp>
+#include <phri/control/controller.hpp>
 #include <phri/control/end_effector_task.hpp>
 #include <phri/model/algorithms.hpp>
-#include <phri/robot/sim_robot.hpp>
+#include <phri/sim/sim_robot.hpp>
 
 #include "allocation_counter.hpp"
 #include "hand_push.hpp"
@@ -26,7 +26,7 @@ const auto& push = hand_push;  // a hand: 50 ms rise, hold, release
 class Rig {
 public:
   Rig(phri::ComplianceMode mode, std::vector<phri::ExternalForce> pushes,
-      phri::LowLevelLoop loop = phri::LowLevelLoop::kCustom)
+      phri::LowLevelMode loop = phri::LowLevelMode::kCurrent)
       : config_(make_config(std::move(pushes))), robot_(config_), cycle_(make_settings(mode, loop)), command_(7) {}
 
   static phri::SimRobotConfig make_config(std::vector<phri::ExternalForce> pushes) {
@@ -36,8 +36,8 @@ public:
     c.disturbances = std::move(pushes);
     return c;
   }
-  static phri::ControlCycleSettings make_settings(phri::ComplianceMode mode, phri::LowLevelLoop loop) {
-    phri::ControlCycleSettings s;
+  static phri::ControllerSettings make_settings(phri::ComplianceMode mode, phri::LowLevelMode loop) {
+    phri::ControllerSettings s;
     s.urdf_path = kRoot + "/robots/kinova_gen3/gen3.urdf";
     s.actuators_path = kRoot + "/robots/kinova_gen3/actuators.yaml";
     s.collision_path = kRoot + "/robots/kinova_gen3/collision.yaml";
@@ -71,7 +71,7 @@ public:
 
   phri::SimRobotConfig config_;
   phri::SimRobot robot_;
-  phri::ControlCycle cycle_;
+  phri::Controller cycle_;
   phri::RobotCommand command_;
   bool torque_ok_ = true;
 
@@ -290,10 +290,10 @@ TEST(SimControl, LowLevelLoopSwitchesBetweenEveryPairWhileMoving) {
   // The end effector follows a vertical sine (5 cm, 0.5 Hz) while the low-level loop switches every
   // 0.4 s along a circuit through all 12 ordered pairs of {position, kinova torque, kinova torque
   // high velocity, custom}. At each switch: no position jump, a bounded step of the motor torque.
-  using L = phri::LowLevelLoop;
-  const L circuit[] = {L::kKinovaTorque, L::kKinovaTorqueHighVelocity, L::kCustom, L::kPosition,
-                       L::kKinovaTorqueHighVelocity, L::kKinovaTorque, L::kCustom, L::kKinovaTorque,
-                       L::kPosition, L::kCustom, L::kKinovaTorqueHighVelocity, L::kPosition};
+  using L = phri::LowLevelMode;
+  const L circuit[] = {L::kKinovaTorque, L::kKinovaTorqueHighVelocity, L::kCurrent, L::kPosition,
+                       L::kKinovaTorqueHighVelocity, L::kKinovaTorque, L::kCurrent, L::kKinovaTorque,
+                       L::kPosition, L::kCurrent, L::kKinovaTorqueHighVelocity, L::kPosition};
   Rig rig(phri::ComplianceMode::kNullSpace, {}, L::kPosition);
   rig.run(0.5);
   const Eigen::Isometry3d centre = rig.cycle_.qp().end_effector().target_pose();
@@ -362,9 +362,9 @@ TEST(SimControl, ExternalTorqueSourcesAgreeOnAPushOnTheTool) {
                                             phri::ExternalTorqueSource::kFused}) {
     phri::SimRobotConfig config = Rig::make_config({push("tool", Eigen::Vector3d(0, 0, 0), force, 1.0, 5.0)});
     phri::SimRobot robot(config);
-    phri::ControlCycleSettings settings = Rig::make_settings(phri::ComplianceMode::kStiff, phri::LowLevelLoop::kCustom);
+    phri::ControllerSettings settings = Rig::make_settings(phri::ComplianceMode::kStiff, phri::LowLevelMode::kCurrent);
     settings.external_torque_source = source;
-    phri::ControlCycle cycle(settings);
+    phri::Controller cycle(settings);
     phri::RobotCommand command(7);
     for (int k = 0; k < 3000; ++k) {
       cycle.step(robot.read(), command);

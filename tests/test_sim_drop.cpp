@@ -4,7 +4,7 @@
 // the tool + mass weight before release, free fall, the momentum balance of the mass over the jerk
 // (cable impulse), the peak force of a half-sine pulse of that impulse and duration, the rigid-
 // support bound mg + sqrt((mg)^2 + 2 mg L k), and the F/T sensor seeing the shock.
-#include <phri/robot/sim_robot.hpp>
+#include <phri/sim/sim_robot.hpp>
 
 #include <gtest/gtest.h>
 

@@ -6,8 +6,8 @@
 #include <phri/app/loop_clock.hpp>
 #include <phri/model/algorithms.hpp>
 #include <phri/model/model.hpp>
-#include <phri/robot/sim_robot.hpp>
-#include <phri/robot/sim_scene.hpp>
+#include <phri/sim/sim_robot.hpp>
+#include <phri/sim/sim_scene.hpp>
 
 #include "allocation_counter.hpp"
 

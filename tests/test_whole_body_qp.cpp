@@ -5,7 +5,7 @@
 #include <phri/control/compliance_controller.hpp>
 #include <phri/control/momentum_observer.hpp>
 #include <phri/control/whole_body_qp.hpp>
-#include <phri/core/config_error.hpp>
+#include <phri/core/error.hpp>
 #include <phri/model/algorithms.hpp>
 
 #include "allocation_counter.hpp"

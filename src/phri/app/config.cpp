@@ -61,7 +61,7 @@ ComplianceMode compliance_mode(const YamlReader& r, std::string_view key) {
 }
 
 // ------------------------------------------------------------------------------------ robot
-void parse_robot(const YamlReader& r, const std::string& base_dir, ControlCycleSettings& c) {
+void parse_robot(const YamlReader& r, const std::string& base_dir, ControllerSettings& c) {
   r.allow_keys({"urdf", "actuators", "collision", "end_effector_frame", "ft_sensor_offset_m", "payloads"});
   c.urdf_path = input_file(r, "urdf", base_dir, false);
   c.actuators_path = input_file(r, "actuators", base_dir, false);
@@ -146,7 +146,7 @@ SimRobotConfig parse_plant(const YamlReader& r, const YAML::Node& raw, const std
 }
 
 // ------------------------------------------------------------------------------------ controller
-void parse_controller(const YamlReader& r, int dof, ControlCycleSettings& c) {
+void parse_controller(const YamlReader& r, int dof, ControllerSettings& c) {
   r.allow_keys({"period_s", "observer_gain", "compliance_deadband", "compliance", "qp", "wrench"});
   c.period_s = positive_or(r, "period_s", c.period_s, 0.1);
   c.observer_gain = positive_or(r, "observer_gain", c.observer_gain, 1e4);
@@ -230,10 +230,10 @@ void parse_controller(const YamlReader& r, int dof, ControlCycleSettings& c) {
 }
 
 // ------------------------------------------------------------------------------------ low level
-void parse_low_level(const YamlReader& r, ControlCycleSettings& c, FsmSettings& fsm) {
+void parse_low_level(const YamlReader& r, ControllerSettings& c, FsmSettings& fsm) {
   r.allow_keys({"torque_loop", "custom"});
   if (r.has("torque_loop")) {
-    fsm.torque_loop = *low_level_loop_from_string(
+    fsm.torque_loop = *low_level_mode_from_string(
         r.choice("torque_loop", {"kinova_torque", "kinova_torque_high_velocity", "custom"}));
   }
   if (r.has("custom")) {
@@ -366,7 +366,7 @@ Config parse(const YAML::Node& raw, const std::string& source, const std::string
   if (root.has("low_level")) parse_low_level(root.at("low_level"), c.controller, c.fsm);
   if (root.has("fsm")) parse_fsm(root.at("fsm"), dof, c.fsm);
   // The FSM's start-up runs in Position; without it the run starts in the torque loop.
-  c.controller.initial_loop = c.fsm.startup.enabled ? LowLevelLoop::kPosition : c.fsm.torque_loop;
+  c.controller.initial_loop = c.fsm.startup.enabled ? LowLevelMode::kPosition : c.fsm.torque_loop;
 
   if (root.has("logging")) {
     const YamlReader l = root.at("logging");

@@ -4,7 +4,7 @@
 //
 //   const phri::Config config = phri::Config::from_yaml_file("configs/demo.yaml");  // throws phri::ConfigError
 //   phri::SimRobot robot(config.plant);
-//   phri::ControlCycle cycle(config.controller);
+//   phri::Controller cycle(config.controller);
 //   phri::Fsm fsm(config.fsm, cycle);                    // config.fsm.timeline: the `events:` list
 //   phri::Gamepad gamepad(config.gamepad);  gamepad.start();
 //   std::optional<phri::Logger> logger;  if (config.logging_enabled) logger.emplace(config.logging);
@@ -24,7 +24,7 @@
 // Schema (top-level sections; all but `robot` and `plant` optional, absent keys keep the defaults
 // of the settings structs, which follow the paper where it gives a value):
 //   robot:       urdf, actuators, collision ('' for none), end_effector_frame, ft_sensor_offset_m,
-//                payloads [{name, frame, mass_kg, com_m, inertia_kgm2}]       -> ControlCycleSettings
+//                payloads [{name, frame, mass_kg, com_m, inertia_kgm2}]       -> ControllerSettings
 //   plant:       either `file: plant_gen3.yaml` plus any keys of that file's `plant:` section to
 //                override (maps merged key by key, lists replaced), or the whole section inline
 //                                                                             -> SimRobotConfig
@@ -32,10 +32,10 @@
 //                compliance {initial_mode, stiffness/damping/weights, touch/release thresholds},
 //                qp {limits, joint_limits {influence_fraction, safety_fraction, amortization},
 //                collision {influence_distance_m, safety_distance_m, approach_speed_m_s, amortization},
-//                ...}, wrench {tool_mass_kg, tool_com_m, bias_samples}       -> ControlCycleSettings
+//                ...}, wrench {tool_mass_kg, tool_com_m, bias_samples}       -> ControllerSettings
 //   low_level:   torque_loop (start-up hands over to it), custom {transfer_gain, integral_gain,
 //                integral_leak, integral_limit_fraction, friction_compensation,
-//                rotor_inertia_compensation}                                 -> ControlCycleSettings
+//                rotor_inertia_compensation}                                 -> ControllerSettings
 //   fsm:         first_scenario, stiffness_step, rest_speed_rad_s, startup {...}, static {...},
 //                dynamic {...}, brake {...}                                 -> FsmSettings
 //   events:      [{at: seconds, event: name}] (names: app/event.hpp)          -> FsmSettings::timeline
@@ -52,12 +52,12 @@
 //
 // The compliance modes fix the gammas (0 or 1 per task, control/compliance_controller.hpp), so the
 // file has no gamma keys.
-#include <phri/app/control_cycle_settings.hpp>
+#include <phri/control/controller_settings.hpp>
 #include <phri/app/fsm.hpp>
 #include <phri/app/gamepad.hpp>
 #include <phri/app/logger.hpp>
 #include <phri/app/loop_clock.hpp>
-#include <phri/robot/sim_robot_config.hpp>
+#include <phri/sim/sim_robot_config.hpp>
 
 #include <string>
 
@@ -74,7 +74,7 @@ struct Config {
   static Config from_yaml_string(const std::string& yaml, const std::string& source_name, const std::string& base_dir);
 
   std::string source;              ///< the file it came from
-  ControlCycleSettings controller;
+  ControllerSettings controller;
   SimRobotConfig plant;
   FsmSettings fsm;                 ///< with the `events:` timeline, sorted by time
   bool logging_enabled = true;

@@ -6,9 +6,9 @@
 //
 // Names (timeline YAML, log legend) and meaning:
 //   stiff_compliance, null_space_compliance, full_body_compliance, dual_compliance
-//                          compliance mode (ControlCycle::set_compliance_mode)
+//                          compliance mode (Controller::set_compliance_mode)
 //   position_loop, kinova_torque_loop, kinova_torque_high_velocity_loop, custom_loop
-//                          low-level loop (ControlCycle::set_low_level_loop)
+//                          low-level loop (Controller::set_low_level_loop)
 //   toggle_loop            position <-> the last torque loop used (custom at first)
 //   static_scenario, dynamic_scenario
 //                          start a scenario (the FSM brakes the current motion first)
@@ -80,12 +80,12 @@ constexpr std::optional<ComplianceMode> compliance_of(Event e) {
 }
 
 /// The low-level loop an event selects, if it selects one (toggle_loop does not: the FSM decides).
-constexpr std::optional<LowLevelLoop> loop_of(Event e) {
+constexpr std::optional<LowLevelMode> loop_of(Event e) {
   switch (e) {
-    case Event::kPositionLoop: return LowLevelLoop::kPosition;
-    case Event::kKinovaTorqueLoop: return LowLevelLoop::kKinovaTorque;
-    case Event::kKinovaTorqueHighVelocityLoop: return LowLevelLoop::kKinovaTorqueHighVelocity;
-    case Event::kCustomLoop: return LowLevelLoop::kCustom;
+    case Event::kPositionLoop: return LowLevelMode::kPosition;
+    case Event::kKinovaTorqueLoop: return LowLevelMode::kKinovaTorque;
+    case Event::kKinovaTorqueHighVelocityLoop: return LowLevelMode::kKinovaTorqueHighVelocity;
+    case Event::kCustomLoop: return LowLevelMode::kCurrent;
     default: return std::nullopt;
   }
 }

@@ -1,6 +1,6 @@
 #include <phri/app/fsm.hpp>
 
-#include <phri/core/config_error.hpp>
+#include <phri/core/error.hpp>
 #include <phri/model/algorithms.hpp>
 
 #include <algorithm>
@@ -51,7 +51,7 @@ void check_settings(const FsmSettings& s, int nv) {
   positive(s.brake.min_duration_s, "brake.min_duration_s");
   if (!(s.stiffness_step >= 1.0) || !std::isfinite(s.stiffness_step)) fail("stiffness_step", "must be >= 1");
   positive(s.rest_speed_rad_s, "rest_speed_rad_s");
-  if (s.torque_loop == LowLevelLoop::kPosition) fail("torque_loop", "must be a torque loop");
+  if (s.torque_loop == LowLevelMode::kPosition) fail("torque_loop", "must be a torque loop");
   for (std::size_t i = 0; i < s.timeline.size(); ++i) {
     if (!(s.timeline[i].time_s >= 0.0) || !std::isfinite(s.timeline[i].time_s)) {
       fail("timeline[" + std::to_string(i) + "].at", "must be finite and >= 0");
@@ -65,7 +65,7 @@ Eigen::VectorXd to_vector(const std::vector<double>& v) {
 
 }  // namespace
 
-Fsm::Fsm(const FsmSettings& settings, const ControlCycle& cycle)
+Fsm::Fsm(const FsmSettings& settings, const Controller& cycle)
     : settings_(settings),
       model_(cycle.model()),
       data_(model_),
@@ -102,7 +102,7 @@ double Fsm::joint_speed(const RobotState& state) const {
   return state.qd_rad_s.size() > 0 ? state.qd_rad_s.cwiseAbs().maxCoeff() : 0.0;
 }
 
-void Fsm::update(double t, const RobotState& state, ControlCycle& cycle) {
+void Fsm::update(double t, const RobotState& state, Controller& cycle) {
   last_event_ = -1;
   // The cycle's first step takes the arm's pose as its targets; the FSM takes over after it.
   if (!cycle.started()) return;
@@ -136,7 +136,7 @@ void Fsm::update(double t, const RobotState& state, ControlCycle& cycle) {
 }
 
 // ------------------------------------------------------------------------------------ events
-void Fsm::handle(Event event, double t, const RobotState& /*state*/, ControlCycle& cycle) {
+void Fsm::handle(Event event, double t, const RobotState& /*state*/, Controller& cycle) {
   last_event_ = code(event);
   ++events_handled_;
   const bool starting = state_ == FsmState::kStartup && !startup_complete_;
@@ -145,7 +145,7 @@ void Fsm::handle(Event event, double t, const RobotState& /*state*/, ControlCycl
     return;
   }
   if (const auto loop = loop_of(event)) {
-    if (*loop != LowLevelLoop::kPosition) torque_loop_ = *loop;
+    if (*loop != LowLevelMode::kPosition) torque_loop_ = *loop;
     if (starting) {
       startup_handover_ = *loop;  // the start-up move itself stays in Position
     } else {
@@ -156,10 +156,10 @@ void Fsm::handle(Event event, double t, const RobotState& /*state*/, ControlCycl
   switch (event) {
     case Event::kToggleLoop:
       if (starting) {
-        startup_handover_ = startup_handover_ == LowLevelLoop::kPosition ? torque_loop_ : LowLevelLoop::kPosition;
+        startup_handover_ = startup_handover_ == LowLevelMode::kPosition ? torque_loop_ : LowLevelMode::kPosition;
       } else {
-        cycle.set_low_level_loop(cycle.low_level().requested() == LowLevelLoop::kPosition ? torque_loop_
-                                                                                          : LowLevelLoop::kPosition);
+        cycle.set_low_level_loop(cycle.low_level().requested() == LowLevelMode::kPosition ? torque_loop_
+                                                                                          : LowLevelMode::kPosition);
       }
       return;
     case Event::kStaticScenario: request(FsmState::kStatic, t, cycle); return;
@@ -186,7 +186,7 @@ void Fsm::handle(Event event, double t, const RobotState& /*state*/, ControlCycl
 }
 
 // A new state: at once when the reference rests, after a brake when it moves.
-void Fsm::request(FsmState next, double t, ControlCycle& cycle) {
+void Fsm::request(FsmState next, double t, Controller& cycle) {
   if (stop_requested_) return;  // the session is over: only compliance and loop events still act
   if (state_ == FsmState::kStartup && !startup_complete_ && next != FsmState::kStopped) {
     after_startup_ = next == FsmState::kStatic ? Scenario::kStatic : Scenario::kDynamic;
@@ -223,7 +223,7 @@ void Fsm::request(FsmState next, double t, ControlCycle& cycle) {
   }
 }
 
-void Fsm::enter(FsmState next, double t, ControlCycle& cycle) {
+void Fsm::enter(FsmState next, double t, Controller& cycle) {
   state_ = next;
   state_entry_time_ = t;
   motion_start_ = t;
@@ -253,17 +253,17 @@ void Fsm::enter(FsmState next, double t, ControlCycle& cycle) {
   }
 }
 
-void Fsm::enter_startup(double t, const RobotState& state, ControlCycle& cycle) {
+void Fsm::enter_startup(double t, const RobotState& state, Controller& cycle) {
   state_ = FsmState::kStartup;
   state_entry_time_ = t;
-  cycle.set_low_level_loop(LowLevelLoop::kPosition);
+  cycle.set_low_level_loop(LowLevelMode::kPosition);
   q_ref_ = state.q_rad;
   joint_move_.start(q_ref_, home_q_, settings_.startup.max_joint_speed_rad_s, settings_.startup.min_duration_s);
   motion_ = Motion::kJointMove;
   motion_start_ = t;
 }
 
-void Fsm::finish_startup(double t, ControlCycle& cycle, bool timed_out) {
+void Fsm::finish_startup(double t, Controller& cycle, bool timed_out) {
   startup_complete_ = true;
   startup_timed_out_ = timed_out;
   cycle.set_low_level_loop(startup_handover_);
@@ -271,7 +271,7 @@ void Fsm::finish_startup(double t, ControlCycle& cycle, bool timed_out) {
 }
 
 // ------------------------------------------------------------------------------------ references
-void Fsm::stream_joint_reference(ControlCycle& cycle) {
+void Fsm::stream_joint_reference(Controller& cycle) {
   cycle.qp().posture().set_target(q_ref_, qd_ref_, qdd_ref_);
   forward_kinematics(model_, data_, q_ref_, qd_ref_, qdd_ref_);
   update_frame_placements(model_, data_);
@@ -281,11 +281,11 @@ void Fsm::stream_joint_reference(ControlCycle& cycle) {
   stream_pose_reference(cycle);
 }
 
-void Fsm::stream_pose_reference(ControlCycle& cycle) {
+void Fsm::stream_pose_reference(Controller& cycle) {
   cycle.qp().end_effector().set_target(pose_ref_.pose, pose_ref_.velocity, pose_ref_.acceleration);
 }
 
-void Fsm::run_motion(double t, ControlCycle& cycle) {
+void Fsm::run_motion(double t, Controller& cycle) {
   const double elapsed = t - motion_start_;
   switch (motion_) {
     case Motion::kHold:

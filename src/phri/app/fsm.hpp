@@ -1,7 +1,7 @@
 #pragma once
 // phri::Fsm: the demo's state machine (paper, "Framework overview": the operator switches
 // compliance modes, low-level loops and scenarios live). It sits between the estimator and the
-// QP (DESIGN.md section 2) and drives a ControlCycle each period:
+// QP (DESIGN.md section 2) and drives a Controller each period:
 //
 //   phri::Fsm fsm(settings, cycle);
 //   for (;;) {
@@ -30,15 +30,15 @@
 // next state starts from it, so no transition steps the reference velocity.
 //
 // Events (app/event.hpp) come from post() (the gamepad) and from the timeline (handled when the
-// robot time reaches them), and act at once: compliance modes (ControlCycle::set_compliance_mode),
+// robot time reaches them), and act at once: compliance modes (Controller::set_compliance_mode),
 // stiffness up/down (x or / stiffness_step, ComplianceController clamps to [0.1, 4]), low-level
 // loops (during start-up: the loop to hand over to), scenarios, stops.
 //
 // update() allocates nothing and never throws; construction checks the settings (ConfigError).
-#include <phri/app/control_cycle.hpp>
+#include <phri/control/controller.hpp>
 #include <phri/app/event.hpp>
 #include <phri/app/scenario.hpp>
-#include <phri/app/spsc_ring.hpp>
+#include <phri/core/spsc_ring.hpp>
 #include <phri/model/data.hpp>
 
 #include <cstdint>
@@ -73,7 +73,7 @@ struct FsmSettings {
   DynamicScenarioSettings dynamic_scenario;
   BrakeSettings brake;
   Scenario first_scenario = Scenario::kStatic;    ///< entered after start-up
-  LowLevelLoop torque_loop = LowLevelLoop::kCustom;  ///< start-up hands over to it; toggle_loop's torque side
+  LowLevelMode torque_loop = LowLevelMode::kCurrent;  ///< start-up hands over to it; toggle_loop's torque side
   double stiffness_step = 1.25;  ///< factor of stiffness_up / stiffness_down
   double rest_speed_rad_s = 0.01;  ///< |qd| below which the arm is at rest (finished())
   std::vector<TimedEvent> timeline;  ///< scripted events (sorted here by time)
@@ -83,12 +83,12 @@ struct FsmSettings {
 class Fsm {
 public:
   /// `cycle`: the controller this FSM will drive (its model gives the forward kinematics).
-  Fsm(const FsmSettings& settings, const ControlCycle& cycle);
+  Fsm(const FsmSettings& settings, const Controller& cycle);
 
   /// Queues an event for the next update (one producer thread; false when the queue is full).
   bool post(Event event) noexcept;
   /// Once per period, before cycle.step(state, ...). `time_s`: robot time (the timeline's clock).
-  void update(double time_s, const RobotState& state, ControlCycle& cycle);
+  void update(double time_s, const RobotState& state, Controller& cycle);
 
   FsmState state() const { return state_; }
   /// The reference is being brought to rest before the next state.
@@ -105,7 +105,7 @@ public:
   /// Time the current state was entered (robot time).
   double state_entry_time() const { return state_entry_time_; }
   /// The torque loop toggle_loop returns to and start-up hands over to.
-  LowLevelLoop torque_loop() const { return torque_loop_; }
+  LowLevelMode torque_loop() const { return torque_loop_; }
   /// The static scenario's end-effector pose (forward kinematics of its posture).
   const Eigen::Isometry3d& static_pose() const { return static_pose_; }
   const FsmSettings& settings() const { return settings_; }
@@ -113,14 +113,14 @@ public:
 private:
   enum class Motion { kHold, kJointMove, kPoseMove, kTrajectory, kPoseBrake, kJointBrake };
 
-  void handle(Event event, double t, const RobotState& state, ControlCycle& cycle);
-  void request(FsmState next, double t, ControlCycle& cycle);
-  void enter(FsmState next, double t, ControlCycle& cycle);
-  void enter_startup(double t, const RobotState& state, ControlCycle& cycle);
-  void finish_startup(double t, ControlCycle& cycle, bool timed_out);
-  void run_motion(double t, ControlCycle& cycle);
-  void stream_joint_reference(ControlCycle& cycle);
-  void stream_pose_reference(ControlCycle& cycle);
+  void handle(Event event, double t, const RobotState& state, Controller& cycle);
+  void request(FsmState next, double t, Controller& cycle);
+  void enter(FsmState next, double t, Controller& cycle);
+  void enter_startup(double t, const RobotState& state, Controller& cycle);
+  void finish_startup(double t, Controller& cycle, bool timed_out);
+  void run_motion(double t, Controller& cycle);
+  void stream_joint_reference(Controller& cycle);
+  void stream_pose_reference(Controller& cycle);
   double joint_speed(const RobotState& state) const;
 
   FsmSettings settings_;
@@ -133,8 +133,8 @@ private:
   FsmState state_ = FsmState::kStartup;
   FsmState pending_ = FsmState::kStatic;  // entered when the brake ends
   Scenario after_startup_;
-  LowLevelLoop torque_loop_;
-  LowLevelLoop startup_handover_;
+  LowLevelMode torque_loop_;
+  LowLevelMode startup_handover_;
   Motion motion_ = Motion::kHold;
   double motion_start_ = 0.0;
   double state_entry_time_ = 0.0;

@@ -40,7 +40,7 @@
 //   | PS                  | GUIDE               | stop (brake, hold, end of session) |
 //   | R2, sticks, L3, R3  |                     | (none)                           |
 #include <phri/app/event.hpp>
-#include <phri/app/spsc_ring.hpp>
+#include <phri/core/spsc_ring.hpp>
 
 #include <array>
 #include <atomic>

@@ -1,6 +1,6 @@
 #include <phri/app/log_row.hpp>
 
-#include <phri/app/control_cycle.hpp>
+#include <phri/control/controller.hpp>
 #include <phri/app/fsm.hpp>
 #include <phri/robot/robot_state.hpp>
 
@@ -23,7 +23,7 @@ void copy_pose(std::array<double, 3>& position, std::array<double, 4>& quaternio
 
 }  // namespace
 
-void fill_log_row(LogRow& row, const RobotState& state, const ControlCycle& cycle) {
+void fill_log_row(LogRow& row, const RobotState& state, const Controller& cycle) {
   row.time_s = state.time_s;
   row.cycle = static_cast<std::int64_t>(state.cycle);
   copy_joints(row.q, state.q_rad);
@@ -54,7 +54,7 @@ void fill_log_row(LogRow& row, const RobotState& state, const ControlCycle& cycl
   row.stiffness_scale = cycle.compliance().stiffness_scale();
 }
 
-void fill_log_row(LogRow& row, const RobotState& state, const ControlCycle& cycle, const Fsm& fsm) {
+void fill_log_row(LogRow& row, const RobotState& state, const Controller& cycle, const Fsm& fsm) {
   fill_log_row(row, state, cycle);
   row.fsm_state = static_cast<std::int32_t>(fsm.state());
   row.event = fsm.last_event_code();

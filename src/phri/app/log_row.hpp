@@ -27,7 +27,7 @@
 
 namespace phri {
 
-class ControlCycle;
+class Controller;
 class Fsm;
 struct RobotState;
 
@@ -50,7 +50,7 @@ struct LogRow {
   double wrench_norm = 0.0;
   std::int32_t compliance_mode = 0;    ///< ComplianceMode
   std::int32_t touched = 0;            ///< dual compliance: 1 while the end effector is touched
-  std::int32_t low_level_loop = 0;     ///< LowLevelLoop running
+  std::int32_t low_level_loop = 0;     ///< LowLevelMode running
   std::int32_t fsm_state = -1;         ///< FsmState; -1: no FSM
   std::int32_t event = -1;             ///< Event handled in this cycle (the last one); -1: none
   std::int32_t cycle_status = 0;       ///< CycleStatus
@@ -119,8 +119,8 @@ void visit_log_columns(const LogRow& r, int dof, Visitor&& v) {
 
 /// Fills every field the robot state and the control cycle give (after cycle.step()): all but
 /// fsm_state, event and cycle_time_s. No allocation.
-void fill_log_row(LogRow& row, const RobotState& state, const ControlCycle& cycle);
+void fill_log_row(LogRow& row, const RobotState& state, const Controller& cycle);
 /// ... and fsm_state and event from the FSM (event: the last one its last update handled).
-void fill_log_row(LogRow& row, const RobotState& state, const ControlCycle& cycle, const Fsm& fsm);
+void fill_log_row(LogRow& row, const RobotState& state, const Controller& cycle, const Fsm& fsm);
 
 }  // namespace phri

@@ -1,9 +1,9 @@
 #include <phri/app/logger.hpp>
 
-#include <phri/app/control_cycle.hpp>
+#include <phri/control/controller.hpp>
 #include <phri/app/event.hpp>
 #include <phri/app/fsm.hpp>
-#include <phri/core/config_error.hpp>
+#include <phri/core/error.hpp>
 #include <phri/qp/qp_status.hpp>
 
 #include <cerrno>
@@ -79,8 +79,8 @@ std::string Logger::legend_yaml() {
   legend_entry(out, "compliance_mode", {ComplianceMode::kStiff, ComplianceMode::kNullSpace, ComplianceMode::kFullBody,
                                         ComplianceMode::kDual});
   out += "touched:\n  0: free\n  1: touched\n";
-  legend_entry(out, "low_level_loop", {LowLevelLoop::kPosition, LowLevelLoop::kKinovaTorque,
-                                       LowLevelLoop::kKinovaTorqueHighVelocity, LowLevelLoop::kCustom});
+  legend_entry(out, "low_level_loop", {LowLevelMode::kPosition, LowLevelMode::kKinovaTorque,
+                                       LowLevelMode::kKinovaTorqueHighVelocity, LowLevelMode::kCurrent});
   out += "fsm_state:\n  -1: none\n";
   for (FsmState st : {FsmState::kStartup, FsmState::kStatic, FsmState::kDynamic, FsmState::kStopped}) {
     out += "  " + std::to_string(static_cast<int>(st)) + ": " + std::string(to_string(st)) + "\n";

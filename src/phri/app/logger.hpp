@@ -24,7 +24,7 @@
 // which pandas.read_csv and PlotJuggler's CSV loader open directly. The codes' legend goes to
 // a sidecar <path without .csv>.legend.yaml (legend_yaml()).
 #include <phri/app/log_row.hpp>
-#include <phri/app/spsc_ring.hpp>
+#include <phri/core/spsc_ring.hpp>
 
 #include <atomic>
 #include <cstdint>

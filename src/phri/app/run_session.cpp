@@ -29,7 +29,7 @@ struct PhaseAccumulator {
 
 }  // namespace
 
-RunSummary run_session(RobotInterface& robot, ControlCycle& cycle, Fsm& fsm, Gamepad* gamepad, Logger* logger,
+RunSummary run_session(RobotInterface& robot, Controller& cycle, Fsm& fsm, Gamepad* gamepad, Logger* logger,
                        const RunOptions& options, std::ostream& out) {
   RunSummary summary;
   const double period = robot.period_s();

@@ -1,14 +1,14 @@
 #pragma once
-// phri::run_session: the control loop of `phri run` — read -> FSM -> ControlCycle -> write -> log,
+// phri::run_session: the control loop of `phri run` — read -> FSM -> Controller -> write -> log,
 // once per period, in lockstep (as fast as possible) or paced by the real-time clock, with the
 // same code path. It measures every cycle's compute time, reports a status line (~5 Hz on a
 // terminal, plain progress lines otherwise) and, at the end, cycle-time statistics and a table per
 // phase (phases are named spans of the run, e.g. the scripted demo's steps).
 //
 // Safety: two consecutive overruns of the real-time period, or stale/invalid sensor data (the
-// ControlCycle holds the previous command then), post a stop to the FSM (brake to rest, hold) and
+// Controller holds the previous command then), post a stop to the FSM (brake to rest, hold) and
 // are reported once, clearly.
-#include <phri/app/control_cycle.hpp>
+#include <phri/control/controller.hpp>
 #include <phri/app/fsm.hpp>
 #include <phri/app/gamepad.hpp>
 #include <phri/app/logger.hpp>
@@ -56,7 +56,7 @@ struct RunSummary {
 
 /// Runs the loop for options.duration_s of robot time (or until the FSM has stopped and the arm
 /// is at rest after a stop event). `gamepad` and `logger` may be null.
-RunSummary run_session(RobotInterface& robot, ControlCycle& cycle, Fsm& fsm, Gamepad* gamepad, Logger* logger,
+RunSummary run_session(RobotInterface& robot, Controller& cycle, Fsm& fsm, Gamepad* gamepad, Logger* logger,
                        const RunOptions& options, std::ostream& out);
 
 /// The end-of-run report: cycle statistics and the per-phase table (markdown).

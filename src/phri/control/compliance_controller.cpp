@@ -1,6 +1,6 @@
 #include <phri/control/compliance_controller.hpp>
 
-#include <phri/core/config_error.hpp>
+#include <phri/core/error.hpp>
 
 #include <algorithm>
 #include <cmath>

@@ -10,7 +10,7 @@
 // acceleration moving continuously) is tracked as given; a target that jumps is approached by a
 // reference governor with bounded speed and acceleration (TargetLimits), so a new far target
 // never steps the torque either.
-#include <phri/control/smoothed_vector.hpp>
+#include <phri/core/smoothed_vector.hpp>
 #include <phri/model/data.hpp>
 #include <phri/model/model.hpp>
 #include <phri/model/spatial.hpp>

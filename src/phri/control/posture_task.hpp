@@ -5,7 +5,7 @@
 //
 // The error of a continuous joint is wrapped to (-pi, pi] so the posture never asks for a full
 // turn. Gains, weight and gamma are smoothed like the end-effector task's.
-#include <phri/control/smoothed_vector.hpp>
+#include <phri/core/smoothed_vector.hpp>
 #include <phri/model/model.hpp>
 
 namespace phri {

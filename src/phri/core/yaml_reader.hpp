@@ -11,7 +11,7 @@
 //
 // Internal to phri's loaders: yaml-cpp is a private dependency of libphri, so only phri's own .cpp
 // files include this header (it is installed with the others but needs yaml-cpp's headers).
-#include <phri/core/config_error.hpp>
+#include <phri/core/error.hpp>
 
 #include <yaml-cpp/yaml.h>
 

@@ -1,11 +1,11 @@
 #include <phri/experiments/friction_identification.hpp>
 
-#include <phri/app/control_cycle_settings.hpp>
-#include <phri/core/config_error.hpp>
+#include <phri/control/controller_settings.hpp>
+#include <phri/core/error.hpp>
 #include <phri/experiments/experiment_files.hpp>
 #include <phri/experiments/friction_perturbation.hpp>
 #include <phri/model/algorithms.hpp>
-#include <phri/robot/sim_robot.hpp>
+#include <phri/sim/sim_robot.hpp>
 
 #include <Eigen/Dense>
 
@@ -344,7 +344,7 @@ FrictionIdentificationResult identify_friction(const FrictionIdentificationOptio
   }
 
   ModelOptions model_options;
-  for (Payload p : ControlCycleSettings::default_payloads()) {
+  for (Payload p : ControllerSettings::default_payloads()) {
     p.frame = "end_effector_link";
     model_options.payloads.push_back(p);
   }

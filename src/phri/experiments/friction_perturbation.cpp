@@ -1,6 +1,6 @@
 #include <phri/experiments/friction_perturbation.hpp>
 
-#include <phri/core/config_error.hpp>
+#include <phri/core/error.hpp>
 #include <phri/core/random_generator.hpp>
 
 namespace phri {

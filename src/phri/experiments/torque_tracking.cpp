@@ -1,11 +1,11 @@
 #include <phri/experiments/torque_tracking.hpp>
 
-#include <phri/app/control_cycle.hpp>
-#include <phri/core/config_error.hpp>
+#include <phri/control/controller.hpp>
+#include <phri/core/error.hpp>
 #include <phri/experiments/experiment_files.hpp>
 #include <phri/experiments/friction_perturbation.hpp>
 #include <phri/model/algorithms.hpp>
-#include <phri/robot/sim_robot.hpp>
+#include <phri/sim/sim_robot.hpp>
 
 #include <yaml-cpp/yaml.h>
 
@@ -103,14 +103,14 @@ std::string controller_actuators(const TorqueTrackingOptions& o) {
   return path;
 }
 
-ControlCycleSettings cycle_settings(const TorqueTrackingOptions& o, TrackingScenario scenario, ComplianceMode mode,
+ControllerSettings cycle_settings(const TorqueTrackingOptions& o, TrackingScenario scenario, ComplianceMode mode,
                                    const std::string& actuators) {
-  ControlCycleSettings s;
+  ControllerSettings s;
   s.urdf_path = o.urdf_path;
   s.actuators_path = actuators;
   s.collision_path = o.collision_path;
   s.initial_compliance = mode;
-  s.initial_loop = LowLevelLoop::kPosition;
+  s.initial_loop = LowLevelMode::kPosition;
   s.custom_torque = o.custom_torque;
   if (scenario == TrackingScenario::kStatic) s.external_torque_source = o.static_external_torque;
   return s;
@@ -155,13 +155,13 @@ double rms(const std::vector<double>& values) {
   return values.empty() ? 0.0 : std::sqrt(sum / static_cast<double>(values.size()));
 }
 
-std::string loop_name(LowLevelLoop loop) { return std::string(to_string(loop)); }
+std::string loop_name(LowLevelMode loop) { return std::string(to_string(loop)); }
 
-TorqueTrackingRun run_one(const TorqueTrackingOptions& o, TrackingScenario scenario, LowLevelLoop loop,
+TorqueTrackingRun run_one(const TorqueTrackingOptions& o, TrackingScenario scenario, LowLevelMode loop,
                           const std::string& actuators, std::ostream* progress, double& simulated) {
   const ComplianceMode mode = scenario == TrackingScenario::kStatic ? o.static_compliance : o.dynamic_compliance;
   SimRobot robot(plant_config(o, scenario));
-  ControlCycle cycle(cycle_settings(o, scenario, mode, actuators));
+  Controller cycle(cycle_settings(o, scenario, mode, actuators));
   const int n = robot.dof();
   RobotCommand command(n);
   Data truth_data(cycle.model());  // FK of the plant's true joint angles (same kinematics)
@@ -281,7 +281,7 @@ void validate(const TorqueTrackingOptions& o) {
 
 }  // namespace
 
-const TorqueTrackingRun* TorqueTrackingResult::find(TrackingScenario scenario, LowLevelLoop loop) const {
+const TorqueTrackingRun* TorqueTrackingResult::find(TrackingScenario scenario, LowLevelMode loop) const {
   for (const TorqueTrackingRun& r : runs) {
     if (r.scenario == scenario && r.loop == loop) return &r;
   }
@@ -289,8 +289,8 @@ const TorqueTrackingRun* TorqueTrackingResult::find(TrackingScenario scenario, L
 }
 
 double TorqueTrackingResult::rms_ratio(TrackingScenario scenario) const {
-  const TorqueTrackingRun* custom = find(scenario, LowLevelLoop::kCustom);
-  const TorqueTrackingRun* hv = find(scenario, LowLevelLoop::kKinovaTorqueHighVelocity);
+  const TorqueTrackingRun* custom = find(scenario, LowLevelMode::kCurrent);
+  const TorqueTrackingRun* hv = find(scenario, LowLevelMode::kKinovaTorqueHighVelocity);
   return custom != nullptr && hv != nullptr && custom->rms_Nm > 0.0 ? hv->rms_Nm / custom->rms_Nm : 0.0;
 }
 
@@ -302,7 +302,7 @@ TorqueTrackingResult run_torque_tracking(const TorqueTrackingOptions& o, std::os
   const std::string actuators = controller_actuators(o);
   if (actuators != o.actuators_path && !o.output_dir.empty()) result.files.push_back(actuators);
   for (TrackingScenario scenario : o.scenarios) {
-    for (LowLevelLoop loop : o.loops) {
+    for (LowLevelMode loop : o.loops) {
       if (progress) {
         *progress << to_string(scenario) << " scenario, " << loop_name(loop) << " loop: "
                    << format_fixed(o.position_phase_s, 1) << " s position control, then "
@@ -347,8 +347,8 @@ std::string torque_tracking_table(const TorqueTrackingResult& r, const TorqueTra
   }
   s << "\n";
   for (TrackingScenario scenario : o.scenarios) {
-    const TorqueTrackingRun* c = r.find(scenario, LowLevelLoop::kCustom);
-    const TorqueTrackingRun* h = r.find(scenario, LowLevelLoop::kKinovaTorqueHighVelocity);
+    const TorqueTrackingRun* c = r.find(scenario, LowLevelMode::kCurrent);
+    const TorqueTrackingRun* h = r.find(scenario, LowLevelMode::kKinovaTorqueHighVelocity);
     if (c == nullptr || h == nullptr) continue;
     s << "- " << to_string(scenario) << ": high-velocity / custom = " << format_fixed(h->rms_Nm / c->rms_Nm, 2)
       << " (RMS), " << format_fixed(h->p95_Nm / c->p95_Nm, 2) << " (p95); true torque: "

@@ -1,8 +1,8 @@
 #pragma once
 // Torque-tracking experiment on the simulated Gen3, as in the paper (section "Evaluation",
 // "Torque tracking", Fig. torque-control-results): the norm of the joint torque tracking error
-// ||tau_d - tau_s|| over time, for the custom low-level torque loop (LowLevelLoop::kCustom) and
-// Kinova's "high-velocity" torque loop (the plant's emulation, LowLevelLoop::kKinovaTorqueHighVelocity),
+// ||tau_d - tau_s|| over time, for the custom low-level torque loop (LowLevelMode::kCurrent) and
+// Kinova's "high-velocity" torque loop (the plant's emulation, LowLevelMode::kKinovaTorqueHighVelocity),
 // in two scenarios:
 //
 // * static: the arm partially extended horizontally (the paper demo's posture target by default),
@@ -21,7 +21,7 @@
 // "true" uses the plant's noise-free transmitted torque. Statistics (RMS, 95th percentile, max of
 // the norm) are taken from `transient_s` after the switch to the loop under test to the end.
 //
-// Each run builds a fresh plant (same seed: same noise and mismatch) and a fresh ControlCycle.
+// Each run builds a fresh plant (same seed: same noise and mismatch) and a fresh Controller.
 //
 // What to expect from the static scenario in this framework: the inverse dynamics subtracts the
 // momentum observer's tau_ext, which at rest converges to g - tau_s, so tau_d = M qdd_d + tau_s
@@ -37,7 +37,7 @@
 // switching: a joint sliding slower than the velocity threshold gets static sign(qdd_d) or nothing
 // depending on whether |qdd_d| crosses the acceleration threshold, which noise makes chatter
 // (friction_velocity_threshold_rad_s lets a run try other thresholds).
-#include <phri/app/control_cycle_settings.hpp>
+#include <phri/control/controller_settings.hpp>
 #include <phri/control/compliance_mode.hpp>
 #include <phri/lowlevel/custom_torque_controller.hpp>
 #include <phri/lowlevel/low_level_controller.hpp>
@@ -81,7 +81,7 @@ struct TorqueTrackingOptions {
 
   // ---- protocol
   std::vector<TrackingScenario> scenarios = {TrackingScenario::kStatic, TrackingScenario::kDynamic};
-  std::vector<LowLevelLoop> loops = {LowLevelLoop::kCustom, LowLevelLoop::kKinovaTorqueHighVelocity};
+  std::vector<LowLevelMode> loops = {LowLevelMode::kCurrent, LowLevelMode::kKinovaTorqueHighVelocity};
   double position_phase_s = 1.0;   ///< position control before the switch (F/T bias, settling)
   double static_duration_s = 10.0; ///< after the switch
   double dynamic_duration_s = 20.0;///< after the switch (two periods of the 9 s triangle)
@@ -127,7 +127,7 @@ struct TorqueTrackingOptions {
 /// Statistics of one run (scenario x loop) over its statistics window.
 struct TorqueTrackingRun {
   TrackingScenario scenario = TrackingScenario::kStatic;
-  LowLevelLoop loop = LowLevelLoop::kCustom;
+  LowLevelMode loop = LowLevelMode::kCurrent;
   double rms_Nm = 0.0;        ///< of ||tau_d - tau_s|| (measured)
   double p95_Nm = 0.0;
   double max_Nm = 0.0;
@@ -149,7 +149,7 @@ struct TorqueTrackingResult {
   std::vector<std::string> files;
 
   /// The run of (scenario, loop); null if it was not run.
-  const TorqueTrackingRun* find(TrackingScenario scenario, LowLevelLoop loop) const;
+  const TorqueTrackingRun* find(TrackingScenario scenario, LowLevelMode loop) const;
   /// RMS of the high-velocity loop over the custom loop's in a scenario (0 if either is missing).
   double rms_ratio(TrackingScenario scenario) const;
 };

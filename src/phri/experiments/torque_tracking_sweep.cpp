@@ -1,6 +1,6 @@
 #include <phri/experiments/torque_tracking_sweep.hpp>
 
-#include <phri/core/config_error.hpp>
+#include <phri/core/error.hpp>
 #include <phri/experiments/experiment_files.hpp>
 
 #include <algorithm>
@@ -27,15 +27,15 @@ StaticSweepResult run_static_sweep(const StaticSweepOptions& o, std::ostream* pr
     for (std::uint64_t seed : o.mismatch_seeds) {
       TorqueTrackingOptions t = o.tracking;
       t.scenarios = {TrackingScenario::kStatic};
-      t.loops = {LowLevelLoop::kCustom, LowLevelLoop::kKinovaTorqueHighVelocity};
+      t.loops = {LowLevelMode::kCurrent, LowLevelMode::kKinovaTorqueHighVelocity};
       t.output_dir.clear();
       t.figure_script.clear();
       t.model_mismatch = true;
       t.torque_constant_error = f;
       t.mismatch_seed = seed;
       const TorqueTrackingResult r = run_torque_tracking(t, nullptr);
-      const TorqueTrackingRun* c = r.find(TrackingScenario::kStatic, LowLevelLoop::kCustom);
-      const TorqueTrackingRun* h = r.find(TrackingScenario::kStatic, LowLevelLoop::kKinovaTorqueHighVelocity);
+      const TorqueTrackingRun* c = r.find(TrackingScenario::kStatic, LowLevelMode::kCurrent);
+      const TorqueTrackingRun* h = r.find(TrackingScenario::kStatic, LowLevelMode::kKinovaTorqueHighVelocity);
       StaticSweepRow row;
       row.torque_constant_error = f;
       row.mismatch_seed = seed;

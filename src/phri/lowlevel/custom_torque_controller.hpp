@@ -21,7 +21,7 @@
 // Entering the loop from another mode is bumpless: reset() starts H(z) at rest and sets the
 // integrator so that the first current equals the current the drive was carrying (even beyond the
 // integrator's clamp: that entry offset then only leaks away, with time constant 1 / theta).
-#include <phri/lowlevel/discrete_transfer_function.hpp>
+#include <phri/core/discrete_transfer_function.hpp>
 #include <phri/lowlevel/friction_compensation.hpp>
 #include <phri/robot/actuator_table.hpp>
 

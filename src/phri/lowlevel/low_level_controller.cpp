@@ -8,7 +8,7 @@ constexpr double kTorqueBlendTime = 0.05;  // s
 }
 
 LowLevelController::LowLevelController(const ActuatorTable& actuators, const CustomTorqueSettings& custom,
-                                       LowLevelLoop initial)
+                                       LowLevelMode initial)
     : custom_(actuators, custom),
       period_s_(custom.period_s),
       loop_(initial),
@@ -28,7 +28,7 @@ void LowLevelController::update(const RobotState& state, const Eigen::VectorXd& 
   loop_ = requested_;
   started_ = true;
   switch (loop_) {
-    case LowLevelLoop::kPosition:
+    case LowLevelMode::kPosition:
       if (entering) {
         // Start the reference where the arm is, moving as it moves: no position step.
         q_ref_ = state.q_rad;
@@ -40,9 +40,9 @@ void LowLevelController::update(const RobotState& state, const Eigen::VectorXd& 
       command.mode = LowLevelMode::kPosition;
       command.q_rad = q_ref_;
       break;
-    case LowLevelLoop::kKinovaTorque:
-    case LowLevelLoop::kKinovaTorqueHighVelocity:
-      command.mode = loop_ == LowLevelLoop::kKinovaTorque ? LowLevelMode::kKinovaTorque
+    case LowLevelMode::kKinovaTorque:
+    case LowLevelMode::kKinovaTorqueHighVelocity:
+      command.mode = loop_ == LowLevelMode::kKinovaTorque ? LowLevelMode::kKinovaTorque
                                                           : LowLevelMode::kKinovaTorqueHighVelocity;
       // Bumpless: start from the torque the motors produce now, fade into tau_d. That torque is
       // the measured current in the vendor's own units (nominal K_T G_r, the constant its loop
@@ -59,7 +59,7 @@ void LowLevelController::update(const RobotState& state, const Eigen::VectorXd& 
       command.tau_Nm = tau_desired + torque_offset_;
       torque_offset_ *= offset_decay_;
       break;
-    case LowLevelLoop::kCustom:
+    case LowLevelMode::kCurrent:
       if (entering) {
         custom_.reset(state.current_A, tau_desired, qdd_desired, state.tau_sensor_Nm, state.qd_rad_s);
       } else {

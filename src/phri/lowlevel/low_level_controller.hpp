@@ -21,38 +21,17 @@
 #include <phri/robot/robot_command.hpp>
 #include <phri/robot/robot_state.hpp>
 
-#include <optional>
-#include <string_view>
 
 namespace phri {
 
-enum class LowLevelLoop { kPosition, kKinovaTorque, kKinovaTorqueHighVelocity, kCustom };
-
-constexpr std::string_view to_string(LowLevelLoop loop) {
-  switch (loop) {
-    case LowLevelLoop::kPosition: return "position";
-    case LowLevelLoop::kKinovaTorque: return "kinova_torque";
-    case LowLevelLoop::kKinovaTorqueHighVelocity: return "kinova_torque_high_velocity";
-    case LowLevelLoop::kCustom: return "custom";
-  }
-  return "unknown";
-}
-constexpr std::optional<LowLevelLoop> low_level_loop_from_string(std::string_view name) {
-  if (name == "position") return LowLevelLoop::kPosition;
-  if (name == "kinova_torque") return LowLevelLoop::kKinovaTorque;
-  if (name == "kinova_torque_high_velocity") return LowLevelLoop::kKinovaTorqueHighVelocity;
-  if (name == "custom") return LowLevelLoop::kCustom;
-  return std::nullopt;
-}
-
 class LowLevelController {
 public:
-  LowLevelController(const ActuatorTable& actuators, const CustomTorqueSettings& custom, LowLevelLoop initial);
+  LowLevelController(const ActuatorTable& actuators, const CustomTorqueSettings& custom, LowLevelMode initial);
 
   /// Switch to `loop` at the next update (no effect if it is already running).
-  void request(LowLevelLoop loop) { requested_ = loop; }
-  LowLevelLoop loop() const { return loop_; }
-  LowLevelLoop requested() const { return requested_; }
+  void request(LowLevelMode loop) { requested_ = loop; }
+  LowLevelMode loop() const { return loop_; }
+  LowLevelMode requested() const { return requested_; }
   int switch_count() const { return switches_; }
 
   /// One control period: the command for the running loop, in `command` (sized for the robot).
@@ -65,8 +44,8 @@ public:
 private:
   CustomTorqueController custom_;
   double period_s_;
-  LowLevelLoop loop_;
-  LowLevelLoop requested_;
+  LowLevelMode loop_;
+  LowLevelMode requested_;
   bool started_ = false;
   int switches_ = 0;
   Eigen::VectorXd q_ref_, qd_ref_;

@@ -1,6 +1,6 @@
 #include <phri/model/collision_model.hpp>
 
-#include <phri/core/config_error.hpp>
+#include <phri/core/error.hpp>
 #include <phri/model/algorithms.hpp>
 #include <phri/model/capsule_distance.hpp>
 

@@ -1,7 +1,7 @@
 // Model construction from URDF (urdfdom) with validation, and the small Model queries.
 #include <phri/model/model.hpp>
 
-#include <phri/core/config_error.hpp>
+#include <phri/core/error.hpp>
 
 #include <console_bridge/console.h>
 #include <urdf_parser/urdf_parser.h>

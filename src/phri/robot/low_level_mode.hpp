@@ -3,6 +3,7 @@
 // vendor's actuator control loops runs (Kinova Kortex low-level servoing, ActuatorConfig
 // ControlMode POSITION / TORQUE / TORQUE_HIGH_VELOCITY / CURRENT).
 #include <cstdint>
+#include <optional>
 #include <string_view>
 
 namespace phri {
@@ -28,15 +29,14 @@ constexpr std::string_view to_string(LowLevelMode mode) {
   return "invalid";
 }
 
-/// Parses the names of to_string; false when unknown.
-constexpr bool parse_low_level_mode(std::string_view name, LowLevelMode& mode) {
+/// Parses the names of to_string. "custom" (the paper's custom torque loop, which drives the motor
+/// current) is accepted for kCurrent.
+constexpr std::optional<LowLevelMode> low_level_mode_from_string(std::string_view name) {
+  if (name == "custom") return LowLevelMode::kCurrent;
   for (int i = 0; i < kLowLevelModeCount; ++i) {
-    if (to_string(static_cast<LowLevelMode>(i)) == name) {
-      mode = static_cast<LowLevelMode>(i);
-      return true;
-    }
+    if (to_string(static_cast<LowLevelMode>(i)) == name) return static_cast<LowLevelMode>(i);
   }
-  return false;
+  return std::nullopt;
 }
 
 }  // namespace phri

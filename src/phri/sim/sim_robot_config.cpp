@@ -1,6 +1,6 @@
 #include <phri/core/random_generator.hpp>
 #include <phri/core/yaml_reader.hpp>
-#include <phri/robot/sim_robot_config.hpp>
+#include <phri/sim/sim_robot_config.hpp>
 
 #include <cmath>
 #include <filesystem>

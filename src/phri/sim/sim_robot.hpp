@@ -41,11 +41,11 @@
 // A divergence of the physics (MuJoCo reports bad accelerations) latches RobotState::fault.
 #include <phri/core/random_generator.hpp>
 #include <phri/robot/actuator_table.hpp>
-#include <phri/robot/kinova_drive_emulator.hpp>
-#include <phri/robot/random_push_generator.hpp>
+#include <phri/sim/kinova_drive_emulator.hpp>
+#include <phri/sim/random_push_generator.hpp>
 #include <phri/robot/robot_interface.hpp>
-#include <phri/robot/sim_robot_config.hpp>
-#include <phri/robot/stick_slip_friction.hpp>
+#include <phri/sim/sim_robot_config.hpp>
+#include <phri/sim/stick_slip_friction.hpp>
 
 #include <Eigen/Core>
 

@@ -1,13 +1,13 @@
-#include <phri/app/control_cycle.hpp>
+#include <phri/control/controller.hpp>
 
-#include <phri/core/config_error.hpp>
+#include <phri/core/error.hpp>
 #include <phri/model/algorithms.hpp>
 
 #include <cmath>
 
 namespace phri {
 
-Model ControlCycle::load_model(const ControlCycleSettings& settings) {
+Model Controller::load_model(const ControllerSettings& settings) {
   ModelOptions options;
   ExtraFrame sensor;
   sensor.name = "ft_sensor";
@@ -21,7 +21,7 @@ Model ControlCycle::load_model(const ControlCycleSettings& settings) {
   return Model::from_urdf_file(settings.urdf_path, options);
 }
 
-WholeBodyQpSettings ControlCycle::qp_settings(const ControlCycleSettings& settings, const ActuatorTable& actuators) {
+WholeBodyQpSettings Controller::qp_settings(const ControllerSettings& settings, const ActuatorTable& actuators) {
   WholeBodyQpSettings qp = settings.qp;
   qp.end_effector_frame = settings.end_effector_frame;
   if (qp.torque_limit.size() == 0) {
@@ -43,7 +43,7 @@ WholeBodyQpSettings ControlCycle::qp_settings(const ControlCycleSettings& settin
 }
 
 namespace {
-ActuatorTable load_actuators(const ControlCycleSettings& settings, const Model& model) {
+ActuatorTable load_actuators(const ControllerSettings& settings, const Model& model) {
   ActuatorTable table = ActuatorTable::from_yaml_file(settings.actuators_path);
   if (table.size() != model.nq()) {
     throw ConfigError(settings.actuators_path, "joints",
@@ -60,7 +60,7 @@ ActuatorTable load_actuators(const ControlCycleSettings& settings, const Model& 
 }
 }  // namespace
 
-ControlCycle::ControlCycle(const ControlCycleSettings& settings)
+Controller::Controller(const ControllerSettings& settings)
     : settings_(settings),
       model_(load_model(settings)),
       data_(model_),
@@ -86,13 +86,13 @@ ControlCycle::ControlCycle(const ControlCycleSettings& settings)
       ft_torque_(Eigen::VectorXd::Zero(model_.nv())),
       ft_torque_low_(Eigen::VectorXd::Zero(model_.nv())),
       tau_ext_(Eigen::VectorXd::Zero(model_.nv())) {
-  if (!(settings.period_s > 0)) throw ConfigError("ControlCycleSettings", "period_s", "must be > 0");
-  if (!(settings.observer_gain > 0)) throw ConfigError("ControlCycleSettings", "observer_gain", "must be > 0");
+  if (!(settings.period_s > 0)) throw ConfigError("ControllerSettings", "period_s", "must be > 0");
+  if (!(settings.observer_gain > 0)) throw ConfigError("ControllerSettings", "observer_gain", "must be > 0");
 }
 
-void ControlCycle::set_compliance_mode(ComplianceMode mode) { pending_mode_ = mode; }
+void Controller::set_compliance_mode(ComplianceMode mode) { pending_mode_ = mode; }
 
-bool ControlCycle::state_usable(const RobotState& state) {
+bool Controller::state_usable(const RobotState& state) {
   if (state.q_rad.size() != model_.nq() || state.qd_rad_s.size() != model_.nv() ||
       state.tau_sensor_Nm.size() != model_.nv() || !state.joints.valid || !state.torque.valid ||
       !state.q_rad.allFinite() || !state.qd_rad_s.allFinite() || !state.tau_sensor_Nm.allFinite() ||
@@ -107,7 +107,7 @@ bool ControlCycle::state_usable(const RobotState& state) {
   return true;
 }
 
-CycleStatus ControlCycle::step(const RobotState& state, RobotCommand& command) {
+CycleStatus Controller::step(const RobotState& state, RobotCommand& command) {
   if (!state_usable(state)) {
     ++held_cycles_;
     // The previous command stays in `command`; before any, hold the measured pose if possible.
@@ -153,7 +153,7 @@ CycleStatus ControlCycle::step(const RobotState& state, RobotCommand& command) {
 
   // ---- QP and inverse dynamics. Under the robot's position loop the external torque is not fed
   // back: the stiff servo rejects it and the observer would only see servo effort.
-  const bool torque_loop = low_level_.requested() != LowLevelLoop::kPosition;
+  const bool torque_loop = low_level_.requested() != LowLevelMode::kPosition;
   if (settings_.external_torque_source == ExternalTorqueSource::kObserver) {
     tau_ext_ = observer_.external_torque();
   } else {

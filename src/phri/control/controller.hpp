@@ -1,15 +1,15 @@
 #pragma once
-// phri::ControlCycle: one control period of the paper's framework, data flowing one way
+// phri::Controller: one control period of the paper's framework, data flowing one way
 // (DESIGN.md section 2):
 //
 //   RobotState -> model terms (M, h, g, J, J̇q̇) -> momentum observer tau_ext, F/T wrench
 //              -> compliance mode (dual-compliance trigger) -> WholeBodyQp (qdd_d, tau_d)
 //              -> LowLevelController -> RobotCommand
 //
-// Built once from ControlCycleSettings (files loaded and checked at construction, ConfigError on
+// Built once from ControllerSettings (files loaded and checked at construction, ConfigError on
 // bad input); step() allocates nothing and never throws. Invalid or stale sensor data: the cycle
 // holds (the previous command is kept) and says so in status().
-#include <phri/app/control_cycle_settings.hpp>
+#include <phri/control/controller_settings.hpp>
 #include <phri/control/compliance_controller.hpp>
 #include <phri/control/momentum_observer.hpp>
 #include <phri/control/whole_body_qp.hpp>
@@ -42,16 +42,16 @@ constexpr std::string_view to_string(CycleStatus s) {
   return "unknown";
 }
 
-class ControlCycle {
+class Controller {
 public:
-  explicit ControlCycle(const ControlCycleSettings& settings);
+  explicit Controller(const ControllerSettings& settings);
 
   /// First call: takes the robot's state as the targets (hold where the arm is). Then one cycle.
   CycleStatus step(const RobotState& state, RobotCommand& command);
 
   // ---- live switches (gamepad, FSM, scripts); effective from the next step
   void set_compliance_mode(ComplianceMode mode);
-  void set_low_level_loop(LowLevelLoop loop) { low_level_.request(loop); }
+  void set_low_level_loop(LowLevelMode loop) { low_level_.request(loop); }
   void set_stiffness_scale(double scale) { compliance_.set_stiffness_scale(scale, qp_); }
 
   // ---- access
@@ -70,17 +70,17 @@ public:
   int sensor_frame() const { return sensor_frame_; }
   CycleStatus status() const { return status_; }
   long held_cycles() const { return held_cycles_; }
-  const ControlCycleSettings& settings() const { return settings_; }
+  const ControllerSettings& settings() const { return settings_; }
   bool started() const { return started_; }
   /// The wrench norm the dual-compliance trigger sees (low-passed).
   double trigger_wrench_norm() const { return trigger_wrench_norm_; }
 
 private:
-  static Model load_model(const ControlCycleSettings& settings);
-  static WholeBodyQpSettings qp_settings(const ControlCycleSettings& settings, const ActuatorTable& actuators);
+  static Model load_model(const ControllerSettings& settings);
+  static WholeBodyQpSettings qp_settings(const ControllerSettings& settings, const ActuatorTable& actuators);
   bool state_usable(const RobotState& state);
 
-  ControlCycleSettings settings_;
+  ControllerSettings settings_;
   Model model_;
   Data data_;
   ActuatorTable actuators_;

@@ -13,10 +13,10 @@
 // `actuators` is the nominal table of actuators.yaml (what the controller believes);
 // `actuator_overrides` and `friction_scale` make the plant's drives differ from it, and `mismatch`
 // perturbs the plant's link inertials relative to the URDF (model mismatch).
-#include <phri/core/config_error.hpp>
+#include <phri/core/error.hpp>
 #include <phri/robot/actuator_table.hpp>
-#include <phri/robot/external_force.hpp>
-#include <phri/robot/random_push_settings.hpp>
+#include <phri/sim/external_force.hpp>
+#include <phri/sim/random_push_settings.hpp>
 
 #include <Eigen/Core>
 

@@ -1,5 +1,5 @@
-#include <phri/core/config_error.hpp>
-#include <phri/robot/sim_scene.hpp>
+#include <phri/core/error.hpp>
+#include <phri/sim/sim_scene.hpp>
 
 #include <mujoco/mujoco.h>
 

@@ -30,10 +30,10 @@
 // * kCurrent — i = i_d (saturated only).
 //
 // All buffers are sized at construction; begin_cycle() and tick() do not allocate.
-#include <phri/lowlevel/discrete_transfer_function.hpp>
+#include <phri/core/discrete_transfer_function.hpp>
 #include <phri/robot/actuator_table.hpp>
 #include <phri/robot/robot_command.hpp>
-#include <phri/robot/sim_robot_config.hpp>
+#include <phri/sim/sim_robot_config.hpp>
 
 #include <Eigen/Core>
 

@@ -1,4 +1,4 @@
-#include <phri/core/config_error.hpp>
+#include <phri/core/error.hpp>
 
 namespace phri {
 namespace {

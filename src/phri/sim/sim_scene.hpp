@@ -14,7 +14,7 @@
 //
 // The arm's keyframes are removed (their qpos would not match once the drop mass adds a free
 // joint); the initial state comes from the plant configuration.
-#include <phri/robot/sim_robot_config.hpp>
+#include <phri/sim/sim_robot_config.hpp>
 
 #include <string>
 

@@ -1,5 +1,5 @@
 #pragma once
-// Everything ControlCycle needs, with the defaults of the paper's demo where it gives them.
+// Everything Controller needs, with the defaults of the paper's demo where it gives them.
 // configs/*.yaml fill it (app/Config); tests and experiments may also build it in code.
 #include <phri/control/compliance_controller.hpp>
 #include <phri/control/compliance_mode.hpp>
@@ -23,7 +23,7 @@ enum class ExternalTorqueSource {
   kFused,             ///< the paper's code: observer + high-pass of J^T F/T (complementary filter, pole K_O)
 };
 
-struct ControlCycleSettings {
+struct ControllerSettings {
   std::string urdf_path;       ///< the controller's (link-side) model
   std::string actuators_path;  ///< actuators.yaml: limits, rotor inertia, friction model
   std::string collision_path;  ///< collision.yaml; empty: no self-collision constraint
@@ -63,7 +63,7 @@ struct ControlCycleSettings {
   WrenchEstimatorSettings wrench;
   CustomTorqueSettings custom_torque;
   ComplianceMode initial_compliance = ComplianceMode::kNullSpace;
-  LowLevelLoop initial_loop = LowLevelLoop::kCustom;
+  LowLevelMode initial_loop = LowLevelMode::kCurrent;
 };
 
 }  // namespace phri

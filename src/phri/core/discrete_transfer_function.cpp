@@ -1,4 +1,4 @@
-#include <phri/lowlevel/discrete_transfer_function.hpp>
+#include <phri/core/discrete_transfer_function.hpp>
 
 #include <algorithm>
 #include <cmath>

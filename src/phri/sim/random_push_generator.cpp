@@ -1,4 +1,4 @@
-#include <phri/robot/random_push_generator.hpp>
+#include <phri/sim/random_push_generator.hpp>
 
 #include <Eigen/Geometry>
 

@@ -1,7 +1,7 @@
-#include <phri/core/config_error.hpp>
-#include <phri/robot/sim_robot.hpp>
-#include <phri/robot/link_inertial.hpp>
-#include <phri/robot/sim_scene.hpp>
+#include <phri/core/error.hpp>
+#include <phri/sim/sim_robot.hpp>
+#include <phri/sim/link_inertial.hpp>
+#include <phri/sim/sim_scene.hpp>
 
 #include <Eigen/Geometry>
 #include <mujoco/mujoco.h>

@@ -1,4 +1,4 @@
-#include <phri/robot/kinova_drive_emulator.hpp>
+#include <phri/sim/kinova_drive_emulator.hpp>
 
 #include <algorithm>
 
