@@ -513,3 +513,21 @@ TEST(ModelAllocation, AlgorithmsDoNotAllocate) {
 }
 
 }  // namespace
+
+TEST(ModelArguments, AWrongSizeIsAnArgumentErrorNamingTheFunctionAndTheSizes) {
+  const phri::Model model = phri::Model::from_urdf_file(kGen3Urdf);
+  phri::Data data(model);
+  const Eigen::VectorXd short_q = Eigen::VectorXd::Zero(model.nq() - 1);
+  try {
+    phri::forward_kinematics(model, data, short_q);
+    FAIL() << "no exception";
+  } catch (const phri::ArgumentError& e) {
+    EXPECT_STREQ(e.what(), "forward_kinematics: q has 6 entries, expected 7");
+  }
+  const Eigen::VectorXd q = Eigen::VectorXd::Zero(model.nq());
+  EXPECT_THROW(phri::rnea(model, data, q, q, short_q), phri::ArgumentError);
+  Eigen::MatrixXd jacobian(6, model.nv() + 1);
+  phri::forward_kinematics(model, data, q);
+  phri::update_frame_placements(model, data);
+  EXPECT_THROW(phri::frame_jacobian(model, data, 0, phri::ReferenceFrame::kWorld, jacobian), phri::Error);
+}

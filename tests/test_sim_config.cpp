@@ -213,8 +213,8 @@ TEST(DiscreteTransferFunction, KinovaFilterMatchesItsDifferenceEquation) {
 }
 
 TEST(DiscreteTransferFunction, RejectsBadCoefficients) {
-  EXPECT_THROW(phri::DiscreteTransferFunction({1.0}, {0.0, 1.0}), std::invalid_argument);
-  EXPECT_THROW(phri::DiscreteTransferFunction({1, 1, 1, 1, 1, 1, 1}, {1.0}), std::invalid_argument);
+  EXPECT_THROW(phri::DiscreteTransferFunction({1.0}, {0.0, 1.0}), phri::ConfigError);
+  EXPECT_THROW(phri::DiscreteTransferFunction({1, 1, 1, 1, 1, 1, 1}, {1.0}), phri::ConfigError);
   phri::DiscreteTransferFunction identity;
   EXPECT_DOUBLE_EQ(identity.step(3.5), 3.5);
 }

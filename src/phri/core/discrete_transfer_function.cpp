@@ -2,26 +2,26 @@
 
 #include <algorithm>
 #include <cmath>
-#include <stdexcept>
+#include <phri/core/error.hpp>
 
 namespace phri {
 
 DiscreteTransferFunction::DiscreteTransferFunction(std::span<const double> numerator,
                                                    std::span<const double> denominator) {
-  if (numerator.empty() || denominator.empty()) throw std::invalid_argument("transfer function: empty coefficients");
+  if (numerator.empty() || denominator.empty()) throw ConfigError("transfer function", "coefficients", "empty coefficients");
   if (numerator.size() > kMaxOrder + 1 || denominator.size() > kMaxOrder + 1) {
-    throw std::invalid_argument("transfer function: order above 5");
+    throw ConfigError("transfer function", "coefficients", "order above 5");
   }
   const double a0 = denominator[0];
-  if (a0 == 0.0 || !std::isfinite(a0)) throw std::invalid_argument("transfer function: a0 must be non-zero");
+  if (a0 == 0.0 || !std::isfinite(a0)) throw ConfigError("transfer function", "coefficients", "a0 must be non-zero");
   b_.fill(0.0);
   a_.fill(0.0);
   for (std::size_t i = 0; i < numerator.size(); ++i) {
-    if (!std::isfinite(numerator[i])) throw std::invalid_argument("transfer function: coefficient not finite");
+    if (!std::isfinite(numerator[i])) throw ConfigError("transfer function", "coefficients", "coefficient not finite");
     b_[i] = numerator[i] / a0;
   }
   for (std::size_t i = 0; i < denominator.size(); ++i) {
-    if (!std::isfinite(denominator[i])) throw std::invalid_argument("transfer function: coefficient not finite");
+    if (!std::isfinite(denominator[i])) throw ConfigError("transfer function", "coefficients", "coefficient not finite");
     a_[i] = denominator[i] / a0;
   }
   order_ = static_cast<int>(std::max(numerator.size(), denominator.size())) - 1;

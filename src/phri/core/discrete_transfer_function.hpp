@@ -21,7 +21,7 @@ public:
   /// Identity filter (y = x).
   DiscreteTransferFunction() = default;
   /// numerator = {b0, b1, ...}, denominator = {a0, a1, ...}; a0 != 0, at most kMaxOrder + 1 entries
-  /// each. Throws std::invalid_argument otherwise (configuration time only).
+  /// each. Throws phri::ConfigError otherwise (configuration time only).
   DiscreteTransferFunction(std::span<const double> numerator, std::span<const double> denominator);
   DiscreteTransferFunction(std::initializer_list<double> numerator, std::initializer_list<double> denominator)
       : DiscreteTransferFunction(std::span<const double>(numerator.begin(), numerator.size()),

@@ -2,7 +2,6 @@
 // For a chain, body i's parent is body i-1, so the backward sweeps are plain running sums.
 #include <phri/model/algorithms.hpp>
 
-#include <cassert>
 
 namespace phri {
 namespace {

@@ -3,7 +3,7 @@
 // change of coordinates: joint i's motion subspace S_i is expressed once, in world axes.
 #include <phri/model/algorithms.hpp>
 
-#include <cassert>
+#include <phri/core/error.hpp>
 
 namespace phri {
 namespace {
@@ -32,13 +32,14 @@ const Eigen::Isometry3d& frame_parent_placement(const Model& model, const Data& 
 }  // namespace
 
 void forward_kinematics(const Model& model, Data& data, const Eigen::VectorXd& q) {
-  assert(q.size() == model.nq());
+  check_size("forward_kinematics", "q", q.size(), model.nq());
   for (int i = 0; i < model.nq(); ++i) place_body(model, data, i, q[i]);
 }
 
 void forward_kinematics(const Model& model, Data& data, const Eigen::VectorXd& q,
                         const Eigen::VectorXd& qd) {
-  assert(q.size() == model.nq() && qd.size() == model.nv());
+  check_size("forward_kinematics", "q", q.size(), model.nq());
+  check_size("forward_kinematics", "qd", qd.size(), model.nv());
   for (int i = 0; i < model.nq(); ++i) {
     place_body(model, data, i, q[i]);
     auto v = data.body_velocities.col(i);
@@ -49,7 +50,7 @@ void forward_kinematics(const Model& model, Data& data, const Eigen::VectorXd& q
 
 void forward_kinematics(const Model& model, Data& data, const Eigen::VectorXd& q,
                         const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd) {
-  assert(qdd.size() == model.nv());
+  check_size("forward_kinematics", "qdd", qdd.size(), model.nv());
   forward_kinematics(model, data, q, qd);
   for (int i = 0; i < model.nq(); ++i) {
     const Vector6d s = data.motion_subspace.col(i);
@@ -112,7 +113,8 @@ Vector6d frame_acceleration(const Model& model, const Data& data, int frame_id, 
 
 void frame_jacobian(const Model& model, const Data& data, int frame_id, ReferenceFrame rf,
                     Eigen::Ref<Eigen::MatrixXd> jacobian) {
-  assert(jacobian.rows() == 6 && jacobian.cols() == model.nv());
+  check_size("frame_jacobian", "jacobian rows", jacobian.rows(), 6);
+  check_size("frame_jacobian", "jacobian cols", jacobian.cols(), model.nv());
   jacobian.setZero();
   const Frame& frame = model.frame(frame_id);
   const Eigen::Isometry3d& oMf = data.frame_placements[static_cast<std::size_t>(frame_id)];
@@ -132,9 +134,10 @@ void frame_jacobian(const Model& model, const Data& data, int frame_id, Referenc
   }
 }
 
-void body_point_linear_jacobian([[maybe_unused]] const Model& model, const Data& data, int body, const Eigen::Vector3d& point,
+void body_point_linear_jacobian(const Model& model, const Data& data, int body, const Eigen::Vector3d& point,
                                 Eigen::Ref<Eigen::MatrixXd> jacobian) {
-  assert(jacobian.rows() == 3 && jacobian.cols() == model.nv());
+  check_size("body_point_linear_jacobian", "jacobian rows", jacobian.rows(), 3);
+  check_size("body_point_linear_jacobian", "jacobian cols", jacobian.cols(), model.nv());
   jacobian.setZero();
   for (int j = 0; j <= body; ++j) {
     const auto s = data.motion_subspace.col(j);
