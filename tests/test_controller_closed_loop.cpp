@@ -123,7 +123,7 @@ public:
   double time_ = 0.0;
   double max_torque_step_ = 0.0;
   bool torque_within_limits_ = true;
-  phri::ControllerStatus status_ = phri::ControllerStatus::kOk;
+  phri::WholeBodyQpStatus status_ = phri::WholeBodyQpStatus::kOk;
 };
 
 TEST(ClosedLoop, NullSpaceComplianceElbowMovesEndEffectorHolds) {

@@ -68,8 +68,7 @@ public:
   }
   void step(const std::function<void()>& each = {}) {
     const phri::RobotState& state = robot_.read();
-    fsm_.update(state.time_s, state, cycle_);
-    cycle_.step(state, command_);
+    cycle_.step(state, fsm_.update(state.time_s, state, cycle_), command_);
     robot_.write(command_);
     if (transitions_.empty() || transitions_.back().state != fsm_.state()) {
       transitions_.push_back({state.time_s, fsm_.state()});
@@ -401,8 +400,7 @@ TEST(Fsm, DemoYamlSession) {
   double full_body_yield = 0.0;
   while (robot.state().time_s < config.run.duration_s && !fsm.finished()) {
     const phri::RobotState& state = robot.read();
-    fsm.update(state.time_s, state, cycle);
-    cycle.step(state, command);
+    cycle.step(state, fsm.update(state.time_s, state, cycle), command);
     robot.write(command);
     phri::fill_log_row(row, state, cycle, fsm);
     logger.push(row);

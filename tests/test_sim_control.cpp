@@ -50,7 +50,8 @@ public:
     const int n = static_cast<int>(std::lround(seconds / robot_.period_s()));
     for (int k = 0; k < n; ++k) {
       const phri::RobotState& state = robot_.read();
-      cycle_.step(state, command_);
+      cycle_.step(state, targets_, command_);
+      targets_.clear();
       robot_.write(command_);
       torque_ok_ &= (cycle_.qp().desired_torque().cwiseAbs().array() <= cycle_.qp().torque_limit().array() + 1e-6).all();
       if (each) each();
@@ -73,6 +74,7 @@ public:
   phri::SimRobot robot_;
   phri::Controller cycle_;
   phri::RobotCommand command_;
+  phri::ControllerTargets targets_{7};
   bool torque_ok_ = true;
 
 private:
@@ -227,7 +229,8 @@ TEST(SimControl, UnreachableTargetGivesBoundedSmoothTorquesAndTheCycleDoesNotAll
   rig.run(0.5);
   Eigen::Isometry3d far = rig.cycle_.qp().end_effector().target_pose();
   far.translation() = Eigen::Vector3d(1.5, 0.0, 0.4);  // out of reach: the arm stretches to a singularity
-  rig.cycle_.qp().end_effector().set_target(far);
+  rig.targets_.has_pose = true;
+  rig.targets_.pose = {far, phri::Vector6d::Zero(), phri::Vector6d::Zero()};
   double max_step = 0.0;
   Eigen::VectorXd last = rig.cycle_.qp().desired_torque();
   std::size_t allocations = 0;
@@ -265,7 +268,7 @@ TEST(SimControl, ComplianceModeSwitchesAreSmooth) {
     last = rig.cycle_.qp().desired_torque();
   });
   for (phri::ComplianceMode mode : modes) {
-    rig.cycle_.set_compliance_mode(mode);
+    rig.targets_.compliance_mode = mode;
     double segment = 0.0;
     int at = 0, k = 0;
     rig.run(0.5, [&]() {
@@ -306,13 +309,14 @@ TEST(SimControl, LowLevelLoopSwitchesBetweenEveryPairWhileMoving) {
     phri::Vector6d velocity = phri::Vector6d::Zero(), acceleration = phri::Vector6d::Zero();
     velocity[2] = 0.05 * w * std::cos(w * t);
     acceleration[2] = -0.05 * w * w * std::sin(w * t);
-    rig.cycle_.qp().end_effector().set_target(target, velocity, acceleration);
+    rig.targets_.has_pose = true;
+    rig.targets_.pose = {target, velocity, acceleration};
   };
   rig.run(1.0, follow);
   double worst_torque_step = 0.0, worst_speed = 0.0, worst_tracking = 0.0, worst_position_jump = 0.0;
   Eigen::VectorXd last_torque = rig.robot_.truth().tau_motor_Nm;
   for (L next : circuit) {
-    rig.cycle_.set_low_level_loop(next);
+    rig.targets_.low_level_mode = next;
     int k = 0;
     double step_here = 0.0, speed_here = 0.0, step_before = 0.0;
     rig.run(0.4, [&]() {

@@ -53,7 +53,7 @@ TEST_F(WholeBodyQpTest, UnconstrainedOptimumIsTheWeightedLeastSquaresSolution) {
   phri::WholeBodyQp qp(model_, nullptr, loose_settings());
   set_tasks(qp, 0.0, 0.0);
   const Eigen::VectorXd tau_ext = Eigen::VectorXd::Zero(7);
-  ASSERT_EQ(qp.update(model_, data_, q_, qd_, tau_ext, 1e-3), phri::ControllerStatus::kOk);
+  ASSERT_EQ(qp.update(model_, data_, q_, qd_, tau_ext, 1e-3), phri::WholeBodyQpStatus::kOk);
   const auto& ee = qp.end_effector();
   const double w = ee.weight(), w0 = qp.posture().weight();
   const Eigen::MatrixXd h = w * ee.jacobian().transpose() * ee.jacobian() +
@@ -118,7 +118,7 @@ TEST_F(WholeBodyQpTest, JointDamperAndTorqueLimitsBound) {
   posture[1] = 3.0;  // the posture pulls beyond the limit
   qp.posture().reset_gains(200.0, 10.0, 1.0, 0.0);
   qp.posture().set_target(posture);
-  ASSERT_EQ(qp.update(model_, data_, q, qd, Eigen::VectorXd::Zero(7), 1e-3), phri::ControllerStatus::kOk);
+  ASSERT_EQ(qp.update(model_, data_, q, qd, Eigen::VectorXd::Zero(7), 1e-3), phri::WholeBodyQpStatus::kOk);
   const double range = 4.48, d_s = 0.01 * range, d_i = 0.1 * range;
   const double xi = 0.9 * 1.3963, m = 1.8, lambda = 4 * m * m * xi / (d_i - d_s);
   const double bound = lambda * lambda / (4 * m * m) * (0.05 - d_s) - lambda * qd[1];
@@ -139,11 +139,11 @@ TEST_F(WholeBodyQpTest, JointDamperAndTorqueLimitsBound) {
 TEST_F(WholeBodyQpTest, InvalidInputHoldsTheLastCommandAndInfeasibleBrakes) {
   phri::WholeBodyQp qp(model_, nullptr, phri::WholeBodyQpSettings{});
   set_tasks(qp, 0.0, 1.0);
-  ASSERT_EQ(qp.update(model_, data_, q_, qd_, Eigen::VectorXd::Zero(7), 1e-3), phri::ControllerStatus::kOk);
+  ASSERT_EQ(qp.update(model_, data_, q_, qd_, Eigen::VectorXd::Zero(7), 1e-3), phri::WholeBodyQpStatus::kOk);
   const Eigen::VectorXd good = qp.desired_torque();
   Eigen::VectorXd bad = Eigen::VectorXd::Zero(7);
   bad[3] = std::numeric_limits<double>::quiet_NaN();
-  EXPECT_EQ(qp.update(model_, data_, q_, qd_, bad, 1e-3), phri::ControllerStatus::kInvalidInput);
+  EXPECT_EQ(qp.update(model_, data_, q_, qd_, bad, 1e-3), phri::WholeBodyQpStatus::kInvalidInput);
   EXPECT_EQ(qp.desired_torque(), good);
   // A push no torque can cancel within the limits while the dampers demand braking: infeasible.
   Eigen::VectorXd q = q_, qd = Eigen::VectorXd::Zero(7);
@@ -153,7 +153,7 @@ TEST_F(WholeBodyQpTest, InvalidInputHoldsTheLastCommandAndInfeasibleBrakes) {
   Eigen::VectorXd huge = Eigen::VectorXd::Zero(7);
   huge[1] = 500.0;
   const auto status = qp.update(model_, data_, q, qd, huge, 1e-3);
-  EXPECT_EQ(status, phri::ControllerStatus::kQpInfeasible);
+  EXPECT_EQ(status, phri::WholeBodyQpStatus::kQpInfeasible);
   EXPECT_TRUE(qp.desired_torque().allFinite());
   EXPECT_TRUE((qp.desired_torque().cwiseAbs().array() <= qp.torque_limit().array() + 1e-9).all());
   EXPECT_LT(qp.desired_acceleration()[1], 0.0);  // braking joint 2

@@ -14,8 +14,7 @@
 //   while (robot.state().time_s < config.run.duration_s && !fsm.finished()) {
 //     const phri::RobotState& state = robot.read();
 //     for (phri::Event e; gamepad.poll(e);) fsm.post(e);
-//     fsm.update(state.time_s, state, cycle);
-//     cycle.step(state, command);
+//     cycle.step(state, fsm.update(state.time_s, state, cycle), command);
 //     robot.write(command);
 //     if (logger) { phri::fill_log_row(row, state, cycle, fsm); row.cycle_time_s = ...; logger->push(row); }
 //     clock.wait_next();

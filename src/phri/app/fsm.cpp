@@ -71,6 +71,7 @@ Fsm::Fsm(const FsmSettings& settings, const Controller& cycle)
       data_(model_),
       ee_frame_(cycle.end_effector_frame()),
       queue_(settings.queue_capacity),
+      targets_(model_.nv()),
       after_startup_(settings.first_scenario),
       torque_loop_(settings.torque_loop),
       startup_handover_(settings.torque_loop),
@@ -102,17 +103,34 @@ double Fsm::joint_speed(const RobotState& state) const {
   return state.qd_rad_s.size() > 0 ? state.qd_rad_s.cwiseAbs().maxCoeff() : 0.0;
 }
 
-void Fsm::update(double t, const RobotState& state, Controller& cycle) {
+// The end-effector task's governed target as of the last cycle (a pose given this period has not
+// passed through its reference governor yet): where a new move starts from.
+const Eigen::Isometry3d& Fsm::pose_target(const Controller& cycle) const { return cycle.qp().end_effector().target_pose(); }
+
+const Eigen::VectorXd& Fsm::posture_target(const Controller& cycle) const {
+  return targets_.has_posture ? targets_.posture.q : cycle.qp().posture().target();
+}
+
+LowLevelMode Fsm::requested_loop(const Controller& cycle) const {
+  return targets_.low_level_mode.value_or(cycle.low_level().requested());
+}
+
+double Fsm::stiffness_scale(const Controller& cycle) const {
+  return targets_.stiffness_scale.value_or(cycle.compliance().stiffness_scale());
+}
+
+const ControllerTargets& Fsm::update(double t, const RobotState& state, const Controller& cycle) {
   last_event_ = -1;
+  targets_.clear();
   // The cycle's first step takes the arm's pose as its targets; the FSM takes over after it.
-  if (!cycle.started()) return;
+  if (!cycle.started()) return targets_;
   if (!initialised_) {
     initialised_ = true;
     if (settings_.startup.enabled) {
-      enter_startup(t, state, cycle);
+      enter_startup(t, state);
     } else {
       startup_complete_ = true;
-      cycle.set_low_level_loop(torque_loop_);
+      targets_.low_level_mode = torque_loop_;
       enter(after_startup_ == Scenario::kStatic ? FsmState::kStatic : FsmState::kDynamic, t, cycle);
     }
   }
@@ -133,15 +151,16 @@ void Fsm::update(double t, const RobotState& state, Controller& cycle) {
   run_motion(t, cycle);
   finished_ = stop_requested_ && state_ == FsmState::kStopped && !braking() &&
               joint_speed(state) < settings_.rest_speed_rad_s;
+  return targets_;
 }
 
 // ------------------------------------------------------------------------------------ events
-void Fsm::handle(Event event, double t, const RobotState& /*state*/, Controller& cycle) {
+void Fsm::handle(Event event, double t, const RobotState& /*state*/, const Controller& cycle) {
   last_event_ = code(event);
   ++events_handled_;
   const bool starting = state_ == FsmState::kStartup && !startup_complete_;
   if (const auto mode = compliance_of(event)) {
-    cycle.set_compliance_mode(*mode);
+    targets_.compliance_mode = *mode;
     return;
   }
   if (const auto loop = loop_of(event)) {
@@ -149,7 +168,7 @@ void Fsm::handle(Event event, double t, const RobotState& /*state*/, Controller&
     if (starting) {
       startup_handover_ = *loop;  // the start-up move itself stays in Position
     } else {
-      cycle.set_low_level_loop(*loop);
+      targets_.low_level_mode = *loop;
     }
     return;
   }
@@ -158,8 +177,7 @@ void Fsm::handle(Event event, double t, const RobotState& /*state*/, Controller&
       if (starting) {
         startup_handover_ = startup_handover_ == LowLevelMode::kPosition ? torque_loop_ : LowLevelMode::kPosition;
       } else {
-        cycle.set_low_level_loop(cycle.low_level().requested() == LowLevelMode::kPosition ? torque_loop_
-                                                                                          : LowLevelMode::kPosition);
+        targets_.low_level_mode = requested_loop(cycle) == LowLevelMode::kPosition ? torque_loop_ : LowLevelMode::kPosition;
       }
       return;
     case Event::kStaticScenario: request(FsmState::kStatic, t, cycle); return;
@@ -176,17 +194,17 @@ void Fsm::handle(Event event, double t, const RobotState& /*state*/, Controller&
       stop_requested_ = true;
       return;
     case Event::kStiffnessUp:
-      cycle.set_stiffness_scale(cycle.compliance().stiffness_scale() * settings_.stiffness_step);
+      targets_.stiffness_scale = stiffness_scale(cycle) * settings_.stiffness_step;
       return;
     case Event::kStiffnessDown:
-      cycle.set_stiffness_scale(cycle.compliance().stiffness_scale() / settings_.stiffness_step);
+      targets_.stiffness_scale = stiffness_scale(cycle) / settings_.stiffness_step;
       return;
     default: return;
   }
 }
 
 // A new state: at once when the reference rests, after a brake when it moves.
-void Fsm::request(FsmState next, double t, Controller& cycle) {
+void Fsm::request(FsmState next, double t, const Controller& cycle) {
   if (stop_requested_) return;  // the session is over: only compliance and loop events still act
   if (state_ == FsmState::kStartup && !startup_complete_ && next != FsmState::kStopped) {
     after_startup_ = next == FsmState::kStatic ? Scenario::kStatic : Scenario::kDynamic;
@@ -223,15 +241,15 @@ void Fsm::request(FsmState next, double t, Controller& cycle) {
   }
 }
 
-void Fsm::enter(FsmState next, double t, Controller& cycle) {
+void Fsm::enter(FsmState next, double t, const Controller& cycle) {
   state_ = next;
   state_entry_time_ = t;
   motion_start_ = t;
   switch (next) {
     case FsmState::kStatic: {
       const StaticScenarioSettings& s = settings_.static_scenario;
-      const Eigen::Isometry3d from = cycle.qp().end_effector().target_pose();
-      q_ref_ = cycle.qp().posture().target();
+      const Eigen::Isometry3d from = pose_target(cycle);
+      q_ref_ = posture_target(cycle);
       pose_move_.start(from, static_pose_, s.move_speed_m_s, s.move_angular_speed_rad_s, s.min_move_duration_s);
       joint_move_.start(q_ref_, static_q_, settings_.startup.max_joint_speed_rad_s, s.min_move_duration_s);
       // One duration for both, the longer.
@@ -242,8 +260,8 @@ void Fsm::enter(FsmState next, double t, Controller& cycle) {
       return;
     }
     case FsmState::kDynamic:
-      dynamic_.start(cycle.qp().end_effector().target_pose());
-      if (settings_.dynamic_scenario.compliance) cycle.set_compliance_mode(*settings_.dynamic_scenario.compliance);
+      dynamic_.start(pose_target(cycle));
+      if (settings_.dynamic_scenario.compliance) targets_.compliance_mode = *settings_.dynamic_scenario.compliance;
       motion_ = Motion::kTrajectory;
       return;
     case FsmState::kStopped:
@@ -253,46 +271,54 @@ void Fsm::enter(FsmState next, double t, Controller& cycle) {
   }
 }
 
-void Fsm::enter_startup(double t, const RobotState& state, Controller& cycle) {
+void Fsm::enter_startup(double t, const RobotState& state) {
   state_ = FsmState::kStartup;
   state_entry_time_ = t;
-  cycle.set_low_level_loop(LowLevelMode::kPosition);
+  targets_.low_level_mode = LowLevelMode::kPosition;
   q_ref_ = state.q_rad;
   joint_move_.start(q_ref_, home_q_, settings_.startup.max_joint_speed_rad_s, settings_.startup.min_duration_s);
   motion_ = Motion::kJointMove;
   motion_start_ = t;
 }
 
-void Fsm::finish_startup(double t, Controller& cycle, bool timed_out) {
+void Fsm::finish_startup(double t, const Controller& cycle, bool timed_out) {
   startup_complete_ = true;
   startup_timed_out_ = timed_out;
-  cycle.set_low_level_loop(startup_handover_);
+  targets_.low_level_mode = startup_handover_;
   enter(after_startup_ == Scenario::kStatic ? FsmState::kStatic : FsmState::kDynamic, t, cycle);
 }
 
 // ------------------------------------------------------------------------------------ references
-void Fsm::stream_joint_reference(Controller& cycle) {
-  cycle.qp().posture().set_target(q_ref_, qd_ref_, qdd_ref_);
+void Fsm::stream_joint_reference() {
+  set_posture_target();
   forward_kinematics(model_, data_, q_ref_, qd_ref_, qdd_ref_);
   update_frame_placements(model_, data_);
   pose_ref_.pose = data_.frame_placements[static_cast<std::size_t>(ee_frame_)];
   pose_ref_.velocity = frame_velocity(model_, data_, ee_frame_, ReferenceFrame::kLocalWorldAligned);
   pose_ref_.acceleration = frame_acceleration(model_, data_, ee_frame_, ReferenceFrame::kLocalWorldAligned);
-  stream_pose_reference(cycle);
+  stream_pose_reference();
 }
 
-void Fsm::stream_pose_reference(Controller& cycle) {
-  cycle.qp().end_effector().set_target(pose_ref_.pose, pose_ref_.velocity, pose_ref_.acceleration);
+void Fsm::set_posture_target() {
+  targets_.has_posture = true;
+  targets_.posture.q = q_ref_;
+  targets_.posture.qd = qd_ref_;
+  targets_.posture.qdd = qdd_ref_;
 }
 
-void Fsm::run_motion(double t, Controller& cycle) {
+void Fsm::stream_pose_reference() {
+  targets_.has_pose = true;
+  targets_.pose = pose_ref_;
+}
+
+void Fsm::run_motion(double t, const Controller& cycle) {
   const double elapsed = t - motion_start_;
   switch (motion_) {
     case Motion::kHold:
       return;
     case Motion::kJointMove:
       joint_move_.evaluate(elapsed, q_ref_, qd_ref_, qdd_ref_);
-      stream_joint_reference(cycle);
+      stream_joint_reference();
       if (elapsed >= joint_move_.duration()) {
         motion_ = Motion::kHold;
         motion_start_ = t;
@@ -300,9 +326,9 @@ void Fsm::run_motion(double t, Controller& cycle) {
       return;
     case Motion::kPoseMove:
       joint_move_.evaluate(elapsed, q_ref_, qd_ref_, qdd_ref_);
-      cycle.qp().posture().set_target(q_ref_, qd_ref_, qdd_ref_);
+      set_posture_target();
       pose_move_.evaluate(elapsed, pose_ref_);
-      stream_pose_reference(cycle);
+      stream_pose_reference();
       if (elapsed >= pose_move_.duration()) {
         motion_ = Motion::kHold;
         motion_start_ = t;
@@ -310,14 +336,14 @@ void Fsm::run_motion(double t, Controller& cycle) {
       return;
     case Motion::kTrajectory:
       dynamic_.evaluate(elapsed, pose_ref_);
-      stream_pose_reference(cycle);
+      stream_pose_reference();
       return;
     case Motion::kPoseBrake:
       pose_brake_.evaluate(elapsed, pose_ref_);
-      stream_pose_reference(cycle);
+      stream_pose_reference();
       if (posture_braking_) {
         joint_brake_.evaluate(elapsed, q_ref_, qd_ref_, qdd_ref_);
-        cycle.qp().posture().set_target(q_ref_, qd_ref_, qdd_ref_);
+        set_posture_target();
       }
       if (elapsed >= pose_brake_.duration() && (!posture_braking_ || elapsed >= joint_brake_.duration())) {
         posture_braking_ = false;
@@ -328,7 +354,7 @@ void Fsm::run_motion(double t, Controller& cycle) {
       return;
     case Motion::kJointBrake:
       joint_brake_.evaluate(elapsed, q_ref_, qd_ref_, qdd_ref_);
-      stream_joint_reference(cycle);
+      stream_joint_reference();
       if (elapsed >= joint_brake_.duration()) {
         motion_ = Motion::kHold;
         enter(pending_, t, cycle);

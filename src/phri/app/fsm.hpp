@@ -1,14 +1,15 @@
 #pragma once
 // phri::Fsm: the demo's state machine (paper, "Framework overview": the operator switches
 // compliance modes, low-level loops and scenarios live). It sits between the estimator and the
-// QP (DESIGN.md section 2) and drives a Controller each period:
+// QP (DESIGN.md section 2): each period it turns events into the controller's targets, plain
+// data (ControllerTargets) that Controller::step applies; it reads the controller, never changes it.
 //
-//   phri::Fsm fsm(settings, cycle);
+//   phri::Fsm fsm(settings, controller);
 //   for (;;) {
 //     const phri::RobotState& s = robot.read();
-//     for (phri::Event e; gamepad.poll(e);) fsm.post(e);    // operator events
-//     fsm.update(s.time_s, s, cycle);                       // timeline events, state, targets
-//     cycle.step(s, command);
+//     for (phri::Event e; gamepad.poll(e);) fsm.post(e);                 // operator events
+//     const phri::ControllerTargets& targets = fsm.update(s.time_s, s, controller);  // timeline, state
+//     controller.step(s, targets, command);
 //     robot.write(command);
 //   }
 //
@@ -30,7 +31,7 @@
 // next state starts from it, so no transition steps the reference velocity.
 //
 // Events (app/event.hpp) come from post() (the gamepad) and from the timeline (handled when the
-// robot time reaches them), and act at once: compliance modes (Controller::set_compliance_mode),
+// robot time reaches them), and act at once: compliance modes (ControllerTargets::compliance_mode),
 // stiffness up/down (x or / stiffness_step, ComplianceController clamps to [0.1, 4]), low-level
 // loops (during start-up: the loop to hand over to), scenarios, stops.
 //
@@ -87,8 +88,10 @@ public:
 
   /// Queues an event for the next update (one producer thread; false when the queue is full).
   bool post(Event event) noexcept;
-  /// Once per period, before cycle.step(state, ...). `time_s`: robot time (the timeline's clock).
-  void update(double time_s, const RobotState& state, Controller& cycle);
+  /// Once per period, before controller.step(state, targets, ...). `time_s`: robot time (the
+  /// timeline's clock). Returns this period's targets (also targets()).
+  const ControllerTargets& update(double time_s, const RobotState& state, const Controller& controller);
+  const ControllerTargets& targets() const { return targets_; }
 
   FsmState state() const { return state_; }
   /// The reference is being brought to rest before the next state.
@@ -113,21 +116,29 @@ public:
 private:
   enum class Motion { kHold, kJointMove, kPoseMove, kTrajectory, kPoseBrake, kJointBrake };
 
-  void handle(Event event, double t, const RobotState& state, Controller& cycle);
-  void request(FsmState next, double t, Controller& cycle);
-  void enter(FsmState next, double t, Controller& cycle);
-  void enter_startup(double t, const RobotState& state, Controller& cycle);
-  void finish_startup(double t, Controller& cycle, bool timed_out);
-  void run_motion(double t, Controller& cycle);
-  void stream_joint_reference(Controller& cycle);
-  void stream_pose_reference(Controller& cycle);
+  void handle(Event event, double t, const RobotState& state, const Controller& cycle);
+  void request(FsmState next, double t, const Controller& cycle);
+  void enter(FsmState next, double t, const Controller& cycle);
+  void enter_startup(double t, const RobotState& state);
+  void finish_startup(double t, const Controller& cycle, bool timed_out);
+  void run_motion(double t, const Controller& cycle);
+  void set_posture_target();
+  void stream_joint_reference();
+  void stream_pose_reference();
   double joint_speed(const RobotState& state) const;
+  // Targets as the controller will hold them: the posture given so far in this update, else the
+  // controller's; the end effector's governed target of the last cycle.
+  const Eigen::Isometry3d& pose_target(const Controller& cycle) const;
+  const Eigen::VectorXd& posture_target(const Controller& cycle) const;
+  LowLevelMode requested_loop(const Controller& cycle) const;
+  double stiffness_scale(const Controller& cycle) const;
 
   FsmSettings settings_;
   const Model& model_;
   Data data_;  // forward kinematics of joint references (start-up)
   int ee_frame_;
   SpscRing<Event> queue_;
+  ControllerTargets targets_;
   std::size_t next_timed_ = 0;
 
   FsmState state_ = FsmState::kStartup;

@@ -54,7 +54,7 @@ struct LogRow {
   std::int32_t fsm_state = -1;         ///< FsmState; -1: no FSM
   std::int32_t event = -1;             ///< Event handled in this cycle (the last one); -1: none
   std::int32_t cycle_status = 0;       ///< CycleStatus
-  std::int32_t controller_status = 0;  ///< ControllerStatus of the whole-body QP
+  std::int32_t controller_status = 0;  ///< WholeBodyQpStatus of the whole-body QP
   std::int32_t qp_status = 0;          ///< QpStatus of the solver
   std::int32_t qp_iterations = 0;
   double stiffness_scale = 1.0;

@@ -91,9 +91,9 @@ std::string Logger::legend_yaml() {
   }
   legend_entry(out, "cycle_status", {CycleStatus::kOk, CycleStatus::kQpFallback, CycleStatus::kInvalidState,
                                      CycleStatus::kStaleState});
-  legend_entry(out, "controller_status", {ControllerStatus::kOk, ControllerStatus::kQpInfeasible,
-                                          ControllerStatus::kQpIterationLimit, ControllerStatus::kQpFailed,
-                                          ControllerStatus::kInvalidInput});
+  legend_entry(out, "controller_status", {WholeBodyQpStatus::kOk, WholeBodyQpStatus::kQpInfeasible,
+                                          WholeBodyQpStatus::kQpIterationLimit, WholeBodyQpStatus::kQpFailed,
+                                          WholeBodyQpStatus::kInvalidInput});
   legend_entry(out, "qp_status", {QpStatus::kOptimal, QpStatus::kInfeasible, QpStatus::kIterationLimit,
                                   QpStatus::kInvalidInput, QpStatus::kNumericalError});
   return out;

@@ -64,8 +64,7 @@ RunSummary run_session(RobotInterface& robot, Controller& cycle, Fsm& fsm, Gamep
       Event event;
       while (gamepad->poll(event)) fsm.post(event);
     }
-    fsm.update(t, state, cycle);
-    const CycleStatus status = cycle.step(state, command);
+    const CycleStatus status = cycle.step(state, fsm.update(t, state, cycle), command);
     const double us = std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count();
     micros[k] = us;
     robot.write(command);

@@ -21,6 +21,7 @@
 // JointBrake (bring a moving reference to rest at a bounded deceleration with continuous velocity
 // and acceleration, so no scenario change steps the reference or the feed-forward).
 #include <phri/control/compliance_mode.hpp>
+#include <phri/control/controller_targets.hpp>
 #include <phri/model/model.hpp>
 #include <phri/model/spatial.hpp>
 
@@ -64,13 +65,6 @@ struct BrakeSettings {
   double angular_deceleration_rad_s2 = 2.0;
   double joint_deceleration_rad_s2 = 1.0;     ///< joint-space references (start-up move)
   double min_duration_s = 0.2;                ///< keeps the jerk of the initial acceleration's fade bounded
-};
-
-/// A reference for the end-effector task: pose, twist and acceleration, world axes, linear first.
-struct PoseReference {
-  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
-  Vector6d velocity = Vector6d::Zero();
-  Vector6d acceleration = Vector6d::Zero();
 };
 
 /// Minimum-jerk (quintic) time scaling: s(0) = 0, s(1) = 1, zero velocity and acceleration at

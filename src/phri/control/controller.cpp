@@ -7,7 +7,7 @@
 
 namespace phri {
 
-Model Controller::load_model(const ControllerSettings& settings) {
+ModelOptions Controller::model_options(const ControllerSettings& settings) {
   ModelOptions options;
   ExtraFrame sensor;
   sensor.name = "ft_sensor";
@@ -18,7 +18,7 @@ Model Controller::load_model(const ControllerSettings& settings) {
     if (payload.frame.empty()) payload.frame = settings.end_effector_frame;  // default: the end effector
     options.payloads.push_back(payload);
   }
-  return Model::from_urdf_file(settings.urdf_path, options);
+  return options;
 }
 
 WholeBodyQpSettings Controller::qp_settings(const ControllerSettings& settings, const ActuatorTable& actuators) {
@@ -43,54 +43,80 @@ WholeBodyQpSettings Controller::qp_settings(const ControllerSettings& settings, 
 }
 
 namespace {
-ActuatorTable load_actuators(const ControllerSettings& settings, const Model& model) {
-  ActuatorTable table = ActuatorTable::from_yaml_file(settings.actuators_path);
+// The actuator table must list the model's joints, in order.
+const ActuatorTable& checked(const ActuatorTable& table, const Model& model, const std::string& source) {
   if (table.size() != model.nq()) {
-    throw ConfigError(settings.actuators_path, "joints",
+    throw ConfigError(source, "joints",
                       std::to_string(table.size()) + " actuators for a model with " + std::to_string(model.nq()) + " joints");
   }
   for (int i = 0; i < model.nq(); ++i) {
     if (table[i].joint_name != model.joint(i).name) {
-      throw ConfigError(settings.actuators_path, "joints[" + std::to_string(i) + "].name",
+      throw ConfigError(source, "joints[" + std::to_string(i) + "].name",
                         "'" + table[i].joint_name + "' but the model's joint " + std::to_string(i + 1) + " is '" +
                             model.joint(i).name + "'");
     }
   }
   return table;
 }
+
+const ControllerSettings& checked(const ControllerSettings& settings) {
+  if (!(settings.period_s > 0)) throw ConfigError("ControllerSettings", "period_s", "must be > 0");
+  if (!(settings.observer_gain > 0)) throw ConfigError("ControllerSettings", "observer_gain", "must be > 0");
+  if (!(settings.wrench_trigger_filter_s >= 0)) throw ConfigError("ControllerSettings", "wrench_trigger_filter_s", "must be >= 0");
+  return settings;
+}
+
+CustomTorqueSettings custom_torque_settings(const ControllerSettings& settings) {
+  CustomTorqueSettings c = settings.custom_torque;
+  c.period_s = settings.period_s;
+  return c;
+}
+
 }  // namespace
 
-Controller::Controller(const ControllerSettings& settings)
-    : settings_(settings),
-      model_(load_model(settings)),
+Controller::LoadedRobot Controller::load(const ControllerSettings& settings) {
+  Model model = Model::from_urdf_file(settings.urdf_path, model_options(settings));
+  ActuatorTable actuators = ActuatorTable::from_yaml_file(settings.actuators_path);
+  std::optional<CollisionModel> collision;
+  if (!settings.collision_path.empty()) collision = CollisionModel::from_yaml_file(settings.collision_path, model);
+  return {std::move(model), std::move(actuators), std::move(collision), settings.actuators_path};
+}
+
+Controller::Controller(const ControllerSettings& settings) : Controller(load(settings), settings) {}
+
+Controller::Controller(Model model, ActuatorTable actuators, std::optional<CollisionModel> collision,
+                       const ControllerSettings& settings)
+    : Controller(LoadedRobot{std::move(model), std::move(actuators), std::move(collision), "ActuatorTable"}, settings) {}
+
+Controller::Controller(LoadedRobot robot, const ControllerSettings& settings)
+    : settings_(checked(settings)),
+      model_(std::move(robot.model)),
       data_(model_),
-      actuators_(load_actuators(settings, model_)),
-      collision_(settings.collision_path.empty()
-                     ? std::nullopt
-                     : std::optional<CollisionModel>(CollisionModel::from_yaml_file(settings.collision_path, model_))),
+      actuators_(checked(robot.actuators, model_, robot.actuators_source)),
+      collision_(std::move(robot.collision)),
       qp_(model_, collision_ ? &*collision_ : nullptr, qp_settings(settings, actuators_)),
       compliance_(settings.compliance),
       observer_(model_, settings.observer_gain),
       wrench_(settings.wrench),
-      low_level_(actuators_, [&] {
-        CustomTorqueSettings c = settings.custom_torque;
-        c.period_s = settings.period_s;
-        return c;
-      }(), settings.initial_loop),
+      low_level_(actuators_, custom_torque_settings(settings), settings.initial_loop),
       end_effector_frame_(model_.frame_id(settings.end_effector_frame)),
       sensor_frame_(model_.frame_id("ft_sensor")),
       q_(Eigen::VectorXd::Zero(model_.nq())),
       qd_(Eigen::VectorXd::Zero(model_.nv())),
-      zero_torque_(Eigen::VectorXd::Zero(model_.nv())),
       ee_jacobian_(Eigen::MatrixXd::Zero(6, model_.nv())),
       ft_torque_(Eigen::VectorXd::Zero(model_.nv())),
-      ft_torque_low_(Eigen::VectorXd::Zero(model_.nv())),
-      tau_ext_(Eigen::VectorXd::Zero(model_.nv())) {
-  if (!(settings.period_s > 0)) throw ConfigError("ControllerSettings", "period_s", "must be > 0");
-  if (!(settings.observer_gain > 0)) throw ConfigError("ControllerSettings", "observer_gain", "must be > 0");
-}
+      tau_ext_(Eigen::VectorXd::Zero(model_.nv())),
+      trigger_filter_(settings.wrench_trigger_filter_s, settings.period_s),
+      ft_fusion_(model_.nv(), settings.observer_gain, settings.period_s),
+      no_targets_(model_.nv()) {}
 
-void Controller::set_compliance_mode(ComplianceMode mode) { pending_mode_ = mode; }
+void Controller::apply(const ControllerTargets& targets) {
+  if (targets.stiffness_scale) compliance_.set_stiffness_scale(*targets.stiffness_scale, qp_);
+  if (targets.has_posture) qp_.posture().set_target(targets.posture.q, targets.posture.qd, targets.posture.qdd);
+  if (targets.has_pose) qp_.end_effector().set_target(targets.pose.pose, targets.pose.velocity, targets.pose.acceleration);
+  if (targets.compliance_mode) pending_mode_ = targets.compliance_mode;
+  if (targets.low_level_mode) low_level_.request(*targets.low_level_mode);
+}
 
 bool Controller::state_usable(const RobotState& state) {
   if (state.q_rad.size() != model_.nq() || state.qd_rad_s.size() != model_.nv() ||
@@ -107,7 +133,38 @@ bool Controller::state_usable(const RobotState& state) {
   return true;
 }
 
-CycleStatus Controller::step(const RobotState& state, RobotCommand& command) {
+// Model terms, momentum observer, F/T wrench at the end effector.
+void Controller::estimate(const RobotState& state) {
+  compute_all_terms(model_, data_, q_, qd_);
+  coriolis_transpose_times_velocity(model_, data_);
+  observer_.update(data_, qd_, state.tau_sensor_Nm, settings_.period_s);
+  if (state.wrench.valid && state.wrench.sequence != last_wrench_sequence_) {
+    last_wrench_sequence_ = state.wrench.sequence;
+    const Eigen::Isometry3d& sensor = data_.frame_placements[static_cast<std::size_t>(sensor_frame_)];
+    const Eigen::Isometry3d& ee = data_.frame_placements[static_cast<std::size_t>(end_effector_frame_)];
+    wrench_.update(state.wrench_sensor, sensor, ee.translation());
+  }
+}
+
+// tau_ext for the QP and the inverse dynamics, from the source the settings choose.
+void Controller::select_external_torque() {
+  if (settings_.external_torque_source == ExternalTorqueSource::kObserver) {
+    tau_ext_ = observer_.external_torque();
+    return;
+  }
+  // J^T of the operator's wrench at the end effector (world axes, about its origin).
+  frame_jacobian(model_, data_, end_effector_frame_, ReferenceFrame::kLocalWorldAligned, ee_jacobian_);
+  ft_torque_.noalias() = ee_jacobian_.transpose() * wrench_.wrench_world();
+  if (settings_.external_torque_source == ExternalTorqueSource::kForceTorqueSensor) {
+    tau_ext_ = ft_torque_;
+  } else {
+    // The paper's code: the F/T's fast part on top of the observer's (crossover at K_O).
+    tau_ext_ = ft_fusion_.update(observer_.external_torque(), ft_torque_);
+  }
+}
+
+CycleStatus Controller::step(const RobotState& state, const ControllerTargets& targets, RobotCommand& command) {
+  apply(targets);
   if (!state_usable(state)) {
     ++held_cycles_;
     // The previous command stays in `command`; before any, hold the measured pose if possible.
@@ -120,18 +177,7 @@ CycleStatus Controller::step(const RobotState& state, RobotCommand& command) {
   last_joint_sequence_ = state.joints.sequence;
   q_ = state.q_rad;
   qd_ = state.qd_rad_s;
-  const double dt = settings_.period_s;
-
-  // ---- estimate
-  compute_all_terms(model_, data_, q_, qd_);
-  coriolis_transpose_times_velocity(model_, data_);
-  observer_.update(data_, qd_, state.tau_sensor_Nm, dt);
-  if (state.wrench.valid && state.wrench.sequence != last_wrench_sequence_) {
-    last_wrench_sequence_ = state.wrench.sequence;
-    const Eigen::Isometry3d& sensor = data_.frame_placements[static_cast<std::size_t>(sensor_frame_)];
-    const Eigen::Isometry3d& ee = data_.frame_placements[static_cast<std::size_t>(end_effector_frame_)];
-    wrench_.update(state.wrench_sensor, sensor, ee.translation());
-  }
+  estimate(state);
 
   // ---- modes and targets
   if (!started_) {
@@ -146,35 +192,18 @@ CycleStatus Controller::step(const RobotState& state, RobotCommand& command) {
   // The trigger sees the wrench norm through a short low-pass (settings.wrench_trigger_filter_s):
   // single-sample spikes of the F/T signal (tool inertia during stick-slip jolts, noise) must not
   // free the end effector for a few milliseconds.
-  const double raw_norm = wrench_.calibrated() ? wrench_.norm() : 0.0;
-  const double alpha = dt / (settings_.wrench_trigger_filter_s + dt);
-  trigger_wrench_norm_ += alpha * (raw_norm - trigger_wrench_norm_);
-  compliance_.update(trigger_wrench_norm_, qp_, data_);
+  compliance_.update(trigger_filter_.update(wrench_.calibrated() ? wrench_.norm() : 0.0), qp_, data_);
 
   // ---- QP and inverse dynamics. Under the robot's position loop the external torque is not fed
   // back: the stiff servo rejects it and the observer would only see servo effort.
-  const bool torque_loop = low_level_.requested() != LowLevelMode::kPosition;
-  if (settings_.external_torque_source == ExternalTorqueSource::kObserver) {
-    tau_ext_ = observer_.external_torque();
-  } else {
-    // J^T of the operator's wrench at the end effector (world axes, about its origin).
-    frame_jacobian(model_, data_, end_effector_frame_, ReferenceFrame::kLocalWorldAligned, ee_jacobian_);
-    ft_torque_.noalias() = ee_jacobian_.transpose() * wrench_.wrench_world();
-    if (settings_.external_torque_source == ExternalTorqueSource::kForceTorqueSensor) {
-      tau_ext_ = ft_torque_;
-    } else {
-      // Complementary filter: the F/T's fast part on top of the observer's (pole K_O).
-      ft_torque_low_ += (1.0 - std::exp(-settings_.observer_gain * dt)) * (ft_torque_ - ft_torque_low_);
-      tau_ext_ = observer_.external_torque() + ft_torque_ - ft_torque_low_;
-    }
-  }
-  if (!torque_loop) tau_ext_.setZero();
-  const ControllerStatus qp_status = qp_.update(model_, data_, q_, qd_, tau_ext_, dt);
+  select_external_torque();
+  if (low_level_.requested() == LowLevelMode::kPosition) tau_ext_.setZero();
+  const WholeBodyQpStatus qp_status = qp_.update(model_, data_, q_, qd_, tau_ext_, settings_.period_s);
 
   // ---- low level
   low_level_.update(state, qp_.desired_torque(), qp_.desired_acceleration(), command);
   have_command_ = true;
-  status_ = qp_status == ControllerStatus::kOk ? CycleStatus::kOk : CycleStatus::kQpFallback;
+  status_ = qp_status == WholeBodyQpStatus::kOk ? CycleStatus::kOk : CycleStatus::kQpFallback;
   return status_;
 }
 

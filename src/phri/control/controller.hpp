@@ -6,14 +6,18 @@
 //              -> compliance mode (dual-compliance trigger) -> WholeBodyQp (qdd_d, tau_d)
 //              -> LowLevelController -> RobotCommand
 //
-// Built once from ControllerSettings (files loaded and checked at construction, ConfigError on
-// bad input); step() allocates nothing and never throws. Invalid or stale sensor data: the cycle
-// holds (the previous command is kept) and says so in status().
+// Built from loaded objects (Model, ActuatorTable, CollisionModel) or from the files named in
+// ControllerSettings (ConfigError on bad input). step() allocates nothing and never throws. Invalid
+// or stale sensor data: the cycle holds (the previous command is kept) and says so in status().
+// Everything that changes the controller at run time arrives in ControllerTargets: the FSM, the
+// gamepad, a dashboard or a script never reach into its stages.
 #include <phri/control/controller_settings.hpp>
+#include <phri/control/controller_targets.hpp>
 #include <phri/control/compliance_controller.hpp>
 #include <phri/control/momentum_observer.hpp>
 #include <phri/control/whole_body_qp.hpp>
 #include <phri/control/wrench_estimator.hpp>
+#include <phri/core/filters.hpp>
 #include <phri/lowlevel/low_level_controller.hpp>
 #include <phri/model/collision_model.hpp>
 #include <phri/model/model.hpp>
@@ -44,20 +48,25 @@ constexpr std::string_view to_string(CycleStatus s) {
 
 class Controller {
 public:
+  /// Loads settings.urdf_path (with model_options(settings)), actuators_path and collision_path.
   explicit Controller(const ControllerSettings& settings);
+  /// From loaded objects. `model` must have the settings' end-effector frame and the "ft_sensor"
+  /// frame (build it with model_options(settings)); `actuators` one entry per joint, in order;
+  /// `collision` built on the same model, or none. The settings' file paths are not used.
+  Controller(Model model, ActuatorTable actuators, std::optional<CollisionModel> collision,
+             const ControllerSettings& settings);
+  /// The model options the controller needs: the F/T sensor frame and the payloads.
+  static ModelOptions model_options(const ControllerSettings& settings);
 
-  /// First call: takes the robot's state as the targets (hold where the arm is). Then one cycle.
-  CycleStatus step(const RobotState& state, RobotCommand& command);
+  /// One cycle: apply the targets, then estimate, QP, inverse dynamics, low level. The first
+  /// usable state becomes the targets (hold where the arm is) before the given ones apply.
+  CycleStatus step(const RobotState& state, const ControllerTargets& targets, RobotCommand& command);
+  /// One cycle with no new targets.
+  CycleStatus step(const RobotState& state, RobotCommand& command) { return step(state, no_targets_, command); }
 
-  // ---- live switches (gamepad, FSM, scripts); effective from the next step
-  void set_compliance_mode(ComplianceMode mode);
-  void set_low_level_loop(LowLevelMode loop) { low_level_.request(loop); }
-  void set_stiffness_scale(double scale) { compliance_.set_stiffness_scale(scale, qp_); }
-
-  // ---- access
+  // ---- access (read only)
   const Model& model() const { return model_; }
   const Data& data() const { return data_; }
-  WholeBodyQp& qp() { return qp_; }
   const WholeBodyQp& qp() const { return qp_; }
   const ComplianceController& compliance() const { return compliance_; }
   const MomentumObserver& observer() const { return observer_; }
@@ -73,12 +82,22 @@ public:
   const ControllerSettings& settings() const { return settings_; }
   bool started() const { return started_; }
   /// The wrench norm the dual-compliance trigger sees (low-passed).
-  double trigger_wrench_norm() const { return trigger_wrench_norm_; }
+  double trigger_wrench_norm() const { return trigger_filter_.value(); }
 
 private:
-  static Model load_model(const ControllerSettings& settings);
+  struct LoadedRobot {
+    Model model;
+    ActuatorTable actuators;
+    std::optional<CollisionModel> collision;
+    std::string actuators_source;  // for error messages
+  };
+  static LoadedRobot load(const ControllerSettings& settings);
+  Controller(LoadedRobot robot, const ControllerSettings& settings);
   static WholeBodyQpSettings qp_settings(const ControllerSettings& settings, const ActuatorTable& actuators);
+  void apply(const ControllerTargets& targets);
   bool state_usable(const RobotState& state);
+  void estimate(const RobotState& state);
+  void select_external_torque();
 
   ControllerSettings settings_;
   Model model_;
@@ -92,7 +111,7 @@ private:
   LowLevelController low_level_;
   int end_effector_frame_ = 0;
   int sensor_frame_ = 0;
-  Eigen::VectorXd q_, qd_, zero_torque_;
+  Eigen::VectorXd q_, qd_;
   std::uint32_t last_joint_sequence_ = 0;
   std::uint32_t last_wrench_sequence_ = 0;
   bool started_ = false;
@@ -100,9 +119,11 @@ private:
   std::optional<ComplianceMode> pending_mode_;
   CycleStatus status_ = CycleStatus::kOk;
   long held_cycles_ = 0;
-  double trigger_wrench_norm_ = 0.0;
   Eigen::MatrixXd ee_jacobian_;              // 6 x nv, for J^T F
-  Eigen::VectorXd ft_torque_, ft_torque_low_, tau_ext_;
+  Eigen::VectorXd ft_torque_, tau_ext_;
+  LowPassFilter trigger_filter_;       // the wrench norm the dual-compliance trigger sees
+  ComplementaryFilter ft_fusion_;      // observer (low) + J^T F/T (high), ExternalTorqueSource::kFused
+  ControllerTargets no_targets_;
 };
 
 }  // namespace phri

@@ -95,11 +95,11 @@ void WholeBodyQp::joint_bounds(const Eigen::VectorXd& q, const Eigen::VectorXd& 
   }
 }
 
-ControllerStatus WholeBodyQp::update(const Model& model, const Data& data, const Eigen::VectorXd& q,
+WholeBodyQpStatus WholeBodyQp::update(const Model& model, const Data& data, const Eigen::VectorXd& q,
                                      const Eigen::VectorXd& qd, const Eigen::VectorXd& tau_ext, double dt) {
   if (!q.allFinite() || !qd.allFinite() || !tau_ext.allFinite() || !data.mass_matrix.allFinite()) {
     tau_desired_ = last_good_tau_;
-    status_ = ControllerStatus::kInvalidInput;
+    status_ = WholeBodyQpStatus::kInvalidInput;
     return status_;
   }
   // qdd_ext = M^-1 tau_ext: what the push alone would do to the arm (through the dead band).
@@ -150,13 +150,13 @@ ControllerStatus WholeBodyQp::update(const Model& model, const Data& data, const
     tau_desired_.noalias() = data.mass_matrix * qdd_desired_;
     tau_desired_ += data.nonlinear_effects - tau_ext;
     last_good_tau_ = tau_desired_;
-    status_ = ControllerStatus::kOk;
+    status_ = WholeBodyQpStatus::kOk;
     return status_;
   }
   warm_ = false;
-  status_ = qp == QpStatus::kInfeasible       ? ControllerStatus::kQpInfeasible
-            : qp == QpStatus::kIterationLimit ? ControllerStatus::kQpIterationLimit
-                                              : ControllerStatus::kQpFailed;
+  status_ = qp == QpStatus::kInfeasible       ? WholeBodyQpStatus::kQpInfeasible
+            : qp == QpStatus::kIterationLimit ? WholeBodyQpStatus::kQpIterationLimit
+                                              : WholeBodyQpStatus::kQpFailed;
   fallback_brake(data, qd, tau_ext);
   return status_;
 }

@@ -65,20 +65,20 @@ struct WholeBodyQpSettings {
   double smoothing_time_constant = 0.1;  ///< s, of the tasks' gain filters
 };
 
-enum class ControllerStatus {
+enum class WholeBodyQpStatus {
   kOk,
   kQpInfeasible,       ///< fallback brake used
   kQpIterationLimit,   ///< fallback brake used
   kQpFailed,           ///< invalid QP data (NaN) or numerical error: fallback brake used
   kInvalidInput,       ///< non-finite state or tau_ext: last finite command held
 };
-constexpr std::string_view to_string(ControllerStatus status) {
+constexpr std::string_view to_string(WholeBodyQpStatus status) {
   switch (status) {
-    case ControllerStatus::kOk: return "ok";
-    case ControllerStatus::kQpInfeasible: return "qp_infeasible";
-    case ControllerStatus::kQpIterationLimit: return "qp_iteration_limit";
-    case ControllerStatus::kQpFailed: return "qp_failed";
-    case ControllerStatus::kInvalidInput: return "invalid_input";
+    case WholeBodyQpStatus::kOk: return "ok";
+    case WholeBodyQpStatus::kQpInfeasible: return "qp_infeasible";
+    case WholeBodyQpStatus::kQpIterationLimit: return "qp_iteration_limit";
+    case WholeBodyQpStatus::kQpFailed: return "qp_failed";
+    case WholeBodyQpStatus::kInvalidInput: return "invalid_input";
   }
   return "unknown";
 }
@@ -95,13 +95,13 @@ public:
 
   /// One control cycle. `data`: after compute_all_terms(q, qd) on the controller's (link-side)
   /// model; tau_ext: estimated external torque. Returns the status; results below.
-  ControllerStatus update(const Model& model, const Data& data, const Eigen::VectorXd& q, const Eigen::VectorXd& qd,
+  WholeBodyQpStatus update(const Model& model, const Data& data, const Eigen::VectorXd& q, const Eigen::VectorXd& qd,
                           const Eigen::VectorXd& tau_ext, double dt);
 
   const Eigen::VectorXd& desired_acceleration() const { return qdd_desired_; }
   const Eigen::VectorXd& desired_torque() const { return tau_desired_; }
   const Eigen::VectorXd& external_acceleration() const { return qdd_external_; }
-  ControllerStatus status() const { return status_; }
+  WholeBodyQpStatus status() const { return status_; }
   QpStatus qp_status() const { return solver_.status(); }
   int qp_iterations() const { return solver_.iterations(); }
   const CollisionData* collision_data() const { return collision_data_ ? &*collision_data_ : nullptr; }
@@ -131,7 +131,7 @@ private:
   Eigen::VectorXd deadband_;
   Eigen::VectorXd qdd_external_, qdd_desired_, tau_desired_, last_good_tau_;
   Eigen::MatrixXd weighted_jacobian_;  // 6 x nv scratch
-  ControllerStatus status_ = ControllerStatus::kOk;
+  WholeBodyQpStatus status_ = WholeBodyQpStatus::kOk;
   bool warm_ = false;
 };
 

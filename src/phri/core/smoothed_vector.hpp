@@ -2,6 +2,8 @@
 // A vector parameter that moves toward its target with a first-order response, so that a gain,
 // weight or gamma changed at run time never steps the commanded torque. With time constant T and
 // period dt, each step moves a fraction dt / (T + dt) of the remaining distance (backward Euler).
+#include <phri/core/filters.hpp>
+
 #include <Eigen/Core>
 
 namespace phri {
@@ -24,8 +26,7 @@ public:
   void set_time_constant(double seconds) { time_constant_ = seconds; }
 
   void step(double dt) {
-    const double alpha = time_constant_ > 0.0 ? dt / (time_constant_ + dt) : 1.0;
-    value_ += alpha * (target_ - value_);
+    value_ += low_pass_gain(time_constant_, dt) * (target_ - value_);
   }
   const Eigen::VectorXd& value() const { return value_; }
   const Eigen::VectorXd& target() const { return target_; }

@@ -191,8 +191,10 @@ TorqueTrackingRun run_one(const TorqueTrackingOptions& o, TrackingScenario scena
   Eigen::Isometry3d start = Eigen::Isometry3d::Identity();
   long fallbacks = 0;
 
+  ControllerTargets targets(n);
   for (int k = 0; k < position_cycles + test_cycles + 1; ++k) {
     const RobotState& state = robot.read();
+    targets.clear();
     const int after = k - position_cycles;  // cycles since the switch (the switch happens at after == 0)
     if (after >= 1) {
       // The previous cycle's set-point against what the sensors read at the end of its period.
@@ -215,7 +217,7 @@ TorqueTrackingRun run_one(const TorqueTrackingOptions& o, TrackingScenario scena
       }
     }
     if (after == 0) {
-      cycle.set_low_level_loop(loop);
+      targets.low_level_mode = loop;
       start = cycle.qp().end_effector().target_pose();
       if (progress) {
         *progress << "  " << to_string(scenario) << " / " << loop_name(loop) << ": switched from position control at t = "
@@ -227,12 +229,13 @@ TorqueTrackingRun run_one(const TorqueTrackingOptions& o, TrackingScenario scena
       trajectory.at((after - delay) * dt, offset, velocity, acceleration);
       Eigen::Isometry3d target = start;
       target.translation() += offset.head<3>();
-      cycle.qp().end_effector().set_target(target, velocity, acceleration);
+      targets.has_pose = true;
+      targets.pose = {target, velocity, acceleration};
     }
-    if (cycle.step(state, command) == CycleStatus::kQpFallback) ++fallbacks;
+    if (cycle.step(state, targets, command) == CycleStatus::kQpFallback) ++fallbacks;
     tau_desired_prev = cycle.qp().desired_torque();
     robot.write(command);
-    if (state.fault) throw ConfigError("SimRobot", "torque tracking", "the simulated plant faulted");
+    if (state.fault) throw ExperimentError("torque tracking", "the simulated plant faulted");
   }
   simulated += robot.state().time_s;
 
