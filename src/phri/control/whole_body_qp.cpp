@@ -1,31 +1,21 @@
 #include <phri/control/whole_body_qp.hpp>
 
 #include <phri/core/error.hpp>
+#include <phri/core/filters.hpp>
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
 namespace phri {
-namespace {
-constexpr double kInf = std::numeric_limits<double>::infinity();
-}
-
-WholeBodyQp::WholeBodyQp(const Model& model, const CollisionModel* collision, const WholeBodyQpSettings& settings)
-    : settings_(settings),
-      collision_(collision),
-      end_effector_(model, model.frame_id(settings.end_effector_frame), settings.smoothing_time_constant),
-      posture_(model, settings.smoothing_time_constant),
-      nv_(model.nv()),
-      num_pairs_(collision ? collision->num_pairs() : 0) {
-  const std::string where = "WholeBodyQpSettings";
-  auto fail = [&](const std::string& key, const std::string& reason) { throw ConfigError(where, key, reason); };
-  torque_limit_ = settings.torque_limit.size() ? settings.torque_limit : model.effort_limits();
-  velocity_limit_ = settings.velocity_limit.size() ? settings.velocity_limit : model.velocity_limits();
-  if (torque_limit_.size() != nv_) fail("torque_limit", "needs one value per joint");
-  if (velocity_limit_.size() != nv_) fail("velocity_limit", "needs one value per joint");
-  if (!(torque_limit_.array() > 0).all() || !torque_limit_.allFinite()) fail("torque_limit", "must be finite and > 0");
-  if (!(velocity_limit_.array() > 0).all() || !velocity_limit_.allFinite()) {
+WholeBodyQp::Limits WholeBodyQp::checked_limits(const Model& model, const WholeBodyQpSettings& settings) {
+  auto fail = [](const std::string& key, const std::string& reason) { throw ConfigError("WholeBodyQpSettings", key, reason); };
+  Limits limits{settings.torque_limit.size() ? settings.torque_limit : model.effort_limits(),
+                settings.velocity_limit.size() ? settings.velocity_limit : model.velocity_limits()};
+  if (limits.torque.size() != model.nv()) fail("torque_limit", "needs one value per joint");
+  if (limits.velocity.size() != model.nv()) fail("velocity_limit", "needs one value per joint");
+  if (!(limits.torque.array() > 0).all() || !limits.torque.allFinite()) fail("torque_limit", "must be finite and > 0");
+  if (!(limits.velocity.array() > 0).all() || !limits.velocity.allFinite()) {
     fail("velocity_limit", "must be finite and > 0 (the URDF gives none for some joint: set it)");
   }
   if (!(settings.velocity_limit_fraction > 0 && settings.velocity_limit_fraction <= 1)) fail("velocity_limit_fraction", "must be in (0, 1]");
@@ -39,59 +29,61 @@ WholeBodyQp::WholeBodyQp(const Model& model, const CollisionModel* collision, co
     fail("collision", "need 0 <= safety_distance < influence_distance, xi > 0, amortization >= 1");
   }
   if (!(settings.velocity_limit_gain > 0) || !(settings.brake_damping > 0)) fail("velocity_limit_gain", "gains must be > 0");
-  velocity_limit_ *= settings.velocity_limit_fraction;
-  deadband_ = settings.compliance_deadband.size() ? settings.compliance_deadband : Eigen::VectorXd::Zero(nv_);
-  if (deadband_.size() != nv_ || !(deadband_.array() >= 0).all() || !deadband_.allFinite()) {
+  if (settings.compliance_deadband.size() &&
+      (settings.compliance_deadband.size() != model.nv() || !(settings.compliance_deadband.array() >= 0).all() ||
+       !settings.compliance_deadband.allFinite())) {
     fail("compliance_deadband", "needs one finite value >= 0 per joint");
   }
+  limits.velocity *= settings.velocity_limit_fraction;
+  return limits;
+}
 
-  lower_ = model.lower_limits();
-  upper_ = model.upper_limits();
-  influence_ = Eigen::VectorXd::Zero(nv_);
-  safety_ = Eigen::VectorXd::Zero(nv_);
-  lambda_ = Eigen::VectorXd::Constant(nv_, settings.velocity_limit_gain);
-  safe_lower_ = Eigen::VectorXd::Constant(nv_, -kInf);
-  safe_upper_ = Eigen::VectorXd::Constant(nv_, kInf);
-  for (int i = 0; i < nv_; ++i) {
-    if (!model.joint(i).has_position_limits()) continue;
-    const double range = upper_[i] - lower_[i];
-    influence_[i] = settings.joint_influence_fraction * range;
-    safety_[i] = settings.joint_safety_fraction * range;
-    const VelocityDamperSettings damper{influence_[i], safety_[i], velocity_limit_[i], settings.joint_damper_amortization};
-    lambda_[i] = damper.lambda();
-    safe_lower_[i] = lower_[i] + safety_[i];
-    safe_upper_[i] = upper_[i] - safety_[i];
+namespace {
+// The velocity limit's rate per joint: its joint-limit damper's lambda, or the set gain.
+Eigen::VectorXd velocity_limit_gains(const JointLimitConstraint& joint_limits, double gain, int nv) {
+  Eigen::VectorXd gains = Eigen::VectorXd::Constant(nv, gain);
+  for (int i = 0; i < nv; ++i) {
+    if (joint_limits.limited(i)) gains[i] = joint_limits.lambda(i);
   }
-  if (collision_) collision_data_.emplace(model, *collision_);
+  return gains;
+}
+}  // namespace
 
+WholeBodyQp::WholeBodyQp(const Model& model, const CollisionModel* collision, const WholeBodyQpSettings& settings)
+    : WholeBodyQp(model, collision, settings, checked_limits(model, settings)) {}
+
+WholeBodyQp::WholeBodyQp(const Model& model, const CollisionModel* collision, const WholeBodyQpSettings& settings,
+                         const Limits& limits)
+    : settings_(settings),
+      end_effector_(model, model.frame_id(settings.end_effector_frame), settings.smoothing_time_constant),
+      posture_(model, settings.smoothing_time_constant),
+      nv_(model.nv()),
+      num_pairs_(collision ? collision->num_pairs() : 0),
+      joint_limits_(model,
+                    {settings.joint_influence_fraction, settings.joint_safety_fraction, settings.joint_damper_amortization},
+                    limits.velocity),
+      velocity_limit_(limits.velocity, velocity_limit_gains(joint_limits_, settings.velocity_limit_gain, model.nv())),
+      torque_limit_(limits.torque),
+      deadband_(settings.compliance_deadband.size() ? settings.compliance_deadband : Eigen::VectorXd::Zero(model.nv())),
+      qdd_external_(Eigen::VectorXd::Zero(nv_)),
+      qdd_desired_(Eigen::VectorXd::Zero(nv_)),
+      tau_desired_(Eigen::VectorXd::Zero(nv_)),
+      last_good_tau_(Eigen::VectorXd::Zero(nv_)),
+      weighted_jacobian_(Eigen::MatrixXd::Zero(6, nv_)) {
+  if (collision) self_collision_.emplace(model, *collision, settings.collision);
   // Rows: nv torque rows (A = M), then one row per collision pair. Bounds: qdd.
   problem_.resize(nv_, 0, nv_ + num_pairs_);
   solver_.resize(nv_, 0, nv_ + num_pairs_);
-  qdd_external_ = Eigen::VectorXd::Zero(nv_);
-  qdd_desired_ = Eigen::VectorXd::Zero(nv_);
-  tau_desired_ = Eigen::VectorXd::Zero(nv_);
-  last_good_tau_ = Eigen::VectorXd::Zero(nv_);
-  weighted_jacobian_ = Eigen::MatrixXd::Zero(6, nv_);
 }
 
-// Acceleration bounds from the joint-limit dampers and the velocity limits (paper: qdd_d <=
+// Acceleration bounds from the velocity limits and the joint-limit dampers (paper: qdd_d <=
 // min(ë_p, ë_v) for an upper limit, >= max(...) for a lower one).
 void WholeBodyQp::joint_bounds(const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
+  velocity_limit_.bound(qd, problem_.lb, problem_.ub);
+  joint_limits_.tighten(q, qd, problem_.lb, problem_.ub);
   for (int i = 0; i < nv_; ++i) {
-    const double lambda = lambda_[i];
-    // Velocity limits: ë_v = -lambda (ė - ė_lim) with e = q (upper) and e = -q (lower).
-    double upper = -lambda * (qd[i] - velocity_limit_[i]);
-    double lower = -lambda * (qd[i] + velocity_limit_[i]);
-    if (std::isfinite(upper_[i])) {
-      const double k = lambda * lambda / (4.0 * settings_.joint_damper_amortization * settings_.joint_damper_amortization);
-      // Distance to the upper limit e = upper - q, ė = -qd: ë = -qdd >= -k (e - d_s) - lambda ė.
-      upper = std::min(upper, k * (upper_[i] - q[i] - safety_[i]) - lambda * qd[i]);
-      // Distance to the lower limit e = q - lower, ė = qd: qdd >= -k (e - d_s) - lambda qd.
-      lower = std::max(lower, -k * (q[i] - lower_[i] - safety_[i]) - lambda * qd[i]);
-    }
-    if (lower > upper) lower = upper = 0.5 * (lower + upper);  // both limits bind (e.g. beyond one): split
-    problem_.lb[i] = lower;
-    problem_.ub[i] = upper;
+    // Both limits bind (e.g. beyond one): split the difference.
+    if (problem_.lb[i] > problem_.ub[i]) problem_.lb[i] = problem_.ub[i] = 0.5 * (problem_.lb[i] + problem_.ub[i]);
   }
 }
 
@@ -103,10 +95,7 @@ WholeBodyQpStatus WholeBodyQp::update(const Model& model, const Data& data, cons
     return status_;
   }
   // qdd_ext = M^-1 tau_ext: what the push alone would do to the arm (through the dead band).
-  for (int i = 0; i < nv_; ++i) {
-    const double x = tau_ext[i];
-    qdd_external_[i] = std::copysign(std::max(std::abs(x) - deadband_[i], 0.0), x);
-  }
+  soft_deadband(tau_ext, deadband_, qdd_external_);
   data.mass_matrix_llt.solveInPlace(qdd_external_);
 
   end_effector_.update(model, data, qdd_external_, dt);
@@ -121,25 +110,10 @@ WholeBodyQpStatus WholeBodyQp::update(const Model& model, const Data& data, cons
   problem_.g.noalias() -= w_0 * posture_.reference();
 
   joint_bounds(q, qd);
-  // Torque rows: tau_min <= M qdd + h - tau_ext <= tau_max.
-  problem_.A.topRows(nv_) = data.mass_matrix;
-  problem_.l.head(nv_) = -torque_limit_ - data.nonlinear_effects + tau_ext;
-  problem_.u.head(nv_) = torque_limit_ - data.nonlinear_effects + tau_ext;
-  // Self-collision rows, active inside the influence distance.
-  if (collision_data_) {
-    compute_collision_distances(model, data, *collision_, *collision_data_, true);
-    const VelocityDamperSettings& c = settings_.collision;
-    const double lambda = c.lambda();
-    const double k = lambda * lambda / (4.0 * c.amortization * c.amortization);
-    for (int p = 0; p < num_pairs_; ++p) {
-      const int row = nv_ + p;
-      problem_.A.row(row) = collision_data_->jacobian.row(p);
-      problem_.u[row] = kInf;
-      const double d = collision_data_->distance[p];
-      problem_.l[row] = d < c.influence_distance
-                            ? -k * (d - c.safety_distance) - lambda * collision_data_->velocity[p] - collision_data_->jdot_qdot[p]
-                            : -kInf;
-    }
+  torque_limit_.rows(data, tau_ext, problem_.A.topRows(nv_), problem_.l.head(nv_), problem_.u.head(nv_));
+  if (self_collision_) {
+    self_collision_->rows(model, data, problem_.A.middleRows(nv_, num_pairs_), problem_.l.segment(nv_, num_pairs_),
+                          problem_.u.segment(nv_, num_pairs_));
   }
 
   const QpStatus qp = solver_.solve(problem_, {.warm_start = warm_, .reuse_hessian_factor = false});
@@ -171,7 +145,7 @@ void WholeBodyQp::fallback_brake(const Data& data, const Eigen::VectorXd& qd, co
   }
   tau_desired_.noalias() = data.mass_matrix * qdd_desired_;
   tau_desired_ += data.nonlinear_effects - tau_ext;
-  tau_desired_ = tau_desired_.cwiseMax(-torque_limit_).cwiseMin(torque_limit_);
+  tau_desired_ = tau_desired_.cwiseMax(-torque_limit()).cwiseMin(torque_limit());
   if (!tau_desired_.allFinite()) tau_desired_ = last_good_tau_;
   last_good_tau_ = tau_desired_;
 }

@@ -16,11 +16,16 @@
 // (no rotor inertia); the low-level loop adds I_r qdd_d on the motor side.
 //
 // Constraints carry no gamma: they hold the *real* acceleration (push included) within bounds,
-// so a push toward a limit is negated. The velocity damper, for a distance e to a limit (e >= d_s
-// wanted), asks ë >= -lambda^2/(4 M^2) (e - d_s) - lambda ė with lambda = 4 M^2 xi / (d_i - d_s)
-// (M > 1: overdamped; xi: the approach speed allowed at the influence distance d_i).
+// so a push toward a limit is negated. Each is its own object: JointLimitConstraint and
+// SelfCollisionConstraint (both the second-order velocity damper, velocity_damper.hpp),
+// VelocityLimitConstraint, TorqueLimitConstraint.
 #include <phri/control/end_effector_task.hpp>
+#include <phri/control/joint_limit_constraint.hpp>
 #include <phri/control/posture_task.hpp>
+#include <phri/control/self_collision_constraint.hpp>
+#include <phri/control/torque_limit_constraint.hpp>
+#include <phri/control/velocity_damper.hpp>
+#include <phri/control/velocity_limit_constraint.hpp>
 #include <phri/model/collision_model.hpp>
 #include <phri/model/data.hpp>
 #include <phri/model/model.hpp>
@@ -31,14 +36,6 @@
 #include <string_view>
 
 namespace phri {
-
-struct VelocityDamperSettings {
-  double influence_distance = 0.0;  ///< d_i (rad for joints, m for distances)
-  double safety_distance = 0.0;     ///< d_s < d_i
-  double xi = 0.0;                  ///< approach speed allowed at d_i (rad/s or m/s)
-  double amortization = 1.8;        ///< M > 1 (paper's demo value 1.8)
-  double lambda() const { return 4.0 * amortization * amortization * xi / (influence_distance - safety_distance); }
-};
 
 struct WholeBodyQpSettings {
   std::string end_effector_frame = "end_effector_link";
@@ -104,28 +101,34 @@ public:
   WholeBodyQpStatus status() const { return status_; }
   QpStatus qp_status() const { return solver_.status(); }
   int qp_iterations() const { return solver_.iterations(); }
-  const CollisionData* collision_data() const { return collision_data_ ? &*collision_data_ : nullptr; }
-  const Eigen::VectorXd& torque_limit() const { return torque_limit_; }
-  const Eigen::VectorXd& velocity_limit() const { return velocity_limit_; }
+  const CollisionData* collision_data() const { return self_collision_ ? &self_collision_->data() : nullptr; }
+  const Eigen::VectorXd& torque_limit() const { return torque_limit_.torque_limit(); }
+  /// Per joint, after velocity_limit_fraction.
+  const Eigen::VectorXd& velocity_limit() const { return velocity_limit_.velocity_limit(); }
   /// Joint position bounds the dampers keep: limit -+ d_s (infinite for continuous joints).
-  const Eigen::VectorXd& safe_lower() const { return safe_lower_; }
-  const Eigen::VectorXd& safe_upper() const { return safe_upper_; }
+  const Eigen::VectorXd& safe_lower() const { return joint_limits_.safe_lower(); }
+  const Eigen::VectorXd& safe_upper() const { return joint_limits_.safe_upper(); }
   const WholeBodyQpSettings& settings() const { return settings_; }
 
 private:
+  struct Limits {
+    Eigen::VectorXd torque, velocity;  // velocity after the fraction
+  };
+  static Limits checked_limits(const Model& model, const WholeBodyQpSettings& settings);
+  WholeBodyQp(const Model& model, const CollisionModel* collision, const WholeBodyQpSettings& settings,
+              const Limits& limits);
   void joint_bounds(const Eigen::VectorXd& q, const Eigen::VectorXd& qd);
   void fallback_brake(const Data& data, const Eigen::VectorXd& qd, const Eigen::VectorXd& tau_ext);
 
   WholeBodyQpSettings settings_;
-  const CollisionModel* collision_;
-  std::optional<CollisionData> collision_data_;
   EndEffectorTask end_effector_;
   PostureTask posture_;
   int nv_;
   int num_pairs_;
-  Eigen::VectorXd torque_limit_, velocity_limit_;
-  Eigen::VectorXd lower_, upper_, influence_, safety_, lambda_;  // joint damper per joint
-  Eigen::VectorXd safe_lower_, safe_upper_;
+  JointLimitConstraint joint_limits_;
+  VelocityLimitConstraint velocity_limit_;
+  TorqueLimitConstraint torque_limit_;
+  std::optional<SelfCollisionConstraint> self_collision_;
   QpProblem problem_;
   QpSolver solver_;
   Eigen::VectorXd deadband_;

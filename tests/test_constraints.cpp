@@ -1,0 +1,168 @@
+// ctest-labels: unit
+// The QP's constraint objects against closed forms: the second-order velocity damper's gain and
+// its overdamped approach (the damped oscillator's analytic solution), the joint-limit and
+// velocity-limit bounds at their edges, the torque rows against tau = M qdd + h - tau_ext, and the
+// self-collision rows' activation at the influence distance.
+#include <phri/control/joint_limit_constraint.hpp>
+#include <phri/control/self_collision_constraint.hpp>
+#include <phri/control/torque_limit_constraint.hpp>
+#include <phri/control/velocity_damper.hpp>
+#include <phri/control/velocity_limit_constraint.hpp>
+#include <phri/model/algorithms.hpp>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+
+namespace {
+
+const std::string kGen3 = std::string(PHRI_SOURCE_DIR) + "/robots/kinova_gen3/";
+
+TEST(VelocityDamper, GainIsTheFormulaOfThePaperForItsDemoValues) {
+  // Paper: d_i 0.03 m, d_s 0.015 m, M 1.8, xi 0.08 m/s: lambda = 4 M^2 xi / (d_i - d_s) = 69.12.
+  const phri::VelocityDamper damper({0.03, 0.015, 0.08, 1.8});
+  EXPECT_NEAR(damper.lambda(), 4.0 * 3.24 * 0.08 / 0.015, 1e-12);
+  EXPECT_NEAR(damper.lambda(), 69.12, 1e-9);
+  EXPECT_NEAR(damper.stiffness(), 69.12 * 69.12 / (4.0 * 3.24), 1e-9);
+  // At the safety distance and at rest the damper allows no approach: ë >= 0.
+  EXPECT_DOUBLE_EQ(damper.min_acceleration(0.015, 0.0), 0.0);
+  // Moving away from the limit faster than the damper's pull: negative ë allowed.
+  EXPECT_LT(damper.min_acceleration(0.02, 0.5), 0.0);
+}
+
+TEST(VelocityDamper, RidingTheBoundIsTheOverdampedOscillatorAndNeverCrossesTheSafetyDistance) {
+  // ë = -k (e - d_s) - lambda ė, started at d_i approaching at xi. With x = e - d_s the solution is
+  // x(t) = A exp(r1 t) + B exp(r2 t), r1,2 = lambda (-1 +- sqrt(1 - 1/M^2)) / 2.
+  const double di = 0.1, ds = 0.02, xi = 0.5, m = 1.8;
+  const phri::VelocityDamper damper({di, ds, xi, m});
+  const double lambda = damper.lambda();
+  const double root = std::sqrt(1.0 - 1.0 / (m * m));
+  const double r1 = 0.5 * lambda * (-1.0 + root), r2 = 0.5 * lambda * (-1.0 - root);
+  const double x0 = di - ds, v0 = -xi;
+  const double b = (v0 - r1 * x0) / (r2 - r1), a = x0 - b;
+  double e = di, e_dot = -xi, min_e = e;
+  const double dt = 1e-6;
+  for (int k = 1; k <= 200000; ++k) {  // 0.2 s, semi-implicit Euler at 1 us
+    e_dot += dt * damper.min_acceleration(e, e_dot);
+    e += dt * e_dot;
+    min_e = std::min(min_e, e);
+    if (k % 20000 == 0) {
+      const double t = k * dt;
+      EXPECT_NEAR(e - ds, a * std::exp(r1 * t) + b * std::exp(r2 * t), 2e-5) << "t = " << t;
+    }
+  }
+  EXPECT_GT(min_e, ds);
+}
+
+class ConstraintTest : public ::testing::Test {
+protected:
+  phri::Model model_ = phri::Model::from_urdf_file(kGen3 + "gen3.urdf");
+  phri::Data data_{model_};
+};
+
+TEST_F(ConstraintTest, JointLimitBoundsStopAJointAtRestAtItsSafetyDistanceAndPushBackBeyond) {
+  const Eigen::VectorXd v = Eigen::VectorXd::Constant(7, 1.0);
+  const phri::JointLimitConstraint limits(model_, {0.1, 0.01, 1.8}, v);
+  const int j = 1;  // joint 2: limited
+  ASSERT_TRUE(limits.limited(j));
+  ASSERT_FALSE(limits.limited(0));  // joint 1: continuous
+  const double range = model_.upper_limits()[j] - model_.lower_limits()[j];
+  EXPECT_NEAR(limits.safe_upper()[j], model_.upper_limits()[j] - 0.01 * range, 1e-12);
+  EXPECT_NEAR(limits.safe_lower()[j], model_.lower_limits()[j] + 0.01 * range, 1e-12);
+  const double inf = std::numeric_limits<double>::infinity();
+  Eigen::VectorXd q = Eigen::VectorXd::Zero(7), qd = Eigen::VectorXd::Zero(7);
+  Eigen::VectorXd lower = Eigen::VectorXd::Constant(7, -inf), upper = Eigen::VectorXd::Constant(7, inf);
+  q[j] = limits.safe_upper()[j];
+  limits.tighten(q, qd, lower, upper);
+  EXPECT_NEAR(upper[j], 0.0, 1e-9);      // at rest on the safety bound: no acceleration toward the limit
+  EXPECT_EQ(upper[0], inf);              // continuous joint untouched
+  q[j] = model_.upper_limits()[j];       // beyond the safety bound
+  lower.setConstant(-inf);
+  upper.setConstant(inf);
+  limits.tighten(q, qd, lower, upper);
+  EXPECT_LT(upper[j], 0.0);              // must accelerate back
+  // Mirror image at the lower limit.
+  q[j] = limits.safe_lower()[j];
+  lower.setConstant(-inf);
+  upper.setConstant(inf);
+  limits.tighten(q, qd, lower, upper);
+  EXPECT_NEAR(lower[j], 0.0, 1e-9);
+}
+
+TEST_F(ConstraintTest, VelocityLimitBoundsVanishAtTheLimitAndConvergeAtTheirGain) {
+  const Eigen::VectorXd v = Eigen::VectorXd::Constant(7, 1.2), gain = Eigen::VectorXd::Constant(7, 50.0);
+  const phri::VelocityLimitConstraint limit(v, gain);
+  Eigen::VectorXd qd = v, lower(7), upper(7);
+  limit.bound(qd, lower, upper);
+  EXPECT_NEAR(upper.cwiseAbs().maxCoeff(), 0.0, 1e-12);
+  EXPECT_NEAR(lower[0], -50.0 * 2.4, 1e-12);
+  // Riding the upper bound from 2 v_max: qd - v decays as exp(-gain t).
+  double speed = 2.4;
+  const double dt = 1e-5;
+  for (int k = 0; k < 10000; ++k) {
+    qd.setConstant(speed);
+    limit.bound(qd, lower, upper);
+    speed += dt * upper[0];
+  }
+  EXPECT_NEAR(speed - 1.2, 1.2 * std::exp(-50.0 * 0.1), 1e-4);
+}
+
+TEST_F(ConstraintTest, TorqueRowsHoldExactlyTheTorquesWithinTheLimits) {
+  Eigen::VectorXd q(7), qd(7);
+  q << 0.3, 0.58, 3.14, -1.84, 0.2, 0.85, 1.57;
+  qd << 0.1, -0.2, 0.3, 0.1, -0.2, 0.1, 0.3;
+  phri::compute_all_terms(model_, data_, q, qd);
+  const Eigen::VectorXd limit = Eigen::VectorXd::Constant(7, 30.0);
+  const phri::TorqueLimitConstraint torque(limit);
+  Eigen::MatrixXd a(7, 7);
+  Eigen::VectorXd l(7), u(7);
+  Eigen::VectorXd tau_ext = Eigen::VectorXd::LinSpaced(7, -3.0, 3.0);
+  torque.rows(data_, tau_ext, a, l, u);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> uniform(-60.0, 60.0);
+  for (int trial = 0; trial < 200; ++trial) {
+    Eigen::VectorXd qdd(7);
+    for (int i = 0; i < 7; ++i) qdd[i] = uniform(rng);
+    // Independent: inverse dynamics by RNEA.
+    const Eigen::VectorXd tau = phri::rnea(model_, data_, q, qd, qdd) - tau_ext;
+    const Eigen::VectorXd row = a * qdd;
+    for (int i = 0; i < 7; ++i) {
+      const bool inside_rows = row[i] >= l[i] && row[i] <= u[i];
+      const bool inside_limit = std::abs(tau[i]) <= 30.0;
+      if (std::abs(std::abs(tau[i]) - 30.0) > 1e-9) {
+        EXPECT_EQ(inside_rows, inside_limit) << "joint " << i;
+      }
+    }
+  }
+}
+
+TEST_F(ConstraintTest, SelfCollisionRowsActOnlyInsideTheInfluenceDistance) {
+  const phri::CollisionModel collision = phri::CollisionModel::from_yaml_file(kGen3 + "collision.yaml", model_);
+  Eigen::VectorXd q(7), qd = Eigen::VectorXd::Constant(7, 0.2);
+  q << 0, 0.58, 3.14, -1.84, 0, 0.85, 1.57;
+  phri::compute_all_terms(model_, data_, q, qd);
+  // An influence distance beyond every pair's distance, then one below every pair's distance.
+  for (const double influence : {10.0, 1e-4}) {
+    phri::SelfCollisionConstraint constraint(model_, collision, {influence, 0.5e-4, 0.08, 1.8});
+    const int n = constraint.num_rows();
+    ASSERT_GT(n, 0);
+    Eigen::MatrixXd a(n, 7);
+    Eigen::VectorXd l(n), u(n);
+    constraint.rows(model_, data_, a, l, u);
+    const phri::VelocityDamper damper({influence, 0.5e-4, 0.08, 1.8});
+    for (int p = 0; p < n; ++p) {
+      EXPECT_EQ(u[p], std::numeric_limits<double>::infinity());
+      const double d = constraint.data().distance[p];
+      if (d < influence) {
+        EXPECT_DOUBLE_EQ(l[p], damper.min_acceleration(d, constraint.data().velocity[p]) - constraint.data().jdot_qdot[p]);
+      } else {
+        EXPECT_EQ(l[p], -std::numeric_limits<double>::infinity());
+      }
+      EXPECT_TRUE(a.row(p).isApprox(constraint.data().jacobian.row(p)));
+    }
+  }
+}
+
+}  // namespace
