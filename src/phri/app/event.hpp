@@ -18,6 +18,7 @@
 //                          scale the end-effector stiffness by the FSM's stiffness step
 //   stop                   brake to rest and hold; the session is over (Fsm::finished())
 #include <phri/control/compliance_mode.hpp>
+#include <phri/core/enum_names.hpp>
 #include <phri/lowlevel/low_level_controller.hpp>
 
 #include <array>
@@ -61,12 +62,7 @@ constexpr std::string_view to_string(Event e) {
   return i >= 0 && i < kEventCount ? kEventNames[static_cast<std::size_t>(i)] : std::string_view("unknown");
 }
 
-constexpr std::optional<Event> event_from_string(std::string_view name) {
-  for (int i = 0; i < kEventCount; ++i) {
-    if (kEventNames[static_cast<std::size_t>(i)] == name) return static_cast<Event>(i);
-  }
-  return std::nullopt;
-}
+constexpr std::optional<Event> event_from_string(std::string_view name) { return enum_from_string<Event, kEventCount>(name); }
 
 /// The compliance mode an event selects, if it is a compliance event.
 constexpr std::optional<ComplianceMode> compliance_of(Event e) {

@@ -1,6 +1,8 @@
 #pragma once
 // The paper's compliance modes (section "Control Modes"): which tasks let an external push
 // through (gamma = 1) and which negate it (gamma = 0).
+#include <phri/core/enum_names.hpp>
+
 #include <optional>
 #include <string_view>
 
@@ -12,6 +14,7 @@ enum class ComplianceMode {
   kFullBody,   ///< gamma_EE = 1, gamma_posture = 1: impedance-like everywhere
   kDual,       ///< null-space compliance; the end effector becomes free while it is touched
 };
+inline constexpr int kComplianceModeCount = 4;
 
 constexpr std::string_view to_string(ComplianceMode mode) {
   switch (mode) {
@@ -24,11 +27,7 @@ constexpr std::string_view to_string(ComplianceMode mode) {
 }
 
 constexpr std::optional<ComplianceMode> compliance_mode_from_string(std::string_view name) {
-  if (name == "stiff") return ComplianceMode::kStiff;
-  if (name == "null_space") return ComplianceMode::kNullSpace;
-  if (name == "full_body") return ComplianceMode::kFullBody;
-  if (name == "dual") return ComplianceMode::kDual;
-  return std::nullopt;
+  return enum_from_string<ComplianceMode, kComplianceModeCount>(name);
 }
 
 }  // namespace phri

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 namespace phri {
 
@@ -12,7 +13,7 @@ Eigen::Vector3d rotation_log(const Eigen::Matrix3d& r) {
   const double angle = std::acos(cos_angle);
   const Eigen::Vector3d skew(r(2, 1) - r(1, 2), r(0, 2) - r(2, 0), r(1, 0) - r(0, 1));  // 2 sin(angle) axis
   if (angle < 1e-6) return 0.5 * skew;  // sin(angle) ~ angle
-  if (M_PI - angle > 1e-6) return angle / (2.0 * std::sin(angle)) * skew;
+  if (std::numbers::pi - angle > 1e-6) return angle / (2.0 * std::sin(angle)) * skew;
   // Near pi: the axis from the symmetric part, R = 2 a a' - I, sign from the skew part.
   Eigen::Vector3d axis;
   int k;

@@ -7,7 +7,8 @@
 //
 // so r follows tau_ext through a first-order low-pass of bandwidth K_O (rad/s) per joint. A high
 // gain follows pushes faster but passes more torque-sensor noise and model error; the paper's
-// implementation uses K_O = 10 (mc_residual_estimation, paper_parameters §4), our default too.
+// implementation uses K_O = 10 (mc_residual_estimation, paper_parameters §4); the controller's
+// default, ControllerSettings::observer_gain, is 50 (the reason is given there).
 // M must be the link-side inertia (no rotor inertia): the torque sensors sit after the rotor.
 #include <phri/model/data.hpp>
 #include <phri/model/model.hpp>
@@ -17,7 +18,7 @@ namespace phri {
 class MomentumObserver {
 public:
   /// gain: K_O in rad/s for every joint.
-  MomentumObserver(const Model& model, double gain = 10.0);
+  MomentumObserver(const Model& model, double gain);
 
   void set_gain(double gain);
   void set_gains(const Eigen::VectorXd& gains);

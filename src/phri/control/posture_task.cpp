@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 namespace phri {
 
@@ -49,7 +50,7 @@ void PostureTask::update(const Eigen::VectorXd& q, const Eigen::VectorXd& qd, co
   gamma_.step(dt);
   for (int i = 0; i < nv_; ++i) {
     double e = target_q_[i] - q[i];
-    if (continuous_[static_cast<std::size_t>(i)]) e = std::remainder(e, 2.0 * M_PI);
+    if (continuous_[static_cast<std::size_t>(i)]) e = std::remainder(e, 2.0 * std::numbers::pi);
     error_[i] = e;
   }
   reference_ = target_qdd_ + stiffness_.value().cwiseProduct(error_) + damping_.value().cwiseProduct(target_qd_ - qd) +

@@ -2,6 +2,8 @@
 // phri::LowLevelMode: how the arm's joint drives interpret a RobotCommand, i.e. which of the
 // vendor's actuator control loops runs (Kinova Kortex low-level servoing, ActuatorConfig
 // ControlMode POSITION / TORQUE / TORQUE_HIGH_VELOCITY / CURRENT).
+#include <phri/core/enum_names.hpp>
+
 #include <cstdint>
 #include <optional>
 #include <string_view>
@@ -33,10 +35,7 @@ constexpr std::string_view to_string(LowLevelMode mode) {
 /// current) is accepted for kCurrent.
 constexpr std::optional<LowLevelMode> low_level_mode_from_string(std::string_view name) {
   if (name == "custom") return LowLevelMode::kCurrent;
-  for (int i = 0; i < kLowLevelModeCount; ++i) {
-    if (to_string(static_cast<LowLevelMode>(i)) == name) return static_cast<LowLevelMode>(i);
-  }
-  return std::nullopt;
+  return enum_from_string<LowLevelMode, kLowLevelModeCount>(name);
 }
 
 }  // namespace phri
