@@ -311,6 +311,13 @@ void Fsm::stream_pose_reference() {
   targets_.pose = pose_ref_;
 }
 
+// A move that is over leaves its last reference as the held target.
+void Fsm::hold_when_done(double t, bool done) {
+  if (!done) return;
+  motion_ = Motion::kHold;
+  motion_start_ = t;
+}
+
 void Fsm::run_motion(double t, const Controller& cycle) {
   const double elapsed = t - motion_start_;
   switch (motion_) {
@@ -319,20 +326,14 @@ void Fsm::run_motion(double t, const Controller& cycle) {
     case Motion::kJointMove:
       joint_move_.evaluate(elapsed, q_ref_, qd_ref_, qdd_ref_);
       stream_joint_reference();
-      if (elapsed >= joint_move_.duration()) {
-        motion_ = Motion::kHold;
-        motion_start_ = t;
-      }
+      hold_when_done(t, elapsed >= joint_move_.duration());
       return;
     case Motion::kPoseMove:
       joint_move_.evaluate(elapsed, q_ref_, qd_ref_, qdd_ref_);
       set_posture_target();
       pose_move_.evaluate(elapsed, pose_ref_);
       stream_pose_reference();
-      if (elapsed >= pose_move_.duration()) {
-        motion_ = Motion::kHold;
-        motion_start_ = t;
-      }
+      hold_when_done(t, elapsed >= pose_move_.duration());
       return;
     case Motion::kTrajectory:
       dynamic_.evaluate(elapsed, pose_ref_);

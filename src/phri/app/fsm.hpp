@@ -123,6 +123,7 @@ private:
   void finish_startup(double t, const Controller& cycle, bool timed_out);
   void run_motion(double t, const Controller& cycle);
   void set_posture_target();
+  void hold_when_done(double t, bool done);
   void stream_joint_reference();
   void stream_pose_reference();
   double joint_speed(const RobotState& state) const;

@@ -64,6 +64,11 @@ struct LogRow {
 /// Calls, in column order, v.number(name, value) for each real column, v.integer(name, value) for
 /// each integer column and v.joints(name, values, dof) for each per-joint group (columns name_1 ..
 /// name_dof).
+template <class Visitor, std::size_t N>
+void visit_numbers(Visitor& v, const std::array<const char*, N>& names, const std::array<double, N>& values) {
+  for (std::size_t i = 0; i < N; ++i) v.number(names[i], values[i]);
+}
+
 template <class Visitor>
 void visit_log_columns(const LogRow& r, int dof, Visitor&& v) {
   v.number("time_s", r.time_s);
@@ -75,34 +80,14 @@ void visit_log_columns(const LogRow& r, int dof, Visitor&& v) {
   v.joints("tau_s", r.tau_s, dof);
   v.joints("tau_ext", r.tau_ext, dof);
   v.joints("current", r.current, dof);
-  v.number("ee_x", r.ee_position[0]);
-  v.number("ee_y", r.ee_position[1]);
-  v.number("ee_z", r.ee_position[2]);
-  v.number("ee_qw", r.ee_quaternion[0]);
-  v.number("ee_qx", r.ee_quaternion[1]);
-  v.number("ee_qy", r.ee_quaternion[2]);
-  v.number("ee_qz", r.ee_quaternion[3]);
-  v.number("target_x", r.target_position[0]);
-  v.number("target_y", r.target_position[1]);
-  v.number("target_z", r.target_position[2]);
-  v.number("target_qw", r.target_quaternion[0]);
-  v.number("target_qx", r.target_quaternion[1]);
-  v.number("target_qy", r.target_quaternion[2]);
-  v.number("target_qz", r.target_quaternion[3]);
-  v.number("err_x", r.error[0]);
-  v.number("err_y", r.error[1]);
-  v.number("err_z", r.error[2]);
-  v.number("err_rx", r.error[3]);
-  v.number("err_ry", r.error[4]);
-  v.number("err_rz", r.error[5]);
+  visit_numbers<Visitor, 3>(v, {"ee_x", "ee_y", "ee_z"}, r.ee_position);
+  visit_numbers<Visitor, 4>(v, {"ee_qw", "ee_qx", "ee_qy", "ee_qz"}, r.ee_quaternion);
+  visit_numbers<Visitor, 3>(v, {"target_x", "target_y", "target_z"}, r.target_position);
+  visit_numbers<Visitor, 4>(v, {"target_qw", "target_qx", "target_qy", "target_qz"}, r.target_quaternion);
+  visit_numbers<Visitor, 6>(v, {"err_x", "err_y", "err_z", "err_rx", "err_ry", "err_rz"}, r.error);
   v.number("err_pos_m", r.error_position_m);
   v.number("err_ori_rad", r.error_orientation_rad);
-  v.number("wrench_fx", r.wrench[0]);
-  v.number("wrench_fy", r.wrench[1]);
-  v.number("wrench_fz", r.wrench[2]);
-  v.number("wrench_mx", r.wrench[3]);
-  v.number("wrench_my", r.wrench[4]);
-  v.number("wrench_mz", r.wrench[5]);
+  visit_numbers<Visitor, 6>(v, {"wrench_fx", "wrench_fy", "wrench_fz", "wrench_mx", "wrench_my", "wrench_mz"}, r.wrench);
   v.number("wrench_norm", r.wrench_norm);
   v.integer("compliance_mode", r.compliance_mode);
   v.integer("touched", r.touched);

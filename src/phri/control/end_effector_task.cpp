@@ -79,49 +79,69 @@ bool EndEffectorTask::target_reached() const {
 // Otherwise the tracked target runs toward it at bounded speed and acceleration, braking so as to
 // stop on it (speed <= sqrt(2 a d)), with its velocity as feed-forward: continuous references,
 // hence no torque step.
-void EndEffectorTask::govern_target(double dt) {
-  // Position.
-  const Eigen::Vector3d gap = commanded_pose_.translation() - target_pose_.translation();
+// One channel of the reference governor (position, or orientation along the geodesic). `gap`
+// goes from the tracked target to the set one (a translation or a rotation vector). Either the
+// set reference is streamed (it moves by about its own speed per period: tracked as given, snap)
+// or the tracked target moves `step` along `direction` at `speed`.
+struct EndEffectorTask::GovernorMove {
+  bool snap = true;
+  Eigen::Vector3d direction = Eigen::Vector3d::Zero();
+  double step = 0.0;
+  double speed = 0.0;
+};
+
+EndEffectorTask::GovernorMove EndEffectorTask::govern_channel(const Eigen::Vector3d& gap, double commanded_speed,
+                                                             double max_speed, double max_acceleration, double dt,
+                                                             const Eigen::Vector3d& direction_at_zero, bool& tracking,
+                                                             double& speed_state) {
   const double distance = gap.norm();
-  const double streamed = 1.5 * dt * std::max(limits_.linear_speed, commanded_velocity_.head<3>().norm()) + 1e-9;
-  if (tracking_position_ && distance <= streamed) {
+  const double streamed = 1.5 * dt * std::max(max_speed, commanded_speed) + 1e-9;
+  if (tracking && distance <= streamed) {
+    speed_state = commanded_speed;
+    return {};
+  }
+  tracking = false;
+  GovernorMove move;
+  move.snap = false;
+  move.speed = std::min({speed_state + max_acceleration * dt, max_speed, std::sqrt(2.0 * max_acceleration * distance)});
+  move.step = std::min(move.speed * dt, distance);
+  move.direction = distance > 0.0 ? Eigen::Vector3d(gap / distance) : direction_at_zero;
+  speed_state = move.speed;
+  if (distance - move.step < 1e-7) tracking = true;
+  return move;
+}
+
+void EndEffectorTask::set_governed_motion(const GovernorMove& move, Eigen::Index offset) {
+  if (move.snap) {
+    target_velocity_.segment<3>(offset) = commanded_velocity_.segment<3>(offset);
+    target_acceleration_.segment<3>(offset) = commanded_acceleration_.segment<3>(offset);
+  } else {
+    target_velocity_.segment<3>(offset) = move.direction * move.speed;
+    target_acceleration_.segment<3>(offset).setZero();
+  }
+}
+
+void EndEffectorTask::govern_target(double dt) {
+  const GovernorMove linear =
+      govern_channel(commanded_pose_.translation() - target_pose_.translation(), commanded_velocity_.head<3>().norm(),
+                     limits_.linear_speed, limits_.linear_acceleration, dt, Eigen::Vector3d::Zero(), tracking_position_,
+                     governor_linear_speed_);
+  if (linear.snap) {
     target_pose_.translation() = commanded_pose_.translation();
-    target_velocity_.head<3>() = commanded_velocity_.head<3>();
-    target_acceleration_.head<3>() = commanded_acceleration_.head<3>();
-    governor_linear_speed_ = commanded_velocity_.head<3>().norm();
   } else {
-    tracking_position_ = false;
-    const double speed = std::min({governor_linear_speed_ + limits_.linear_acceleration * dt, limits_.linear_speed,
-                                   std::sqrt(2.0 * limits_.linear_acceleration * distance)});
-    const double step = std::min(speed * dt, distance);
-    const Eigen::Vector3d direction = distance > 0.0 ? Eigen::Vector3d(gap / distance) : Eigen::Vector3d::Zero();
-    target_pose_.translation() += direction * step;
-    target_velocity_.head<3>() = direction * speed;
-    target_acceleration_.head<3>().setZero();
-    governor_linear_speed_ = speed;
-    if (distance - step < 1e-7) tracking_position_ = true;
+    target_pose_.translation() += linear.direction * linear.step;
   }
-  // Orientation: the same along the geodesic from the tracked to the set orientation.
-  const Eigen::Vector3d rotation = rotation_log(commanded_pose_.linear() * target_pose_.linear().transpose());
-  const double angle = rotation.norm();
-  const double streamed_angle = 1.5 * dt * std::max(limits_.angular_speed, commanded_velocity_.tail<3>().norm()) + 1e-9;
-  if (tracking_rotation_ && angle <= streamed_angle) {
+  set_governed_motion(linear, 0);
+  const GovernorMove angular =
+      govern_channel(rotation_log(commanded_pose_.linear() * target_pose_.linear().transpose()),
+                     commanded_velocity_.tail<3>().norm(), limits_.angular_speed, limits_.angular_acceleration, dt,
+                     Eigen::Vector3d::UnitZ(), tracking_rotation_, governor_angular_speed_);
+  if (angular.snap) {
     target_pose_.linear() = commanded_pose_.linear();
-    target_velocity_.tail<3>() = commanded_velocity_.tail<3>();
-    target_acceleration_.tail<3>() = commanded_acceleration_.tail<3>();
-    governor_angular_speed_ = commanded_velocity_.tail<3>().norm();
   } else {
-    tracking_rotation_ = false;
-    const double speed = std::min({governor_angular_speed_ + limits_.angular_acceleration * dt, limits_.angular_speed,
-                                   std::sqrt(2.0 * limits_.angular_acceleration * angle)});
-    const double step = std::min(speed * dt, angle);
-    const Eigen::Vector3d axis = angle > 0.0 ? Eigen::Vector3d(rotation / angle) : Eigen::Vector3d::UnitZ();
-    target_pose_.linear() = Eigen::AngleAxisd(step, axis).toRotationMatrix() * target_pose_.linear();
-    target_velocity_.tail<3>() = axis * speed;
-    target_acceleration_.tail<3>().setZero();
-    governor_angular_speed_ = speed;
-    if (angle - step < 1e-7) tracking_rotation_ = true;
+    target_pose_.linear() = Eigen::AngleAxisd(angular.step, angular.direction).toRotationMatrix() * target_pose_.linear();
   }
+  set_governed_motion(angular, 3);
 }
 
 void EndEffectorTask::update(const Model& model, const Data& data, const Eigen::VectorXd& qdd_external, double dt) {

@@ -73,7 +73,12 @@ public:
   const Eigen::Isometry3d& pose() const { return pose_; }
 
 private:
+  struct GovernorMove;
+  static GovernorMove govern_channel(const Eigen::Vector3d& gap, double commanded_speed, double max_speed,
+                                     double max_acceleration, double dt, const Eigen::Vector3d& direction_at_zero,
+                                     bool& tracking, double& speed_state);
   void govern_target(double dt);
+  void set_governed_motion(const GovernorMove& move, Eigen::Index offset);
 
   int frame_id_;
   TargetLimits limits_;

@@ -16,10 +16,8 @@ ConfigError::ConfigError(std::string file, std::string element, std::string reas
       element_(std::move(element)),
       reason_(std::move(reason)) {}
 
-IoError::IoError(std::string path, std::string reason) : Error(compose(path, "", reason)), path_(std::move(path)) {}
-
-ExperimentError::ExperimentError(std::string experiment, std::string reason)
-    : Error(compose(experiment, "", reason)), experiment_(std::move(experiment)) {}
+SubjectError::SubjectError(std::string subject, const std::string& reason)
+    : Error(compose(subject, "", reason)), subject_(std::move(subject)) {}
 
 void throw_size_error(const char* function, const char* argument, long actual, long expected) {
   throw ArgumentError(std::string(function) + ": " + argument + " has " + std::to_string(actual) + " entries, expected " +

@@ -35,24 +35,27 @@ private:
   std::string reason_;
 };
 
-class IoError : public Error {
+/// An error about one named thing (a path, an experiment): message "subject: reason".
+class SubjectError : public Error {
 public:
-  /// Message "path: reason".
-  IoError(std::string path, std::string reason);
-  const std::string& path() const { return path_; }
+  SubjectError(std::string subject, const std::string& reason);
+  const std::string& subject() const { return subject_; }
 
 private:
-  std::string path_;
+  std::string subject_;
 };
 
-class ExperimentError : public Error {
+/// subject(): the path.
+class IoError : public SubjectError {
 public:
-  /// Message "experiment: reason".
-  ExperimentError(std::string experiment, std::string reason);
-  const std::string& experiment() const { return experiment_; }
+  using SubjectError::SubjectError;
+  const std::string& path() const { return subject(); }
+};
 
-private:
-  std::string experiment_;
+/// subject(): the experiment.
+class ExperimentError : public SubjectError {
+public:
+  using SubjectError::SubjectError;
 };
 
 class ArgumentError : public Error {

@@ -26,21 +26,27 @@ constexpr double kMax = std::numeric_limits<double>::max();
 // from kLargeRows rows on, Eigen's blocked matrix-vector products win.
 constexpr Index kLargeRows = 16;
 
-// Four partial sums: no loop-carried dependence on a single accumulator.
-[[gnu::always_inline]] inline double dot(const double* __restrict a, const double* __restrict b, Index n) {
+// sum_i term(i) for i in [0, n), in four partial sums: no loop-carried dependence on a single
+// accumulator, so the compiler vectorises it.
+template <class Term>
+[[gnu::always_inline]] inline double sum4(Index n, Term term) {
   double s0 = 0.0;
   double s1 = 0.0;
   double s2 = 0.0;
   double s3 = 0.0;
   Index i = 0;
   for (; i + 4 <= n; i += 4) {
-    s0 += a[i] * b[i];
-    s1 += a[i + 1] * b[i + 1];
-    s2 += a[i + 2] * b[i + 2];
-    s3 += a[i + 3] * b[i + 3];
+    s0 += term(i);
+    s1 += term(i + 1);
+    s2 += term(i + 2);
+    s3 += term(i + 3);
   }
-  for (; i < n; ++i) s0 += a[i] * b[i];
+  for (; i < n; ++i) s0 += term(i);
   return (s0 + s1) + (s2 + s3);
+}
+
+[[gnu::always_inline]] inline double dot(const double* __restrict a, const double* __restrict b, Index n) {
+  return sum4(n, [a, b](Index i) { return a[i] * b[i]; });
 }
 
 // y += alpha x
@@ -73,19 +79,7 @@ void columns_axpy(const double* m, Index ld, Index rows, Index cols, const doubl
 // x * 0 is 0 for finite x and NaN otherwise, and a sum of zeros and NaNs is NaN in any order:
 // four partial sums let the compiler vectorise the check.
 [[gnu::always_inline]] inline bool all_finite(const double* p, Index n) {
-  double s0 = 0.0;
-  double s1 = 0.0;
-  double s2 = 0.0;
-  double s3 = 0.0;
-  Index i = 0;
-  for (; i + 4 <= n; i += 4) {
-    s0 += p[i] * 0.0;
-    s1 += p[i + 1] * 0.0;
-    s2 += p[i + 2] * 0.0;
-    s3 += p[i + 3] * 0.0;
-  }
-  for (; i < n; ++i) s0 += p[i] * 0.0;
-  return (s0 + s1) + (s2 + s3) == 0.0;
+  return sum4(n, [p](Index i) { return p[i] * 0.0; }) == 0.0;
 }
 
 // v[0..q) <- R^-1 v[0..q), R the leading q x q block of an upper-triangular matrix (leading
