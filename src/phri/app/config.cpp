@@ -144,19 +144,23 @@ void parse_compliance_deadband(const YamlReader& d, int dof, ControllerSettings&
   if (d.has("per_joint_Nm")) c.qp.compliance_deadband = d.per_joint<Eigen::VectorXd>("per_joint_Nm", dof, 0.0, 100.0);
 }
 
-void parse_compliance(const YamlReader& m, ControllerSettings& c) {
-  m.allow_keys({"initial_mode", "ee_position_stiffness", "ee_orientation_stiffness", "ee_weight",
-                "full_body_ee_stiffness", "posture_stiffness", "posture_damping", "posture_weight", "touch_threshold",
-                "release_threshold", "touched_ee_damping", "touched_posture_damping", "trigger_filter_s"});
-  ComplianceSettings& s = c.compliance;
-  if (m.has("initial_mode")) c.initial_compliance = compliance_mode(m, "initial_mode");
+// The end-effector task's gains, in the stiff and full-body modes.
+void parse_end_effector_task(const YamlReader& m, ComplianceSettings& s) {
   s.ee_position_stiffness = non_negative_or(m, "ee_position_stiffness", s.ee_position_stiffness, 1e5);
   s.ee_orientation_stiffness = non_negative_or(m, "ee_orientation_stiffness", s.ee_orientation_stiffness, 1e5);
   s.ee_weight = non_negative_or(m, "ee_weight", s.ee_weight, 1e9);
   s.full_body_ee_stiffness = non_negative_or(m, "full_body_ee_stiffness", s.full_body_ee_stiffness, 1e5);
+}
+
+void parse_posture_task(const YamlReader& m, ComplianceSettings& s) {
   s.posture_stiffness = non_negative_or(m, "posture_stiffness", s.posture_stiffness, 1e5);
   s.posture_damping = non_negative_or(m, "posture_damping", s.posture_damping, 1e4);
   s.posture_weight = positive_or(m, "posture_weight", s.posture_weight, 1e9);
+}
+
+// Dual compliance: the Schmitt trigger on the filtered wrench and the damping while touched.
+void parse_touch_trigger(const YamlReader& m, ControllerSettings& c) {
+  ComplianceSettings& s = c.compliance;
   s.touch_threshold = non_negative_or(m, "touch_threshold", s.touch_threshold, 1e4);
   s.release_threshold = non_negative_or(m, "release_threshold", s.release_threshold, 1e4);
   s.touched_ee_damping = non_negative_or(m, "touched_ee_damping", s.touched_ee_damping, 1e4);
@@ -164,6 +168,16 @@ void parse_compliance(const YamlReader& m, ControllerSettings& c) {
   c.wrench_trigger_filter_s = non_negative_or(m, "trigger_filter_s", c.wrench_trigger_filter_s, 1.0);
   require_below(m, "release_threshold", s.release_threshold, s.touch_threshold,
                 "must be below touch_threshold (the Schmitt trigger's hysteresis)");
+}
+
+void parse_compliance(const YamlReader& m, ControllerSettings& c) {
+  m.allow_keys({"initial_mode", "ee_position_stiffness", "ee_orientation_stiffness", "ee_weight",
+                "full_body_ee_stiffness", "posture_stiffness", "posture_damping", "posture_weight", "touch_threshold",
+                "release_threshold", "touched_ee_damping", "touched_posture_damping", "trigger_filter_s"});
+  if (m.has("initial_mode")) c.initial_compliance = compliance_mode(m, "initial_mode");
+  parse_end_effector_task(m, c.compliance);
+  parse_posture_task(m, c.compliance);
+  parse_touch_trigger(m, c);
 }
 
 // qp.joint_limits: the joint-limit velocity damper.
