@@ -122,7 +122,7 @@ private:
   void allocate_buffers();
   // reset(), in this order
   void restart_noise_and_counters();
-  Eigen::Vector3d place_initial_pose();  // returns the drop mass's weight on the tool (0 without)
+  Eigen::Vector3d place_initial_pose();  // returns the drop mass's weight (zero without a drop test)
   Eigen::VectorXd holding_torque(const Eigen::Vector3d& drop_force_on_tool) const;
   void start_drives_holding(const Eigen::VectorXd& hold);
   void take_initial_ft_sample(const Eigen::VectorXd& hold);
