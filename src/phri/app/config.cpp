@@ -5,21 +5,15 @@
 
 #include <cmath>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 
 namespace phri {
 namespace {
 
 constexpr double kHuge = 1e9;
 
-std::string resolve(const std::string& base_dir, const std::string& file) {
-  const std::filesystem::path p(file);
-  // Absolute, so that a second resolution (the plant's own loader, against its base folder)
-  // cannot prefix it again when the configuration was named by a relative path.
-  if (p.is_absolute()) return p.lexically_normal().string();
-  return std::filesystem::absolute(std::filesystem::path(base_dir) / p).lexically_normal().string();
-}
+// Input files are made absolute, so that a second resolution (the plant's own loader, against its
+// base folder) cannot prefix them again when the configuration was named by a relative path.
+constexpr PathForm kInputPaths = PathForm::kAbsolute;
 
 // An input file named under `key`, relative to base_dir; it must exist. Empty text: "" when
 // allowed (e.g. no collision model).
@@ -29,7 +23,7 @@ std::string input_file(const YamlReader& r, std::string_view key, const std::str
     if (allow_empty) return "";
     throw r.error(key, "empty file name");
   }
-  const std::string path = resolve(base_dir, text);
+  const std::string path = resolve_path(base_dir, text, kInputPaths);
   if (!std::filesystem::is_regular_file(path)) throw r.error(key, "file not found: " + path);
   return path;
 }
@@ -46,14 +40,10 @@ double non_negative_or(const YamlReader& r, std::string_view key, double fallbac
   return r.number_or(key, fallback, 0.0, max);
 }
 
-Eigen::Vector3d vector3(const YamlReader& r, std::string_view key, double min, double max) {
-  const auto v = r.numbers(key, 3, min, max);
-  return Eigen::Vector3d(v[0], v[1], v[2]);
-}
-
-Eigen::VectorXd per_joint(const YamlReader& r, std::string_view key, int dof, double min, double max) {
-  const auto v = r.numbers(key, dof, min, max);
-  return Eigen::Map<const Eigen::VectorXd>(v.data(), dof);
+// The pairs whose order the controller relies on (a damper's safety distance inside its influence
+// distance, a trigger's release level below its press level): an error at `key` otherwise.
+void require_below(const YamlReader& r, std::string_view key, double value, double bound, const std::string& reason) {
+  if (!(value < bound)) throw r.error(key, reason);
 }
 
 ComplianceMode compliance_mode(const YamlReader& r, std::string_view key) {
@@ -79,9 +69,8 @@ void parse_robot(const YamlReader& r, const std::string& base_dir, ControllerSet
       payload.name = p.text("name");
       payload.frame = p.text_or("frame", "");  // empty: the end-effector frame
       payload.inertia.mass = p.number("mass_kg", 0.0, 100.0);
-      payload.inertia.com = p.has("com_m") ? vector3(p, "com_m", -2.0, 2.0) : Eigen::Vector3d::Zero();
-      payload.inertia.inertia_com =
-          (p.has("inertia_kgm2") ? vector3(p, "inertia_kgm2", 0.0, 10.0) : Eigen::Vector3d::Zero()).asDiagonal();
+      payload.inertia.com = p.vector3_or("com_m", Eigen::Vector3d::Zero(), -2.0, 2.0);
+      payload.inertia.inertia_com = p.vector3_or("inertia_kgm2", Eigen::Vector3d::Zero(), 0.0, 10.0).asDiagonal();
       c.payloads.push_back(payload);
     }
   }
@@ -95,7 +84,9 @@ void absolutize_robot(YAML::Node plant, const std::string& dir) {
   YAML::Node robot = plant["robot"];
   for (const char* key : {"mjcf", "actuators"}) {
     const YAML::Node& robot_view = robot;
-    if (robot_view[key] && robot_view[key].IsScalar()) robot[key] = resolve(dir, robot_view[key].Scalar());
+    if (robot_view[key] && robot_view[key].IsScalar()) {
+      robot[key] = resolve_path(dir, robot_view[key].Scalar(), kInputPaths);
+    }
   }
 }
 
@@ -112,9 +103,9 @@ void merge(YAML::Node base, const YAML::Node& over) {
   }
 }
 
-SimRobotConfig parse_plant(const YamlReader& r, const YAML::Node& raw, const std::string& source,
-                           const std::string& base_dir) {
+SimRobotConfig parse_plant(const YamlReader& r, const std::string& base_dir) {
   r.expect_map();
+  const YAML::Node& raw = r.node();
   YAML::Node plant;
   if (r.has("file")) {
     const std::string file = input_file(r, "file", base_dir, false);
@@ -142,91 +133,105 @@ SimRobotConfig parse_plant(const YamlReader& r, const YAML::Node& raw, const std
   YAML::Emitter out;
   out << document;
   // Key paths in errors stay "plant.<...>", as in this file.
-  return SimRobotConfig::from_yaml_string(out.c_str(), source, base_dir);
+  return SimRobotConfig::from_yaml_string(out.c_str(), r.file(), base_dir);
 }
 
 // ------------------------------------------------------------------------------------ controller
+void parse_compliance_deadband(const YamlReader& d, int dof, ControllerSettings& c) {
+  d.allow_keys({"large_Nm", "small_Nm", "per_joint_Nm"});
+  c.deadband_large_Nm = non_negative_or(d, "large_Nm", c.deadband_large_Nm, 100.0);
+  c.deadband_small_Nm = non_negative_or(d, "small_Nm", c.deadband_small_Nm, 100.0);
+  if (d.has("per_joint_Nm")) c.qp.compliance_deadband = d.per_joint<Eigen::VectorXd>("per_joint_Nm", dof, 0.0, 100.0);
+}
+
+// The end-effector task's gains, in the stiff and full-body modes.
+void parse_end_effector_task(const YamlReader& m, ComplianceSettings& s) {
+  s.ee_position_stiffness = non_negative_or(m, "ee_position_stiffness", s.ee_position_stiffness, 1e5);
+  s.ee_orientation_stiffness = non_negative_or(m, "ee_orientation_stiffness", s.ee_orientation_stiffness, 1e5);
+  s.ee_weight = non_negative_or(m, "ee_weight", s.ee_weight, 1e9);
+  s.full_body_ee_stiffness = non_negative_or(m, "full_body_ee_stiffness", s.full_body_ee_stiffness, 1e5);
+}
+
+void parse_posture_task(const YamlReader& m, ComplianceSettings& s) {
+  s.posture_stiffness = non_negative_or(m, "posture_stiffness", s.posture_stiffness, 1e5);
+  s.posture_damping = non_negative_or(m, "posture_damping", s.posture_damping, 1e4);
+  s.posture_weight = positive_or(m, "posture_weight", s.posture_weight, 1e9);
+}
+
+// Dual compliance: the Schmitt trigger on the filtered wrench and the damping while touched.
+void parse_touch_trigger(const YamlReader& m, ControllerSettings& c) {
+  ComplianceSettings& s = c.compliance;
+  s.touch_threshold = non_negative_or(m, "touch_threshold", s.touch_threshold, 1e4);
+  s.release_threshold = non_negative_or(m, "release_threshold", s.release_threshold, 1e4);
+  s.touched_ee_damping = non_negative_or(m, "touched_ee_damping", s.touched_ee_damping, 1e4);
+  s.touched_posture_damping = non_negative_or(m, "touched_posture_damping", s.touched_posture_damping, 1e4);
+  c.wrench_trigger_filter_s = non_negative_or(m, "trigger_filter_s", c.wrench_trigger_filter_s, 1.0);
+  require_below(m, "release_threshold", s.release_threshold, s.touch_threshold,
+                "must be below touch_threshold (the Schmitt trigger's hysteresis)");
+}
+
+void parse_compliance(const YamlReader& m, ControllerSettings& c) {
+  m.allow_keys({"initial_mode", "ee_position_stiffness", "ee_orientation_stiffness", "ee_weight",
+                "full_body_ee_stiffness", "posture_stiffness", "posture_damping", "posture_weight", "touch_threshold",
+                "release_threshold", "touched_ee_damping", "touched_posture_damping", "trigger_filter_s"});
+  if (m.has("initial_mode")) c.initial_compliance = compliance_mode(m, "initial_mode");
+  parse_end_effector_task(m, c.compliance);
+  parse_posture_task(m, c.compliance);
+  parse_touch_trigger(m, c);
+}
+
+// qp.joint_limits: the joint-limit velocity damper.
+void parse_joint_limit_damper(const YamlReader& j, WholeBodyQpSettings& s) {
+  j.allow_keys({"influence_fraction", "safety_fraction", "amortization"});
+  s.joint_influence_fraction = positive_or(j, "influence_fraction", s.joint_influence_fraction, 0.49);
+  s.joint_safety_fraction = non_negative_or(j, "safety_fraction", s.joint_safety_fraction, 0.49);
+  s.joint_damper_amortization = j.number_or("amortization", s.joint_damper_amortization, 1.0, 100.0);
+  require_below(j, "safety_fraction", s.joint_safety_fraction, s.joint_influence_fraction,
+                "must be below influence_fraction (d_s < d_i)");
+}
+
+// qp.collision: the self-collision velocity damper.
+void parse_collision_damper(const YamlReader& k, VelocityDamperSettings& d) {
+  k.allow_keys({"influence_distance_m", "safety_distance_m", "approach_speed_m_s", "amortization"});
+  d.influence_distance = positive_or(k, "influence_distance_m", d.influence_distance, 1.0);
+  d.safety_distance = non_negative_or(k, "safety_distance_m", d.safety_distance, 1.0);
+  d.xi = positive_or(k, "approach_speed_m_s", d.xi, 10.0);
+  d.amortization = k.number_or("amortization", d.amortization, 1.0, 100.0);
+  require_below(k, "safety_distance_m", d.safety_distance, d.influence_distance,
+                "must be below influence_distance_m (d_s < d_i)");
+}
+
+void parse_qp(const YamlReader& q, int dof, WholeBodyQpSettings& s) {
+  q.allow_keys({"torque_limit_Nm", "velocity_limit_rad_s", "velocity_limit_fraction", "joint_limits",
+                "velocity_limit_gain", "collision", "regularization", "brake_damping", "smoothing_time_constant_s"});
+  if (q.has("torque_limit_Nm")) s.torque_limit = q.per_joint<Eigen::VectorXd>("torque_limit_Nm", dof, 1e-3, 1e4);
+  if (q.has("velocity_limit_rad_s")) {
+    s.velocity_limit = q.per_joint<Eigen::VectorXd>("velocity_limit_rad_s", dof, 1e-3, 100.0);
+  }
+  s.velocity_limit_fraction = positive_or(q, "velocity_limit_fraction", s.velocity_limit_fraction, 1.0);
+  if (q.has("joint_limits")) parse_joint_limit_damper(q.at("joint_limits"), s);
+  s.velocity_limit_gain = positive_or(q, "velocity_limit_gain", s.velocity_limit_gain, 1e4);
+  if (q.has("collision")) parse_collision_damper(q.at("collision"), s.collision);
+  s.regularization = non_negative_or(q, "regularization", s.regularization, 1.0);
+  s.brake_damping = positive_or(q, "brake_damping", s.brake_damping, 1e4);
+  s.smoothing_time_constant = non_negative_or(q, "smoothing_time_constant_s", s.smoothing_time_constant, 10.0);
+}
+
+void parse_wrench(const YamlReader& w, WrenchEstimatorSettings& s) {
+  w.allow_keys({"tool_mass_kg", "tool_com_m", "bias_samples"});
+  s.tool_mass_kg = non_negative_or(w, "tool_mass_kg", s.tool_mass_kg, 100.0);
+  s.tool_com_m = w.vector3_or("tool_com_m", s.tool_com_m, -2.0, 2.0);
+  s.bias_samples = static_cast<int>(w.integer_or("bias_samples", s.bias_samples, 0, 1000000));
+}
+
 void parse_controller(const YamlReader& r, int dof, ControllerSettings& c) {
   r.allow_keys({"period_s", "observer_gain", "compliance_deadband", "compliance", "qp", "wrench"});
   c.period_s = positive_or(r, "period_s", c.period_s, 0.1);
   c.observer_gain = positive_or(r, "observer_gain", c.observer_gain, 1e4);
-
-  if (r.has("compliance_deadband")) {
-    const YamlReader d = r.at("compliance_deadband");
-    d.allow_keys({"large_Nm", "small_Nm", "per_joint_Nm"});
-    c.deadband_large_Nm = non_negative_or(d, "large_Nm", c.deadband_large_Nm, 100.0);
-    c.deadband_small_Nm = non_negative_or(d, "small_Nm", c.deadband_small_Nm, 100.0);
-    if (d.has("per_joint_Nm")) c.qp.compliance_deadband = per_joint(d, "per_joint_Nm", dof, 0.0, 100.0);
-  }
-
-  if (r.has("compliance")) {
-    const YamlReader m = r.at("compliance");
-    m.allow_keys({"initial_mode", "ee_position_stiffness", "ee_orientation_stiffness", "ee_weight",
-                  "full_body_ee_stiffness", "posture_stiffness", "posture_damping", "posture_weight",
-                  "touch_threshold", "release_threshold", "touched_ee_damping", "touched_posture_damping",
-                  "trigger_filter_s"});
-    ComplianceSettings& s = c.compliance;
-    if (m.has("initial_mode")) c.initial_compliance = compliance_mode(m, "initial_mode");
-    s.ee_position_stiffness = non_negative_or(m, "ee_position_stiffness", s.ee_position_stiffness, 1e5);
-    s.ee_orientation_stiffness = non_negative_or(m, "ee_orientation_stiffness", s.ee_orientation_stiffness, 1e5);
-    s.ee_weight = non_negative_or(m, "ee_weight", s.ee_weight, 1e9);
-    s.full_body_ee_stiffness = non_negative_or(m, "full_body_ee_stiffness", s.full_body_ee_stiffness, 1e5);
-    s.posture_stiffness = non_negative_or(m, "posture_stiffness", s.posture_stiffness, 1e5);
-    s.posture_damping = non_negative_or(m, "posture_damping", s.posture_damping, 1e4);
-    s.posture_weight = positive_or(m, "posture_weight", s.posture_weight, 1e9);
-    s.touch_threshold = non_negative_or(m, "touch_threshold", s.touch_threshold, 1e4);
-    s.release_threshold = non_negative_or(m, "release_threshold", s.release_threshold, 1e4);
-    s.touched_ee_damping = non_negative_or(m, "touched_ee_damping", s.touched_ee_damping, 1e4);
-    s.touched_posture_damping = non_negative_or(m, "touched_posture_damping", s.touched_posture_damping, 1e4);
-    c.wrench_trigger_filter_s = non_negative_or(m, "trigger_filter_s", c.wrench_trigger_filter_s, 1.0);
-    if (!(s.release_threshold < s.touch_threshold)) {
-      throw m.error("release_threshold", "must be below touch_threshold (the Schmitt trigger's hysteresis)");
-    }
-  }
-
-  if (r.has("qp")) {
-    const YamlReader q = r.at("qp");
-    q.allow_keys({"torque_limit_Nm", "velocity_limit_rad_s", "velocity_limit_fraction", "joint_limits",
-                  "velocity_limit_gain", "collision", "regularization", "brake_damping", "smoothing_time_constant_s"});
-    WholeBodyQpSettings& s = c.qp;
-    if (q.has("torque_limit_Nm")) s.torque_limit = per_joint(q, "torque_limit_Nm", dof, 1e-3, 1e4);
-    if (q.has("velocity_limit_rad_s")) s.velocity_limit = per_joint(q, "velocity_limit_rad_s", dof, 1e-3, 100.0);
-    s.velocity_limit_fraction = positive_or(q, "velocity_limit_fraction", s.velocity_limit_fraction, 1.0);
-    if (q.has("joint_limits")) {
-      const YamlReader j = q.at("joint_limits");
-      j.allow_keys({"influence_fraction", "safety_fraction", "amortization"});
-      s.joint_influence_fraction = positive_or(j, "influence_fraction", s.joint_influence_fraction, 0.49);
-      s.joint_safety_fraction = non_negative_or(j, "safety_fraction", s.joint_safety_fraction, 0.49);
-      s.joint_damper_amortization = j.number_or("amortization", s.joint_damper_amortization, 1.0, 100.0);
-      if (!(s.joint_safety_fraction < s.joint_influence_fraction)) {
-        throw j.error("safety_fraction", "must be below influence_fraction (d_s < d_i)");
-      }
-    }
-    s.velocity_limit_gain = positive_or(q, "velocity_limit_gain", s.velocity_limit_gain, 1e4);
-    if (q.has("collision")) {
-      const YamlReader k = q.at("collision");
-      k.allow_keys({"influence_distance_m", "safety_distance_m", "approach_speed_m_s", "amortization"});
-      VelocityDamperSettings& d = s.collision;
-      d.influence_distance = positive_or(k, "influence_distance_m", d.influence_distance, 1.0);
-      d.safety_distance = non_negative_or(k, "safety_distance_m", d.safety_distance, 1.0);
-      d.xi = positive_or(k, "approach_speed_m_s", d.xi, 10.0);
-      d.amortization = k.number_or("amortization", d.amortization, 1.0, 100.0);
-      if (!(d.safety_distance < d.influence_distance)) {
-        throw k.error("safety_distance_m", "must be below influence_distance_m (d_s < d_i)");
-      }
-    }
-    s.regularization = non_negative_or(q, "regularization", s.regularization, 1.0);
-    s.brake_damping = positive_or(q, "brake_damping", s.brake_damping, 1e4);
-    s.smoothing_time_constant = non_negative_or(q, "smoothing_time_constant_s", s.smoothing_time_constant, 10.0);
-  }
-
-  if (r.has("wrench")) {
-    const YamlReader w = r.at("wrench");
-    w.allow_keys({"tool_mass_kg", "tool_com_m", "bias_samples"});
-    c.wrench.tool_mass_kg = non_negative_or(w, "tool_mass_kg", c.wrench.tool_mass_kg, 100.0);
-    if (w.has("tool_com_m")) c.wrench.tool_com_m = vector3(w, "tool_com_m", -2.0, 2.0);
-    c.wrench.bias_samples = static_cast<int>(w.integer_or("bias_samples", c.wrench.bias_samples, 0, 1000000));
-  }
+  if (r.has("compliance_deadband")) parse_compliance_deadband(r.at("compliance_deadband"), dof, c);
+  if (r.has("compliance")) parse_compliance(r.at("compliance"), c);
+  if (r.has("qp")) parse_qp(r.at("qp"), dof, c.qp);
+  if (r.has("wrench")) parse_wrench(r.at("wrench"), c.wrench);
 }
 
 // ------------------------------------------------------------------------------------ low level
@@ -264,7 +269,7 @@ void parse_fsm(const YamlReader& r, int dof, FsmSettings& f) {
     s.allow_keys({"enabled", "home_q_rad", "max_joint_speed_rad_s", "min_duration_s", "tolerance_rad", "timeout_s"});
     StartupSettings& st = f.startup;
     st.enabled = s.boolean_or("enabled", st.enabled);
-    if (s.has("home_q_rad")) st.home_q_rad = s.numbers("home_q_rad", dof, -100.0, 100.0);
+    if (s.has("home_q_rad")) st.home_q_rad = s.per_joint("home_q_rad", dof, -100.0, 100.0);
     st.max_joint_speed_rad_s = positive_or(s, "max_joint_speed_rad_s", st.max_joint_speed_rad_s, 5.0);
     st.min_duration_s = non_negative_or(s, "min_duration_s", st.min_duration_s, 1000.0);
     st.tolerance_rad = positive_or(s, "tolerance_rad", st.tolerance_rad, 10.0);
@@ -274,7 +279,7 @@ void parse_fsm(const YamlReader& r, int dof, FsmSettings& f) {
     const YamlReader s = r.at("static");
     s.allow_keys({"posture_q_rad", "move_speed_m_s", "move_angular_speed_rad_s", "min_move_duration_s"});
     StaticScenarioSettings& st = f.static_scenario;
-    if (s.has("posture_q_rad")) st.posture_q_rad = s.numbers("posture_q_rad", dof, -100.0, 100.0);
+    if (s.has("posture_q_rad")) st.posture_q_rad = s.per_joint("posture_q_rad", dof, -100.0, 100.0);
     st.move_speed_m_s = positive_or(s, "move_speed_m_s", st.move_speed_m_s, 2.0);
     st.move_angular_speed_rad_s = positive_or(s, "move_angular_speed_rad_s", st.move_angular_speed_rad_s, 10.0);
     st.min_move_duration_s = non_negative_or(s, "min_move_duration_s", st.min_move_duration_s, 1000.0);
@@ -341,8 +346,8 @@ std::vector<TimedEvent> parse_events(const YamlReader& list, double duration_s) 
   return out;
 }
 
-Config parse(const YAML::Node& raw, const std::string& source, const std::string& base_dir) {
-  const YamlReader root(raw, source, "");
+Config parse(const YamlReader& root, const std::string& base_dir) {
+  const std::string& source = root.file();
   root.allow_keys({"robot", "plant", "controller", "low_level", "fsm", "events", "logging", "gamepad", "run"});
   Config c;
   c.source = source;
@@ -351,7 +356,7 @@ Config parse(const YAML::Node& raw, const std::string& source, const std::string
   const int dof = ActuatorTable::from_yaml_file(c.controller.actuators_path).size();
 
   const YamlReader plant = root.at("plant");
-  c.plant = parse_plant(plant, raw["plant"], source, base_dir);
+  c.plant = parse_plant(plant, base_dir);
   if (c.plant.dof() != dof) {
     throw ConfigError(source, "plant.robot.actuators",
                       "the plant has " + std::to_string(c.plant.dof()) + " joints, the controller's robot.actuators " +
@@ -388,7 +393,7 @@ Config parse(const YAML::Node& raw, const std::string& source, const std::string
     GamepadMapping& m = c.gamepad.mapping;
     m.trigger_press = positive_or(g, "trigger_press", m.trigger_press, 1.0);
     m.trigger_release = non_negative_or(g, "trigger_release", m.trigger_release, 1.0);
-    if (!(m.trigger_release < m.trigger_press)) throw g.error("trigger_release", "must be below trigger_press");
+    require_below(g, "trigger_release", m.trigger_release, m.trigger_press, "must be below trigger_press");
   }
 
   if (root.has("run")) {
@@ -407,21 +412,11 @@ Config parse(const YAML::Node& raw, const std::string& source, const std::string
 }  // namespace
 
 Config Config::from_yaml_file(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw ConfigError(path, "", "cannot open the file");
-  std::stringstream text;
-  text << in.rdbuf();
-  return from_yaml_string(text.str(), path, std::filesystem::path(path).parent_path().string());
+  return parse(YamlReader::load_file(path), std::filesystem::path(path).parent_path().string());
 }
 
 Config Config::from_yaml_string(const std::string& yaml, const std::string& source_name, const std::string& base_dir) {
-  YAML::Node raw;
-  try {
-    raw = YAML::Load(yaml);
-  } catch (const YAML::Exception& e) {
-    throw ConfigError(source_name, "", std::string("invalid YAML: ") + e.what());
-  }
-  return parse(raw, source_name, base_dir);
+  return parse(YamlReader::load_string(yaml, source_name), base_dir);
 }
 
 }  // namespace phri

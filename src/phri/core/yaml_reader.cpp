@@ -1,24 +1,29 @@
+#include <phri/core/number_text.hpp>
 #include <phri/core/yaml_reader.hpp>
 
 #include <cmath>
-#include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
 namespace phri {
 namespace {
 
-std::string format_number(double value) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof(buffer), "%.10g", value);
-  return buffer;
-}
+// Significant digits of the numbers in error messages.
+constexpr int kMessageDigits = 10;
 
 std::string range_text(double min, double max) {
-  return "[" + format_number(min) + ", " + format_number(max) + "]";
+  return "[" + format_number(min, kMessageDigits) + ", " + format_number(max, kMessageDigits) + "]";
 }
 
 }  // namespace
+
+std::string resolve_path(const std::string& base_dir, const std::string& file, PathForm form) {
+  // An absolute `file` replaces base_dir in the join; an empty base_dir leaves `file` as it is.
+  std::filesystem::path path = std::filesystem::path(base_dir) / file;
+  if (form == PathForm::kAbsolute) path = std::filesystem::absolute(path);
+  return path.lexically_normal().string();
+}
 
 YamlReader YamlReader::load_file(const std::string& path) {
   std::ifstream in(path);
@@ -126,7 +131,7 @@ double YamlReader::as_number(double min, double max) const {
   }
   if (!std::isfinite(value)) throw error("", "must be finite, got '" + node_.Scalar() + "'");
   if (value < min || value > max) {
-    throw error("", "must be in " + range_text(min, max) + ", got " + format_number(value));
+    throw error("", "must be in " + range_text(min, max) + ", got " + format_number(value, kMessageDigits));
   }
   return value;
 }
@@ -212,6 +217,16 @@ std::vector<double> YamlReader::numbers(std::string_view key, int expected_size,
   out.reserve(list.size());
   for (std::size_t i = 0; i < list.size(); ++i) out.push_back(list.at(i).as_number(min, max));
   return out;
+}
+
+Eigen::Vector3d YamlReader::vector3(std::string_view key, double min, double max) const {
+  const std::vector<double> v = numbers(key, 3, min, max);
+  return Eigen::Vector3d(v[0], v[1], v[2]);
+}
+
+Eigen::Vector3d YamlReader::vector3_or(std::string_view key, const Eigen::Vector3d& fallback, double min,
+                                       double max) const {
+  return has(key) ? vector3(key, min, max) : fallback;
 }
 
 }  // namespace phri

@@ -13,15 +13,30 @@
 // files include this header (it is installed with the others but needs yaml-cpp's headers).
 #include <phri/core/error.hpp>
 
+#include <Eigen/Core>
 #include <yaml-cpp/yaml.h>
 
 #include <cstddef>
 #include <initializer_list>
 #include <string>
 #include <string_view>
+#include <type_traits>
 #include <vector>
 
 namespace phri {
+
+/// What resolve_path does with a relative result (see there).
+enum class PathForm {
+  kAsGiven,   ///< base_dir / file, relative when base_dir is
+  kAbsolute,  ///< anchored at the working directory
+};
+
+/// `file` as named in a YAML file whose folder is `base_dir`: an absolute `file` stays as it is
+/// (normalised), a relative one is joined to `base_dir`. The plant loader keeps paths in the form
+/// it was given (kAsGiven: the paths it reports are the caller's); the run configuration makes
+/// them absolute (kAbsolute) so that the plant loader, resolving them again against its own base
+/// folder, cannot prefix them a second time.
+std::string resolve_path(const std::string& base_dir, const std::string& file, PathForm form);
 
 class YamlReader {
 public:
@@ -80,6 +95,15 @@ public:
                         std::initializer_list<std::string_view> choices) const;
   /// A sequence of numbers; `expected_size` < 0 accepts any length.
   std::vector<double> numbers(std::string_view key, int expected_size, double min, double max) const;
+  /// Exactly `dof` numbers, one per joint, as std::vector<double> or Eigen::VectorXd.
+  template <class Vector = std::vector<double>>
+  Vector per_joint(std::string_view key, int dof, double min, double max) const;
+  /// Three numbers (a point, a force, principal inertias...).
+  Eigen::Vector3d vector3(std::string_view key, double min, double max) const;
+  Eigen::Vector3d vector3_or(std::string_view key, const Eigen::Vector3d& fallback, double min, double max) const;
+
+  /// The node itself, for loaders that compose documents (merging a file with overrides).
+  const YAML::Node& node() const { return node_; }
 
   /// A ConfigError for this node (key empty) or one of its keys.
   ConfigError error(std::string_view key, const std::string& reason) const;
@@ -89,5 +113,16 @@ private:
   std::string file_;
   std::string path_;
 };
+
+template <class Vector>
+Vector YamlReader::per_joint(std::string_view key, int dof, double min, double max) const {
+  static_assert(std::is_same_v<Vector, std::vector<double>> || std::is_same_v<Vector, Eigen::VectorXd>);
+  std::vector<double> values = numbers(key, dof, min, max);
+  if constexpr (std::is_same_v<Vector, Eigen::VectorXd>) {
+    return Eigen::Map<const Eigen::VectorXd>(values.data(), dof);
+  } else {
+    return values;
+  }
+}
 
 }  // namespace phri

@@ -32,7 +32,7 @@ SimRobotConfig completed(SimRobotConfig config) {
   return config;
 }
 
-mjModel* load_scene(const std::string& xml, const std::string& source) {
+MjModelPtr load_scene(const std::string& xml, const std::string& source) {
   mjVFS vfs;
   mj_defaultVFS(&vfs);
   const char* name = "phri_scene.xml";
@@ -42,9 +42,9 @@ mjModel* load_scene(const std::string& xml, const std::string& source) {
   const int index = mj_findFileVFS(&vfs, name);
   std::memcpy(vfs.filedata[index], xml.data(), xml.size());
   char error[1024] = "";
-  mjModel* m = mj_loadXML(name, &vfs, error, sizeof(error));
+  MjModelPtr m(mj_loadXML(name, &vfs, error, sizeof(error)));
   mj_deleteVFS(&vfs);
-  if (m == nullptr) throw ConfigError(source, "scene", std::string("MuJoCo cannot load the composed scene: ") + error);
+  if (!m) throw ConfigError(source, "scene", std::string("MuJoCo cannot load the composed scene: ") + error);
   return m;
 }
 
@@ -56,6 +56,42 @@ Eigen::Matrix3d rotation(const mjtNum* xmat) {
   return r;
 }
 
+// The body's first capsule geom, -1 if it has none.
+int first_capsule(const mjModel* m, int body) {
+  for (int g = m->body_geomadr[body]; g >= 0 && g < m->body_geomadr[body] + m->body_geomnum[body]; ++g) {
+    if (m->geom_type[g] == mjGEOM_CAPSULE) return g;
+  }
+  return -1;
+}
+
+// The segment and radius of a capsule geom, in its body's frame: where random pushes land.
+RandomPushGenerator::LinkSurface capsule_surface(const mjModel* m, int body, int capsule) {
+  RandomPushGenerator::LinkSurface s;
+  s.body = body;
+  s.radius = m->geom_size[3 * capsule];
+  const double half = m->geom_size[3 * capsule + 1];
+  // Capsule axis = the geom's local z, placed by geom_pos / geom_quat in the body frame.
+  mjtNum axis[3];
+  const mjtNum z[3] = {0.0, 0.0, half};
+  mju_rotVecQuat(axis, z, m->geom_quat + 4 * capsule);
+  const Eigen::Vector3d c(m->geom_pos[3 * capsule], m->geom_pos[3 * capsule + 1], m->geom_pos[3 * capsule + 2]);
+  const Eigen::Vector3d a(axis[0], axis[1], axis[2]);
+  s.p0 = c - a;
+  s.p1 = c + a;
+  return s;
+}
+
+// The mode and the set-point that mode uses; the other set-points keep their values.
+void copy_setpoint(const RobotCommand& from, RobotCommand& to) {
+  to.mode = from.mode;
+  switch (from.mode) {
+    case LowLevelMode::kPosition: to.q_rad = from.q_rad; break;
+    case LowLevelMode::kKinovaTorque:
+    case LowLevelMode::kKinovaTorqueHighVelocity: to.tau_Nm = from.tau_Nm; break;
+    case LowLevelMode::kCurrent: to.current_A = from.current_A; break;
+  }
+}
+
 }  // namespace
 
 SimRobot::SimRobot(const SimRobotConfig& config)
@@ -63,185 +99,183 @@ SimRobot::SimRobot(const SimRobotConfig& config)
       plant_actuators_(config_.plant_actuators()),
       n_(config_.dof()),
       drive_(config_.actuators, config_.vendor, config_.physics_step_s(), config_.control_period_s) {
-  const std::string& src = config_.source;
   substeps_ = config_.substeps_per_cycle();
   filter_decimation_ = static_cast<int>(std::lround(config_.physics_rate_Hz / config_.vendor.high_velocity_rate_Hz));
   ft_decimation_ = static_cast<int>(std::lround(config_.physics_rate_Hz / config_.ft_sensor.rate_Hz));
 
   scene_xml_ = SimScene::build_mjcf(config_);
   m_ = load_scene(scene_xml_, config_.mjcf_path);
-  std::unique_ptr<mjModel, void (*)(mjModel*)> model_guard(m_, mj_deleteModel);
-
-  // ---- options
-  const double dt = config_.physics_step_s();
-  m_->opt.timestep = dt;
-  m_->opt.integrator = mjINT_EULER;
-  m_->opt.disableflags |= mjDSBL_SENSOR;  // enabled only on F/T sampling steps
-  if (!config_.floor.enabled) m_->opt.disableflags |= mjDSBL_CONTACT;
-
-  // ---- arm joints, in the order of actuators.yaml
-  qadr_.resize(static_cast<std::size_t>(n_));
-  dadr_.resize(static_cast<std::size_t>(n_));
-  lower_.resize(n_);
-  upper_.resize(n_);
-  torque_per_amp_.resize(n_);
-  nominal_torque_per_amp_.resize(n_);
-  vendor_torque_ = Eigen::VectorXd::Zero(n_);
-  current_limit_.resize(n_);
-  max_torque_.resize(n_);
-  armature_.resize(n_);
-  viscous_.resize(n_);
-  offsets_.resize(n_);
-  std::vector<int> arm_bodies;
-  for (int i = 0; i < n_; ++i) {
-    const ActuatorParameters& a = plant_actuators_[i];
-    const int j = mj_name2id(m_, mjOBJ_JOINT, a.joint_name.c_str());
-    if (j < 0) throw ConfigError(config_.mjcf_path, a.joint_name, "joint of actuators.yaml missing in the MJCF");
-    if (m_->jnt_type[j] != mjJNT_HINGE) throw ConfigError(config_.mjcf_path, a.joint_name, "expected a hinge joint");
-    const auto k = static_cast<std::size_t>(i);
-    qadr_[k] = m_->jnt_qposadr[j];
-    dadr_[k] = m_->jnt_dofadr[j];
-    arm_bodies.push_back(m_->jnt_bodyid[j]);
-    if (m_->jnt_limited[j]) {
-      lower_[i] = m_->jnt_range[2 * j];
-      upper_[i] = m_->jnt_range[2 * j + 1];
-    } else {
-      lower_[i] = -100.0;
-      upper_[i] = 100.0;
-    }
-    torque_per_amp_[i] = a.torque_per_amp();
-    nominal_torque_per_amp_[i] = config_.actuators[i].torque_per_amp();
-    current_limit_[i] = a.current_limit_A;
-    max_torque_[i] = a.max_motor_torque_Nm();
-    armature_[i] = a.reflected_inertia_kgm2;
-    viscous_[i] = a.friction.viscous_Nms_per_rad;
-    offsets_[i] = config_.noise.torque_sensor_offset_Nm[k];
-    const int d = dadr_[k];
-    m_->dof_armature[d] = a.reflected_inertia_kgm2;
-    // Dry friction: StickSlipFriction (its spring through qfrc_applied, its damper and the viscous
-    // friction through MuJoCo's joint damping, which the Euler step integrates implicitly).
-    m_->dof_damping[d] = a.friction.viscous_Nms_per_rad;
-    m_->dof_frictionloss[d] = 0.0;
-    dry_.emplace_back(StickSlipFriction::presliding(a.friction.coulomb_Nm, a.friction.static_Nm,
-                                                    a.reflected_inertia_kgm2, dt,
-                                                    config_.friction.breakaway_velocity_rad_s));
-  }
-  quantum_ = config_.noise.encoder_counts_per_rev > 0.0 ? 2.0 * 3.14159265358979323846 / config_.noise.encoder_counts_per_rev
-                                                         : 0.0;
-
-  // ---- link inertial mismatch (arm links only; the scene's tool is configured explicitly)
-  if (config_.mismatch.enabled) {
-    RandomGenerator rng(config_.mismatch.seed, kMismatchStream);
-    for (int b : arm_bodies) {
-      LinkInertial li;
-      li.mass_kg = m_->body_mass[b];
-      li.com_m = Eigen::Vector3d(m_->body_ipos[3 * b], m_->body_ipos[3 * b + 1], m_->body_ipos[3 * b + 2]);
-      li.principal_kgm2 =
-          Eigen::Vector3d(m_->body_inertia[3 * b], m_->body_inertia[3 * b + 1], m_->body_inertia[3 * b + 2]);
-      const LinkInertial p = li.perturbed(config_.mismatch.mass_fraction, config_.mismatch.com_fraction,
-                                          config_.mismatch.inertia_fraction, rng);
-      m_->body_mass[b] = p.mass_kg;
-      for (int k = 0; k < 3; ++k) {
-        m_->body_ipos[3 * b + k] = p.com_m[k];
-        m_->body_inertia[3 * b + k] = p.principal_kgm2[k];
-      }
-    }
-  }
-
-  // ---- scene objects
-  tool_body_ = mj_name2id(m_, mjOBJ_BODY, SimScene::kToolBody);
-  sensor_site_ = mj_name2id(m_, mjOBJ_SITE, SimScene::kSensorSite);
-  const int force_sensor = mj_name2id(m_, mjOBJ_SENSOR, SimScene::kForceSensor);
-  const int torque_sensor = mj_name2id(m_, mjOBJ_SENSOR, SimScene::kTorqueSensor);
-  if (tool_body_ < 0 || sensor_site_ < 0 || force_sensor < 0 || torque_sensor < 0) {
-    throw ConfigError(src, "scene", "tool body or F/T sensor missing from the composed scene");
-  }
-  force_adr_ = m_->sensor_adr[force_sensor];
-  torque_adr_ = m_->sensor_adr[torque_sensor];
-  if (config_.drop_test.enabled) {
-    anchor_site_ = mj_name2id(m_, mjOBJ_SITE, SimScene::kAnchorSite);
-    drop_body_ = mj_name2id(m_, mjOBJ_BODY, SimScene::kDropBody);
-    const int free = m_->body_jntadr[drop_body_];
-    drop_qadr_ = m_->jnt_qposadr[free];
-    drop_dadr_ = m_->jnt_dofadr[free];
-    latch_damping_ = 2.0 * std::sqrt(config_.drop_test.latch_stiffness_N_per_m * config_.drop_test.mass_kg);
-  }
-  for (std::size_t i = 0; i < config_.disturbances.size(); ++i) {
-    const auto& f = config_.disturbances[i];
-    const int b = mj_name2id(m_, mjOBJ_BODY, f.body.c_str());
-    if (b <= 0) {
-      throw ConfigError(src, "plant.disturbances[" + std::to_string(i) + "].body", "no body '" + f.body + "' in the scene");
-    }
-    disturbance_bodies_.push_back(b);
-  }
-  if (config_.random_pushes.enabled) {
-    std::vector<std::string> names = config_.random_pushes.links;
-    if (names.empty()) {
-      for (int b : arm_bodies) names.emplace_back(mj_id2name(m_, mjOBJ_BODY, b));
-    }
-    for (std::size_t i = 0; i < names.size(); ++i) {
-      const int b = mj_name2id(m_, mjOBJ_BODY, names[i].c_str());
-      const std::string key = "plant.random_pushes.links[" + std::to_string(i) + "]";
-      if (b <= 0) throw ConfigError(src, key, "no body '" + names[i] + "' in the scene");
-      int capsule = -1;
-      for (int g = m_->body_geomadr[b]; g >= 0 && g < m_->body_geomadr[b] + m_->body_geomnum[b]; ++g) {
-        if (m_->geom_type[g] == mjGEOM_CAPSULE) {
-          capsule = g;
-          break;
-        }
-      }
-      if (capsule < 0) throw ConfigError(src, key, "body '" + names[i] + "' has no capsule geom to push on");
-      RandomPushGenerator::LinkSurface s;
-      s.body = b;
-      s.radius = m_->geom_size[3 * capsule];
-      const double half = m_->geom_size[3 * capsule + 1];
-      // Capsule axis = the geom's local z, placed by geom_pos / geom_quat in the body frame.
-      mjtNum axis[3];
-      const mjtNum z[3] = {0.0, 0.0, half};
-      mju_rotVecQuat(axis, z, m_->geom_quat + 4 * capsule);
-      const Eigen::Vector3d c(m_->geom_pos[3 * capsule], m_->geom_pos[3 * capsule + 1], m_->geom_pos[3 * capsule + 2]);
-      const Eigen::Vector3d a(axis[0], axis[1], axis[2]);
-      s.p0 = c - a;
-      s.p1 = c + a;
-      push_links_.push_back(s);
-    }
-  }
-
-  d_ = mj_makeData(m_);
-  if (d_ == nullptr) throw ConfigError(src, "scene", "MuJoCo could not allocate its data");
-  mj_setConst(m_, d_);  // derived constants after the inertial and armature edits
-  model_guard.release();
-
-  // ---- buffers
-  command_ = RobotCommand(n_);
-  pending_ = RobotCommand(n_);
-  state_ = RobotState(n_);
-  q_meas_ = Eigen::VectorXd::Zero(n_);
-  qd_meas_ = Eigen::VectorXd::Zero(n_);
-  tau_meas_ = Eigen::VectorXd::Zero(n_);
-  current_ = Eigen::VectorXd::Zero(n_);
-  tau_motor_ = Eigen::VectorXd::Zero(n_);
-  tau_viscous_ = Eigen::VectorXd::Zero(n_);
-  tau_dry_ = Eigen::VectorXd::Zero(n_);
-  tau_s_ = Eigen::VectorXd::Zero(n_);
-  v_before_ = Eigen::VectorXd::Zero(n_);
-  f_dry_ = Eigen::VectorXd::Zero(n_);
-  damping_ = Eigen::VectorXd::Zero(n_);
-  qdd_ = Eigen::VectorXd::Zero(n_);
-  for (Eigen::VectorXd* v : {&truth_.q_rad, &truth_.qd_rad_s, &truth_.qdd_rad_s2, &truth_.current_A,
-                             &truth_.tau_motor_Nm, &truth_.tau_friction_Nm, &truth_.tau_transmitted_Nm}) {
-    *v = Eigen::VectorXd::Zero(n_);
-  }
+  set_physics_options();
+  const std::vector<int> arm_bodies = bind_arm_joints();
+  if (config_.mismatch.enabled) perturb_link_inertials(arm_bodies);
+  find_ft_sensor();
+  if (config_.drop_test.enabled) find_drop_test();
+  find_disturbance_bodies();
+  if (config_.random_pushes.enabled) find_push_links(arm_bodies);
+  make_data();
+  allocate_buffers();
   reset();
 }
 
-SimRobot::~SimRobot() {
-  if (d_ != nullptr) mj_deleteData(d_);
-  if (m_ != nullptr) mj_deleteModel(m_);
+SimRobot::~SimRobot() = default;
+
+void SimRobot::set_physics_options() {
+  m_->opt.timestep = config_.physics_step_s();
+  m_->opt.integrator = mjINT_EULER;
+  m_->opt.disableflags |= mjDSBL_SENSOR;  // enabled only on F/T sampling steps
+  if (!config_.floor.enabled) m_->opt.disableflags |= mjDSBL_CONTACT;
+}
+
+std::vector<int> SimRobot::bind_arm_joints() {
+  qadr_.resize(static_cast<std::size_t>(n_));
+  dadr_.resize(static_cast<std::size_t>(n_));
+  // Filled joint by joint in bind_joint().
+  for (Eigen::VectorXd* v : {&lower_, &upper_, &torque_per_amp_, &nominal_torque_per_amp_, &current_limit_,
+                             &max_torque_, &armature_, &viscous_, &offsets_}) {
+    v->resize(n_);
+  }
+  vendor_torque_ = Eigen::VectorXd::Zero(n_);
+  std::vector<int> arm_bodies;
+  for (int i = 0; i < n_; ++i) arm_bodies.push_back(bind_joint(i));
+  quantum_ = config_.noise.encoder_counts_per_rev > 0.0 ? 2.0 * 3.14159265358979323846 / config_.noise.encoder_counts_per_rev
+                                                         : 0.0;
+  return arm_bodies;
+}
+
+int SimRobot::bind_joint(int i) {
+  const ActuatorParameters& a = plant_actuators_[i];
+  const int j = mj_name2id(m_.get(), mjOBJ_JOINT, a.joint_name.c_str());
+  if (j < 0) throw ConfigError(config_.mjcf_path, a.joint_name, "joint of actuators.yaml missing in the MJCF");
+  if (m_->jnt_type[j] != mjJNT_HINGE) throw ConfigError(config_.mjcf_path, a.joint_name, "expected a hinge joint");
+  const auto k = static_cast<std::size_t>(i);
+  qadr_[k] = m_->jnt_qposadr[j];
+  dadr_[k] = m_->jnt_dofadr[j];
+  if (m_->jnt_limited[j]) {
+    lower_[i] = m_->jnt_range[2 * j];
+    upper_[i] = m_->jnt_range[2 * j + 1];
+  } else {
+    lower_[i] = -100.0;
+    upper_[i] = 100.0;
+  }
+  torque_per_amp_[i] = a.torque_per_amp();
+  nominal_torque_per_amp_[i] = config_.actuators[i].torque_per_amp();
+  current_limit_[i] = a.current_limit_A;
+  max_torque_[i] = a.max_motor_torque_Nm();
+  armature_[i] = a.reflected_inertia_kgm2;
+  viscous_[i] = a.friction.viscous_Nms_per_rad;
+  offsets_[i] = config_.noise.torque_sensor_offset_Nm[k];
+  const int d = dadr_[k];
+  m_->dof_armature[d] = a.reflected_inertia_kgm2;
+  // Dry friction: StickSlipFriction (its spring through qfrc_applied, its damper and the viscous
+  // friction through MuJoCo's joint damping, which the Euler step integrates implicitly).
+  m_->dof_damping[d] = a.friction.viscous_Nms_per_rad;
+  m_->dof_frictionloss[d] = 0.0;
+  dry_.emplace_back(StickSlipFriction::presliding(a.friction.coulomb_Nm, a.friction.static_Nm,
+                                                  a.reflected_inertia_kgm2, config_.physics_step_s(),
+                                                  config_.friction.breakaway_velocity_rad_s));
+  return m_->jnt_bodyid[j];
+}
+
+// Arm links only; the scene's tool is configured explicitly.
+void SimRobot::perturb_link_inertials(const std::vector<int>& arm_bodies) {
+  RandomGenerator rng(config_.mismatch.seed, kMismatchStream);
+  for (int b : arm_bodies) {
+    LinkInertial li;
+    li.mass_kg = m_->body_mass[b];
+    li.com_m = Eigen::Vector3d(m_->body_ipos[3 * b], m_->body_ipos[3 * b + 1], m_->body_ipos[3 * b + 2]);
+    li.principal_kgm2 =
+        Eigen::Vector3d(m_->body_inertia[3 * b], m_->body_inertia[3 * b + 1], m_->body_inertia[3 * b + 2]);
+    const LinkInertial p = li.perturbed(config_.mismatch.mass_fraction, config_.mismatch.com_fraction,
+                                        config_.mismatch.inertia_fraction, rng);
+    m_->body_mass[b] = p.mass_kg;
+    for (int k = 0; k < 3; ++k) {
+      m_->body_ipos[3 * b + k] = p.com_m[k];
+      m_->body_inertia[3 * b + k] = p.principal_kgm2[k];
+    }
+  }
+}
+
+void SimRobot::find_ft_sensor() {
+  tool_body_ = mj_name2id(m_.get(), mjOBJ_BODY, SimScene::kToolBody);
+  sensor_site_ = mj_name2id(m_.get(), mjOBJ_SITE, SimScene::kSensorSite);
+  const int force_sensor = mj_name2id(m_.get(), mjOBJ_SENSOR, SimScene::kForceSensor);
+  const int torque_sensor = mj_name2id(m_.get(), mjOBJ_SENSOR, SimScene::kTorqueSensor);
+  if (tool_body_ < 0 || sensor_site_ < 0 || force_sensor < 0 || torque_sensor < 0) {
+    throw ConfigError(config_.source, "scene", "tool body or F/T sensor missing from the composed scene");
+  }
+  force_adr_ = m_->sensor_adr[force_sensor];
+  torque_adr_ = m_->sensor_adr[torque_sensor];
+}
+
+void SimRobot::find_drop_test() {
+  anchor_site_ = mj_name2id(m_.get(), mjOBJ_SITE, SimScene::kAnchorSite);
+  drop_body_ = mj_name2id(m_.get(), mjOBJ_BODY, SimScene::kDropBody);
+  const int free = m_->body_jntadr[drop_body_];
+  drop_qadr_ = m_->jnt_qposadr[free];
+  drop_dadr_ = m_->jnt_dofadr[free];
+  latch_damping_ = 2.0 * std::sqrt(config_.drop_test.latch_stiffness_N_per_m * config_.drop_test.mass_kg);
+}
+
+void SimRobot::find_disturbance_bodies() {
+  for (std::size_t i = 0; i < config_.disturbances.size(); ++i) {
+    const auto& f = config_.disturbances[i];
+    const int b = mj_name2id(m_.get(), mjOBJ_BODY, f.body.c_str());
+    if (b <= 0) {
+      throw ConfigError(config_.source, "plant.disturbances[" + std::to_string(i) + "].body",
+                        "no body '" + f.body + "' in the scene");
+    }
+    disturbance_bodies_.push_back(b);
+  }
+}
+
+// The links random pushes land on (all arm links when the configuration names none).
+void SimRobot::find_push_links(const std::vector<int>& arm_bodies) {
+  std::vector<std::string> names = config_.random_pushes.links;
+  if (names.empty()) {
+    for (int b : arm_bodies) names.emplace_back(mj_id2name(m_.get(), mjOBJ_BODY, b));
+  }
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    const int b = mj_name2id(m_.get(), mjOBJ_BODY, names[i].c_str());
+    const std::string key = "plant.random_pushes.links[" + std::to_string(i) + "]";
+    if (b <= 0) throw ConfigError(config_.source, key, "no body '" + names[i] + "' in the scene");
+    const int capsule = first_capsule(m_.get(), b);
+    if (capsule < 0) throw ConfigError(config_.source, key, "body '" + names[i] + "' has no capsule geom to push on");
+    push_links_.push_back(capsule_surface(m_.get(), b, capsule));
+  }
+}
+
+void SimRobot::make_data() {
+  d_.reset(mj_makeData(m_.get()));
+  if (!d_) throw ConfigError(config_.source, "scene", "MuJoCo could not allocate its data");
+  mj_setConst(m_.get(), d_.get());  // derived constants after the inertial and armature edits
+}
+
+void SimRobot::allocate_buffers() {
+  command_ = RobotCommand(n_);
+  pending_ = RobotCommand(n_);
+  state_ = RobotState(n_);
+  // Per-step buffers and truth, sized once here: read() and write() do not allocate.
+  for (Eigen::VectorXd* v : {&q_meas_, &qd_meas_, &tau_meas_, &current_, &tau_motor_, &tau_viscous_, &tau_dry_, &tau_s_,
+                             &v_before_, &f_dry_, &damping_, &qdd_, &truth_.q_rad, &truth_.qd_rad_s,
+                             &truth_.qdd_rad_s2, &truth_.current_A, &truth_.tau_motor_Nm, &truth_.tau_friction_Nm,
+                             &truth_.tau_transmitted_Nm}) {
+    *v = Eigen::VectorXd::Zero(n_);
+  }
 }
 
 void SimRobot::reset() {
-  mj_resetData(m_, d_);
+  mj_resetData(m_.get(), d_.get());
+  restart_noise_and_counters();
+  const Eigen::Vector3d drop_force_on_tool = place_initial_pose();
+  mj_forward(m_.get(), d_.get());  // kinematics, bias forces, Jacobians at the initial pose
+  const Eigen::VectorXd hold = holding_torque(drop_force_on_tool);
+  start_drives_holding(hold);
+  take_initial_ft_sample(hold);
+  sample_state();
+  state_.cycle = 0;
+}
+
+void SimRobot::restart_noise_and_counters() {
   joint_noise_.reseed(config_.seed, kJointNoiseStream);
   ft_noise_.reseed(config_.seed, kFtNoiseStream);
   pushes_ = RandomPushGenerator(config_.random_pushes, push_links_, config_.seed);
@@ -252,41 +286,46 @@ void SimRobot::reset() {
   state_ = RobotState(n_);
   truth_.drop_released = false;
   truth_.cable_force_N = 0.0;
+}
 
+Eigen::Vector3d SimRobot::place_initial_pose() {
   for (int i = 0; i < n_; ++i) {
     const auto k = static_cast<std::size_t>(i);
     d_->qpos[qadr_[k]] = config_.initial_q_rad[k];
     dry_[k].reset(config_.initial_q_rad[k]);
   }
-  mj_kinematics(m_, d_);
-  Eigen::Vector3d drop_force_on_tool = Eigen::Vector3d::Zero();
-  if (drop_body_ >= 0) {
-    // The mass hangs on the latch at its static deflection m g / k below the anchor.
-    const double k = config_.drop_test.latch_stiffness_N_per_m;
-    const Eigen::Vector3d g(m_->opt.gravity[0], m_->opt.gravity[1], m_->opt.gravity[2]);
-    const mjtNum* anchor = d_->site_xpos + 3 * anchor_site_;
-    const Eigen::Vector3d p = Eigen::Vector3d(anchor[0], anchor[1], anchor[2]) + config_.drop_test.mass_kg * g / k;
-    for (int k3 = 0; k3 < 3; ++k3) d_->qpos[drop_qadr_ + k3] = p[k3];
-    d_->qpos[drop_qadr_ + 3] = 1.0;
-    d_->qpos[drop_qadr_ + 4] = d_->qpos[drop_qadr_ + 5] = d_->qpos[drop_qadr_ + 6] = 0.0;
-    drop_force_on_tool = config_.drop_test.mass_kg * g;
-  }
-  mj_forward(m_, d_);  // kinematics, bias forces, Jacobians at the initial pose
+  mj_kinematics(m_.get(), d_.get());
+  if (drop_body_ < 0) return Eigen::Vector3d::Zero();
+  // The mass hangs on the latch at its static deflection m g / k below the anchor.
+  const double k = config_.drop_test.latch_stiffness_N_per_m;
+  const Eigen::Vector3d g(m_->opt.gravity[0], m_->opt.gravity[1], m_->opt.gravity[2]);
+  const mjtNum* anchor = d_->site_xpos + 3 * anchor_site_;
+  const Eigen::Vector3d p = Eigen::Vector3d(anchor[0], anchor[1], anchor[2]) + config_.drop_test.mass_kg * g / k;
+  for (int k3 = 0; k3 < 3; ++k3) d_->qpos[drop_qadr_ + k3] = p[k3];
+  d_->qpos[drop_qadr_ + 3] = 1.0;
+  d_->qpos[drop_qadr_ + 4] = d_->qpos[drop_qadr_ + 5] = d_->qpos[drop_qadr_ + 6] = 0.0;
+  return config_.drop_test.mass_kg * g;
+}
 
-  // The arm starts at rest, already holding itself (and the latched drop mass): the holding torque
-  // is the bias force minus the generalized force of the mass's weight at the anchor.
+// The arm starts at rest, already holding itself (and the latched drop mass): the holding torque
+// is the bias force minus the generalized force of the mass's weight at the anchor.
+Eigen::VectorXd SimRobot::holding_torque(const Eigen::Vector3d& drop_force_on_tool) const {
   Eigen::VectorXd hold = Eigen::VectorXd::Zero(n_);
   for (int i = 0; i < n_; ++i) hold[i] = d_->qfrc_bias[dadr_[static_cast<std::size_t>(i)]];
-  if (drop_body_ >= 0) {
-    std::vector<mjtNum> jacp(static_cast<std::size_t>(3 * m_->nv));
-    mj_jacSite(m_, d_, jacp.data(), nullptr, anchor_site_);
-    for (int i = 0; i < n_; ++i) {
-      const int d = dadr_[static_cast<std::size_t>(i)];
-      double gen = 0.0;
-      for (int r = 0; r < 3; ++r) gen += jacp[static_cast<std::size_t>(r * m_->nv + d)] * drop_force_on_tool[r];
-      hold[i] -= gen;
-    }
+  if (drop_body_ < 0) return hold;
+  std::vector<mjtNum> jacp(static_cast<std::size_t>(3 * m_->nv));
+  mj_jacSite(m_.get(), d_.get(), jacp.data(), nullptr, anchor_site_);
+  for (int i = 0; i < n_; ++i) {
+    const int d = dadr_[static_cast<std::size_t>(i)];
+    double gen = 0.0;
+    for (int r = 0; r < 3; ++r) gen += jacp[static_cast<std::size_t>(r * m_->nv + d)] * drop_force_on_tool[r];
+    hold[i] -= gen;
   }
+  return hold;
+}
+
+// The drives' state holding `hold`, and the initial command: hold the initial pose in Position mode.
+void SimRobot::start_drives_holding(const Eigen::VectorXd& hold) {
   for (int i = 0; i < n_; ++i) {
     tau_motor_[i] = hold[i];
     current_[i] = hold[i] / torque_per_amp_[i];
@@ -297,35 +336,39 @@ void SimRobot::reset() {
   f_dry_.setZero();
   qdd_.setZero();
 
-  // Initial command: hold the initial pose in Position mode.
   command_.mode = LowLevelMode::kPosition;
   for (int i = 0; i < n_; ++i) command_.q_rad[i] = config_.initial_q_rad[static_cast<std::size_t>(i)];
   for (int i = 0; i < n_; ++i) q_meas_[i] = quantize(d_->qpos[qadr_[static_cast<std::size_t>(i)]]);
   drive_ = KinovaDriveEmulator(config_.actuators, config_.vendor, config_.physics_step_s(), config_.control_period_s);
   drive_.begin_cycle(command_, false, q_meas_, vendor_torque());
   drive_.set_position_integral(vendor_torque());
+}
 
-  // Initial F/T sample with the arm held (qacc ~ 0) and the latch carrying the mass.
+// Initial F/T sample with the arm held (qacc ~ 0) and the latch carrying the mass.
+void SimRobot::take_initial_ft_sample(const Eigen::VectorXd& hold) {
   for (int i = 0; i < n_; ++i) d_->qfrc_applied[dadr_[static_cast<std::size_t>(i)]] = hold[i];
   mju_zero(d_->xfrc_applied, 6 * m_->nbody);
   apply_drop_forces(0.0);
   m_->opt.disableflags &= ~mjDSBL_SENSOR;
-  mj_forward(m_, d_);
+  mj_forward(m_.get(), d_.get());
   m_->opt.disableflags |= mjDSBL_SENSOR;
+  sample_ft_sensor();
+  wrench_sequence_ = 1;
+  wrench_stamp_ = 0.0;
+  truth_.wrench_sensor = wrench_true_;
+}
+
+// The wrench from MuJoCo's sensors (evaluated by the last forward pass), and its measurement.
+void SimRobot::sample_ft_sensor() {
   for (int k = 0; k < 3; ++k) {
     wrench_true_[k] = kWrenchSign * d_->sensordata[force_adr_ + k];
     wrench_true_[3 + k] = kWrenchSign * d_->sensordata[torque_adr_ + k];
   }
+  const auto& ft = config_.ft_sensor;
   for (int k = 0; k < 3; ++k) {
-    wrench_meas_[k] = wrench_true_[k] + config_.ft_sensor.force_bias_N[k] + ft_noise_.normal(config_.ft_sensor.force_std_N);
-    wrench_meas_[3 + k] =
-        wrench_true_[3 + k] + config_.ft_sensor.torque_bias_Nm[k] + ft_noise_.normal(config_.ft_sensor.torque_std_Nm);
+    wrench_meas_[k] = wrench_true_[k] + ft.force_bias_N[k] + ft_noise_.normal(ft.force_std_N);
+    wrench_meas_[3 + k] = wrench_true_[3 + k] + ft.torque_bias_Nm[k] + ft_noise_.normal(ft.torque_std_Nm);
   }
-  wrench_sequence_ = 1;
-  wrench_stamp_ = 0.0;
-  truth_.wrench_sensor = wrench_true_;
-  sample_state();
-  state_.cycle = 0;
 }
 
 double SimRobot::quantize(double q) const { return quantum_ > 0.0 ? quantum_ * std::round(q / quantum_) : q; }
@@ -367,13 +410,7 @@ WriteStatus SimRobot::write(const RobotCommand& command) {
     ++state_.rejected_writes;
     return status;
   }
-  pending_.mode = command.mode;
-  switch (command.mode) {
-    case LowLevelMode::kPosition: pending_.q_rad = command.q_rad; break;
-    case LowLevelMode::kKinovaTorque:
-    case LowLevelMode::kKinovaTorqueHighVelocity: pending_.tau_Nm = command.tau_Nm; break;
-    case LowLevelMode::kCurrent: pending_.current_A = command.current_A; break;
-  }
+  copy_setpoint(command, pending_);
   has_pending_ = true;
   return WriteStatus::kOk;
 }
@@ -385,13 +422,7 @@ const RobotState& SimRobot::read() {
   }
   const bool fresh = has_pending_;
   if (fresh) {
-    command_.mode = pending_.mode;
-    switch (pending_.mode) {
-      case LowLevelMode::kPosition: command_.q_rad = pending_.q_rad; break;
-      case LowLevelMode::kKinovaTorque:
-      case LowLevelMode::kKinovaTorqueHighVelocity: command_.tau_Nm = pending_.tau_Nm; break;
-      case LowLevelMode::kCurrent: command_.current_A = pending_.current_A; break;
-    }
+    copy_setpoint(pending_, command_);
     has_pending_ = false;
   }
   drive_.begin_cycle(command_, fresh, q_meas_, vendor_torque());
@@ -415,7 +446,7 @@ void SimRobot::substep() {
     damping_[i] = viscous_[i] + dry_[k].damping();
     m_->dof_damping[d] = damping_[i];
   }
-  mj_step1(m_, d_);
+  mj_step1(m_.get(), d_.get());
   const double t = d_->time;
 
   // 2. The drives' sensors and the vendor loop.
@@ -445,7 +476,7 @@ void SimRobot::substep() {
   // 5. Step, with the F/T sensor evaluated on its sampling steps only.
   const bool ft_step = (substep_count_ + 1) % static_cast<std::uint64_t>(ft_decimation_) == 0;
   if (ft_step) m_->opt.disableflags &= ~mjDSBL_SENSOR;
-  mj_step2(m_, d_);
+  mj_step2(m_.get(), d_.get());
   if (ft_step) m_->opt.disableflags |= mjDSBL_SENSOR;
 
   // Transmitted torque: motor torque, minus friction and rotor inertia on the motor side. The
@@ -462,15 +493,7 @@ void SimRobot::substep() {
 
   // 6. F/T sample.
   if (ft_step) {
-    for (int k = 0; k < 3; ++k) {
-      wrench_true_[k] = kWrenchSign * d_->sensordata[force_adr_ + k];
-      wrench_true_[3 + k] = kWrenchSign * d_->sensordata[torque_adr_ + k];
-    }
-    const auto& ft = config_.ft_sensor;
-    for (int k = 0; k < 3; ++k) {
-      wrench_meas_[k] = wrench_true_[k] + ft.force_bias_N[k] + ft_noise_.normal(ft.force_std_N);
-      wrench_meas_[3 + k] = wrench_true_[3 + k] + ft.torque_bias_Nm[k] + ft_noise_.normal(ft.torque_std_Nm);
-    }
+    sample_ft_sensor();
     ++wrench_sequence_;
     wrench_stamp_ = t;
   }
@@ -518,7 +541,7 @@ void SimRobot::apply_drop_forces(double t) {
   const mjtNum* a = d_->site_xpos + 3 * anchor_site_;
   const Eigen::Vector3d anchor(a[0], a[1], a[2]);
   mjtNum v6[6];
-  mj_objectVelocity(m_, d_, mjOBJ_SITE, anchor_site_, v6, 0);  // (angular; linear), world axes
+  mj_objectVelocity(m_.get(), d_.get(), mjOBJ_SITE, anchor_site_, v6, 0);  // (angular; linear), world axes
   const Eigen::Vector3d anchor_velocity(v6[3], v6[4], v6[5]);
   const Eigen::Vector3d p(d_->qpos[drop_qadr_], d_->qpos[drop_qadr_ + 1], d_->qpos[drop_qadr_ + 2]);
   const Eigen::Vector3d v(d_->qvel[drop_dadr_], d_->qvel[drop_dadr_ + 1], d_->qvel[drop_dadr_ + 2]);

@@ -42,6 +42,7 @@
 #include <phri/core/random_generator.hpp>
 #include <phri/robot/actuator_table.hpp>
 #include <phri/sim/kinova_drive_emulator.hpp>
+#include <phri/sim/mujoco_handles.hpp>
 #include <phri/sim/random_push_generator.hpp>
 #include <phri/robot/robot_interface.hpp>
 #include <phri/sim/sim_robot_config.hpp>
@@ -51,9 +52,6 @@
 
 #include <cstdint>
 #include <vector>
-
-struct mjModel_;
-struct mjData_;
 
 namespace phri {
 
@@ -104,12 +102,32 @@ public:
   void reset();
 
   /// MuJoCo model and data, read-only (viewers, tests comparing with MuJoCo's own quantities).
-  const mjModel_* mujoco_model() const { return m_; }
-  const mjData_* mujoco_data() const { return d_; }
+  const mjModel_* mujoco_model() const { return m_.get(); }
+  const mjData_* mujoco_data() const { return d_.get(); }
   /// MJCF text of the scene that was loaded.
   const std::string& scene_mjcf() const { return scene_xml_; }
 
 private:
+  // construction, in this order: the model's options, the arm's joints (their drive constants
+  // written into the model), the link mismatch, the scene objects, then the data and the buffers
+  void set_physics_options();
+  std::vector<int> bind_arm_joints();  // returns the joints' bodies, in the order of actuators.yaml
+  int bind_joint(int i);               // returns the joint's body
+  void perturb_link_inertials(const std::vector<int>& arm_bodies);
+  void find_ft_sensor();
+  void find_drop_test();
+  void find_disturbance_bodies();
+  void find_push_links(const std::vector<int>& arm_bodies);
+  void make_data();
+  void allocate_buffers();
+  // reset(), in this order
+  void restart_noise_and_counters();
+  Eigen::Vector3d place_initial_pose();  // returns the drop mass's weight (zero without a drop test)
+  Eigen::VectorXd holding_torque(const Eigen::Vector3d& drop_force_on_tool) const;
+  void start_drives_holding(const Eigen::VectorXd& hold);
+  void take_initial_ft_sample(const Eigen::VectorXd& hold);
+
+  void sample_ft_sensor();
   void substep();
   void apply_external_forces(double t);
   void apply_force(int body, const Eigen::Vector3d& point_local, bool local_frame, const Eigen::Vector3d& force,
@@ -131,8 +149,8 @@ private:
   int filter_decimation_ = 1;
   int ft_decimation_ = 1;
   std::string scene_xml_;
-  mjModel_* m_ = nullptr;
-  mjData_* d_ = nullptr;
+  MjModelPtr m_;
+  MjDataPtr d_;  // after m_: deleted before the model
 
   // joint addressing and drive/friction constants (plant side)
   std::vector<int> qadr_, dadr_;

@@ -13,30 +13,202 @@ constexpr std::uint64_t kTorqueConstantMismatchStream = 4;
 
 constexpr double kHuge = 1e9;
 
-std::string resolve(const std::string& base_dir, const std::string& file) {
-  const std::filesystem::path p(file);
-  if (p.is_absolute() || base_dir.empty()) return p.lexically_normal().string();
-  return (std::filesystem::path(base_dir) / p).lexically_normal().string();
-}
-
-Eigen::Vector3d vector3(const YamlReader& r, std::string_view key, double min, double max) {
-  const auto v = r.numbers(key, 3, min, max);
-  return Eigen::Vector3d(v[0], v[1], v[2]);
-}
-
-Eigen::Vector3d vector3_or(const YamlReader& r, std::string_view key, const Eigen::Vector3d& fallback, double min,
-                           double max) {
-  return r.has(key) ? vector3(r, key, min, max) : fallback;
-}
-
 ExternalForce::Profile parse_profile(const std::string& name) {
   if (name == "step") return ExternalForce::Profile::kStep;
   if (name == "ramp") return ExternalForce::Profile::kRamp;
   return ExternalForce::Profile::kHalfSine;
 }
 
-std::vector<double> per_joint(const YamlReader& r, std::string_view key, int n, double min, double max) {
-  return r.numbers(key, n, min, max);
+// ---- one parser per section of `plant:`, in the order parse() reads them
+
+void parse_robot_files(const YamlReader& r, const std::string& base_dir, SimRobotConfig& c) {
+  r.allow_keys({"mjcf", "actuators"});
+  c.mjcf_path = resolve_path(base_dir, r.text("mjcf"), PathForm::kAsGiven);
+  c.actuators_path = resolve_path(base_dir, r.text("actuators"), PathForm::kAsGiven);
+  c.actuators = ActuatorTable::from_yaml_file(c.actuators_path);
+}
+
+void parse_timing(const YamlReader& t, SimRobotConfig& c) {
+  t.allow_keys({"physics_rate_Hz", "control_period_s"});
+  c.physics_rate_Hz = t.number_or("physics_rate_Hz", c.physics_rate_Hz, 1000.0, 100000.0);
+  c.control_period_s = t.number_or("control_period_s", c.control_period_s, 1e-4, 0.1);
+}
+
+std::vector<double> parse_initial_q(const YamlReader& init, int n) {
+  init.allow_keys({"q_rad"});
+  return init.per_joint("q_rad", n, -100.0, 100.0);
+}
+
+SimRobotConfig::ActuatorOverride parse_actuator_override(const YamlReader& j, const std::string& joint) {
+  j.allow_keys({"coulomb_Nm", "viscous_Nms_per_rad", "static_Nm", "reflected_inertia_kgm2", "torque_constant_scale"});
+  SimRobotConfig::ActuatorOverride ov;
+  ov.joint = joint;
+  if (j.has("coulomb_Nm")) ov.coulomb_Nm = j.number("coulomb_Nm", 0.0, 1e3);
+  if (j.has("viscous_Nms_per_rad")) ov.viscous_Nms_per_rad = j.number("viscous_Nms_per_rad", 0.0, 1e3);
+  if (j.has("static_Nm")) ov.static_Nm = j.number("static_Nm", 0.0, 1e3);
+  if (j.has("reflected_inertia_kgm2")) ov.reflected_inertia_kgm2 = j.number("reflected_inertia_kgm2", 0.0, 100.0);
+  if (j.has("torque_constant_scale")) ov.torque_constant_scale = j.number("torque_constant_scale", 0.1, 10.0);
+  return ov;
+}
+
+void parse_actuator_overrides(const YamlReader& o, SimRobotConfig& c) {
+  o.expect_map();
+  for (const auto& a : c.actuators.joints()) {
+    if (o.has(a.joint_name)) c.actuator_overrides.push_back(parse_actuator_override(o.at(a.joint_name), a.joint_name));
+  }
+  // Any key that is not a joint of actuators.yaml is an error.
+  for (const std::string& key : o.keys()) {
+    if (c.actuators.index_of(key) < 0) throw o.error(key, "unknown joint (not in " + c.actuators_path + ")");
+  }
+}
+
+void parse_friction(const YamlReader& f, SimRobotConfig::Friction& s) {
+  f.allow_keys({"breakaway_velocity_rad_s"});
+  s.breakaway_velocity_rad_s = f.number_or("breakaway_velocity_rad_s", 1e-3, 1e-6, 1.0);
+}
+
+void parse_noise(const YamlReader& z, int n, SimRobotConfig::Noise& s) {
+  z.allow_keys({"torque_sensor_std_Nm", "torque_sensor_offset_Nm", "velocity_std_rad_s", "current_std_A",
+                "encoder_counts_per_rev"});
+  s.torque_sensor_std_Nm = z.number_or("torque_sensor_std_Nm", s.torque_sensor_std_Nm, 0.0, 10.0);
+  if (z.has("torque_sensor_offset_Nm")) s.torque_sensor_offset_Nm = z.per_joint("torque_sensor_offset_Nm", n, -10.0, 10.0);
+  s.velocity_std_rad_s = z.number_or("velocity_std_rad_s", s.velocity_std_rad_s, 0.0, 1.0);
+  s.current_std_A = z.number_or("current_std_A", s.current_std_A, 0.0, 10.0);
+  s.encoder_counts_per_rev = z.number_or("encoder_counts_per_rev", s.encoder_counts_per_rev, 0.0, 1e12);
+}
+
+void parse_ft_sensor(const YamlReader& f, SimRobotConfig::FtSensor& s) {
+  f.allow_keys({"flange_site", "sensor_offset_m", "flange_side_mass_kg", "flange_side_com_m", "flange_side_inertia_kgm2",
+                "rate_Hz", "force_std_N", "torque_std_Nm", "force_bias_N", "torque_bias_Nm"});
+  s.flange_site = f.text_or("flange_site", s.flange_site);
+  s.sensor_offset_m = f.number_or("sensor_offset_m", s.sensor_offset_m, 0.0, 1.0);
+  s.flange_side_mass_kg = f.number_or("flange_side_mass_kg", s.flange_side_mass_kg, 1e-4, 100.0);
+  s.flange_side_com_m = f.vector3_or("flange_side_com_m", s.flange_side_com_m, -1.0, 1.0);
+  s.flange_side_inertia_kgm2 = f.vector3_or("flange_side_inertia_kgm2", s.flange_side_inertia_kgm2, 1e-9, 10.0);
+  s.rate_Hz = f.number_or("rate_Hz", s.rate_Hz, 1.0, 100000.0);
+  s.force_std_N = f.number_or("force_std_N", s.force_std_N, 0.0, 100.0);
+  s.torque_std_Nm = f.number_or("torque_std_Nm", s.torque_std_Nm, 0.0, 10.0);
+  s.force_bias_N = f.vector3_or("force_bias_N", s.force_bias_N, -1000.0, 1000.0);
+  s.torque_bias_Nm = f.vector3_or("torque_bias_Nm", s.torque_bias_Nm, -100.0, 100.0);
+}
+
+void parse_tool(const YamlReader& t, SimRobotConfig::Tool& s) {
+  t.allow_keys({"mass_kg", "com_m", "inertia_kgm2"});
+  s.mass_kg = t.number_or("mass_kg", s.mass_kg, 1e-4, 100.0);
+  s.com_m = t.vector3_or("com_m", s.com_m, -1.0, 1.0);
+  s.inertia_kgm2 = t.vector3_or("inertia_kgm2", s.inertia_kgm2, 1e-9, 10.0);
+}
+
+void parse_mismatch(const YamlReader& m, SimRobotConfig::Mismatch& s) {
+  m.allow_keys({"enabled", "seed", "mass_fraction", "com_fraction", "inertia_fraction", "torque_constant_fraction"});
+  s.enabled = m.boolean_or("enabled", false);
+  s.seed = static_cast<std::uint64_t>(m.integer_or("seed", 7, 0, (1LL << 62)));
+  s.mass_fraction = m.number_or("mass_fraction", s.mass_fraction, 0.0, 0.5);
+  s.com_fraction = m.number_or("com_fraction", s.com_fraction, 0.0, 0.5);
+  s.inertia_fraction = m.number_or("inertia_fraction", s.inertia_fraction, 0.0, 0.5);
+  s.torque_constant_fraction = m.number_or("torque_constant_fraction", s.torque_constant_fraction, 0.0, 0.5);
+}
+
+// vendor.position: the gains of the vendor's position loop, one per joint.
+void parse_vendor_position(const YamlReader& pos, int n, SimRobotConfig::Vendor& v) {
+  pos.allow_keys({"kp_Nm_per_rad", "kd_Nms_per_rad", "ki_Nm_per_rad_s", "integral_limit_Nm"});
+  if (pos.has("kp_Nm_per_rad")) v.position_kp_Nm_per_rad = pos.per_joint("kp_Nm_per_rad", n, 0.0, 1e6);
+  if (pos.has("kd_Nms_per_rad")) v.position_kd_Nms_per_rad = pos.per_joint("kd_Nms_per_rad", n, 0.0, 1e4);
+  if (pos.has("ki_Nm_per_rad_s")) v.position_ki_Nm_per_rad_s = pos.per_joint("ki_Nm_per_rad_s", n, 0.0, 1e7);
+  if (pos.has("integral_limit_Nm")) v.position_integral_limit_Nm = pos.per_joint("integral_limit_Nm", n, 0.0, 1e4);
+}
+
+// vendor.torque: the vendor's torque loop, one value per joint.
+void parse_vendor_torque(const YamlReader& t, int n, SimRobotConfig::Vendor& v) {
+  t.allow_keys({"feedback_gain", "velocity_damping_Nms_per_rad"});
+  if (t.has("feedback_gain")) v.torque_feedback_gain = t.per_joint("feedback_gain", n, 0.0, 0.95);
+  if (t.has("velocity_damping_Nms_per_rad")) {
+    v.torque_velocity_damping_Nms_per_rad = t.per_joint("velocity_damping_Nms_per_rad", n, 0.0, 1e3);
+  }
+}
+
+// vendor.torque_high_velocity: the filter of the high-velocity torque loop.
+void parse_vendor_high_velocity(const YamlReader& h, SimRobotConfig::Vendor& v) {
+  h.allow_keys({"numerator", "denominator", "rate_Hz"});
+  if (h.has("numerator")) v.high_velocity_numerator = h.numbers("numerator", -1, -1e6, 1e6);
+  if (h.has("denominator")) v.high_velocity_denominator = h.numbers("denominator", -1, -1e6, 1e6);
+  v.high_velocity_rate_Hz = h.number_or("rate_Hz", v.high_velocity_rate_Hz, 1.0, 100000.0);
+}
+
+void parse_vendor(const YamlReader& r, int n, SimRobotConfig::Vendor& v) {
+  r.allow_keys({"position", "torque", "torque_high_velocity"});
+  if (r.has("position")) parse_vendor_position(r.at("position"), n, v);
+  if (r.has("torque")) parse_vendor_torque(r.at("torque"), n, v);
+  if (r.has("torque_high_velocity")) parse_vendor_high_velocity(r.at("torque_high_velocity"), v);
+}
+
+void parse_drop_test(const YamlReader& d, SimRobotConfig::DropTest& s) {
+  d.allow_keys({"enabled", "mass_kg", "radius_m", "cable_length_m", "cable_stiffness_N_per_m", "cable_damping_Ns_per_m",
+                "anchor_m", "release_time_s", "latch_stiffness_N_per_m"});
+  s.enabled = d.boolean_or("enabled", false);
+  s.mass_kg = d.number_or("mass_kg", s.mass_kg, 1e-3, 100.0);
+  s.radius_m = d.number_or("radius_m", s.radius_m, 1e-3, 0.5);
+  s.cable_length_m = d.number_or("cable_length_m", s.cable_length_m, 0.0, 10.0);
+  s.cable_stiffness_N_per_m = d.number_or("cable_stiffness_N_per_m", s.cable_stiffness_N_per_m, 1.0, 1e7);
+  s.cable_damping_Ns_per_m = d.number_or("cable_damping_Ns_per_m", s.cable_damping_Ns_per_m, 0.0, 1e5);
+  s.anchor_m = d.vector3_or("anchor_m", s.anchor_m, -1.0, 1.0);
+  s.release_time_s = d.number_or("release_time_s", s.release_time_s, 0.0, kHuge);
+  s.latch_stiffness_N_per_m = d.number_or("latch_stiffness_N_per_m", s.latch_stiffness_N_per_m, 1.0, 1e7);
+}
+
+void parse_floor(const YamlReader& f, SimRobotConfig::Floor& s) {
+  f.allow_keys({"enabled", "height_m"});
+  s.enabled = f.boolean_or("enabled", false);
+  s.height_m = f.number_or("height_m", 0.0, -10.0, 10.0);
+}
+
+// One entry of `disturbances:`.
+ExternalForce parse_disturbance(const YamlReader& e) {
+  e.allow_keys({"body", "point_m", "frame", "force_N", "torque_Nm", "profile", "start_s", "duration_s", "rise_s"});
+  ExternalForce f;
+  f.body = e.text("body");
+  f.point_m = e.vector3_or("point_m", Eigen::Vector3d::Zero(), -10.0, 10.0);
+  f.frame = e.choice_or("frame", "world", {"world", "local"}) == "world" ? ExternalForce::Frame::kWorld
+                                                                        : ExternalForce::Frame::kLocal;
+  f.force_N = e.vector3_or("force_N", Eigen::Vector3d::Zero(), -1e4, 1e4);
+  f.torque_Nm = e.vector3_or("torque_Nm", Eigen::Vector3d::Zero(), -1e3, 1e3);
+  f.profile = parse_profile(e.choice("profile", {"step", "ramp", "half_sine"}));
+  f.start_s = e.number("start_s", 0.0, kHuge);
+  f.duration_s = e.number("duration_s", 1e-6, kHuge);
+  f.rise_s = e.number_or("rise_s", f.duration_s, 0.0, kHuge);
+  if (f.profile == ExternalForce::Profile::kRamp && f.rise_s > f.duration_s) {
+    throw e.error("rise_s", "must not exceed duration_s");
+  }
+  return f;
+}
+
+std::vector<ExternalForce> parse_disturbances(const YamlReader& list) {
+  list.expect_sequence();
+  std::vector<ExternalForce> out;
+  for (std::size_t i = 0; i < list.size(); ++i) out.push_back(parse_disturbance(list.at(i)));
+  return out;
+}
+
+void parse_random_pushes(const YamlReader& r, RandomPushSettings& s) {
+  r.allow_keys({"enabled", "links", "start_s", "min_interval_s", "max_interval_s", "min_force_N", "max_force_N",
+                "min_duration_s", "max_duration_s", "profile"});
+  s.enabled = r.boolean_or("enabled", false);
+  if (r.has("links")) {
+    const YamlReader links = r.at("links");
+    links.expect_sequence();
+    for (std::size_t i = 0; i < links.size(); ++i) s.links.push_back(links.at(i).as_text());
+  }
+  s.start_s = r.number_or("start_s", s.start_s, 0.0, kHuge);
+  s.min_interval_s = r.number_or("min_interval_s", s.min_interval_s, 0.0, kHuge);
+  s.max_interval_s = r.number_or("max_interval_s", s.max_interval_s, 0.0, kHuge);
+  s.min_force_N = r.number_or("min_force_N", s.min_force_N, 0.0, 1000.0);
+  s.max_force_N = r.number_or("max_force_N", s.max_force_N, 0.0, 1000.0);
+  s.min_duration_s = r.number_or("min_duration_s", s.min_duration_s, 1e-3, 10.0);
+  s.max_duration_s = r.number_or("max_duration_s", s.max_duration_s, 1e-3, 10.0);
+  s.profile = parse_profile(r.choice_or("profile", "half_sine", {"step", "ramp", "half_sine"}));
+  if (s.max_interval_s < s.min_interval_s) throw r.error("max_interval_s", "must be >= min_interval_s");
+  if (s.max_force_N < s.min_force_N) throw r.error("max_force_N", "must be >= min_force_N");
+  if (s.max_duration_s < s.min_duration_s) throw r.error("max_duration_s", "must be >= min_duration_s");
 }
 
 SimRobotConfig parse(const YamlReader& root, const std::string& base_dir) {
@@ -46,204 +218,23 @@ SimRobotConfig parse(const YamlReader& root, const std::string& base_dir) {
                 "ft_sensor", "tool", "mismatch", "vendor", "drop_test", "floor", "disturbances", "random_pushes"});
   SimRobotConfig c;
   c.source = root.file();
-
-  const YamlReader robot = p.at("robot");
-  robot.allow_keys({"mjcf", "actuators"});
-  c.mjcf_path = resolve(base_dir, robot.text("mjcf"));
-  c.actuators_path = resolve(base_dir, robot.text("actuators"));
-  c.actuators = ActuatorTable::from_yaml_file(c.actuators_path);
+  parse_robot_files(p.at("robot"), base_dir, c);
   const int n = c.actuators.size();
-
-  if (p.has("timing")) {
-    const YamlReader t = p.at("timing");
-    t.allow_keys({"physics_rate_Hz", "control_period_s"});
-    c.physics_rate_Hz = t.number_or("physics_rate_Hz", c.physics_rate_Hz, 1000.0, 100000.0);
-    c.control_period_s = t.number_or("control_period_s", c.control_period_s, 1e-4, 0.1);
-  }
-
-  const YamlReader init = p.at("initial");
-  init.allow_keys({"q_rad"});
-  c.initial_q_rad = per_joint(init, "q_rad", n, -100.0, 100.0);
-
+  if (p.has("timing")) parse_timing(p.at("timing"), c);
+  c.initial_q_rad = parse_initial_q(p.at("initial"), n);
   c.seed = static_cast<std::uint64_t>(p.integer_or("seed", 1, 0, (1LL << 62)));
-
-  if (p.has("actuator_overrides")) {
-    const YamlReader o = p.at("actuator_overrides");
-    o.expect_map();
-    for (const auto& a : c.actuators.joints()) {
-      if (!o.has(a.joint_name)) continue;
-      const YamlReader j = o.at(a.joint_name);
-      j.allow_keys({"coulomb_Nm", "viscous_Nms_per_rad", "static_Nm", "reflected_inertia_kgm2",
-                    "torque_constant_scale"});
-      SimRobotConfig::ActuatorOverride ov;
-      ov.joint = a.joint_name;
-      if (j.has("coulomb_Nm")) ov.coulomb_Nm = j.number("coulomb_Nm", 0.0, 1e3);
-      if (j.has("viscous_Nms_per_rad")) ov.viscous_Nms_per_rad = j.number("viscous_Nms_per_rad", 0.0, 1e3);
-      if (j.has("static_Nm")) ov.static_Nm = j.number("static_Nm", 0.0, 1e3);
-      if (j.has("reflected_inertia_kgm2")) ov.reflected_inertia_kgm2 = j.number("reflected_inertia_kgm2", 0.0, 100.0);
-      if (j.has("torque_constant_scale")) ov.torque_constant_scale = j.number("torque_constant_scale", 0.1, 10.0);
-      c.actuator_overrides.push_back(ov);
-    }
-    // Any key that is not a joint of actuators.yaml is an error.
-    for (const std::string& key : o.keys()) {
-      if (c.actuators.index_of(key) < 0) throw o.error(key, "unknown joint (not in " + c.actuators_path + ")");
-    }
-  }
+  if (p.has("actuator_overrides")) parse_actuator_overrides(p.at("actuator_overrides"), c);
   c.friction_scale = p.number_or("friction_scale", 1.0, 0.0, 10.0);
-  if (p.has("friction")) {
-    const YamlReader f = p.at("friction");
-    f.allow_keys({"breakaway_velocity_rad_s"});
-    c.friction.breakaway_velocity_rad_s = f.number_or("breakaway_velocity_rad_s", 1e-3, 1e-6, 1.0);
-  }
-
-  if (p.has("noise")) {
-    const YamlReader z = p.at("noise");
-    z.allow_keys({"torque_sensor_std_Nm", "torque_sensor_offset_Nm", "velocity_std_rad_s", "current_std_A",
-                  "encoder_counts_per_rev"});
-    c.noise.torque_sensor_std_Nm = z.number_or("torque_sensor_std_Nm", c.noise.torque_sensor_std_Nm, 0.0, 10.0);
-    if (z.has("torque_sensor_offset_Nm")) c.noise.torque_sensor_offset_Nm = per_joint(z, "torque_sensor_offset_Nm", n, -10.0, 10.0);
-    c.noise.velocity_std_rad_s = z.number_or("velocity_std_rad_s", c.noise.velocity_std_rad_s, 0.0, 1.0);
-    c.noise.current_std_A = z.number_or("current_std_A", c.noise.current_std_A, 0.0, 10.0);
-    c.noise.encoder_counts_per_rev = z.number_or("encoder_counts_per_rev", c.noise.encoder_counts_per_rev, 0.0, 1e12);
-  }
-
-  if (p.has("ft_sensor")) {
-    const YamlReader f = p.at("ft_sensor");
-    f.allow_keys({"flange_site", "sensor_offset_m", "flange_side_mass_kg", "flange_side_com_m",
-                  "flange_side_inertia_kgm2", "rate_Hz", "force_std_N", "torque_std_Nm", "force_bias_N",
-                  "torque_bias_Nm"});
-    auto& s = c.ft_sensor;
-    s.flange_site = f.text_or("flange_site", s.flange_site);
-    s.sensor_offset_m = f.number_or("sensor_offset_m", s.sensor_offset_m, 0.0, 1.0);
-    s.flange_side_mass_kg = f.number_or("flange_side_mass_kg", s.flange_side_mass_kg, 1e-4, 100.0);
-    s.flange_side_com_m = vector3_or(f, "flange_side_com_m", s.flange_side_com_m, -1.0, 1.0);
-    s.flange_side_inertia_kgm2 = vector3_or(f, "flange_side_inertia_kgm2", s.flange_side_inertia_kgm2, 1e-9, 10.0);
-    s.rate_Hz = f.number_or("rate_Hz", s.rate_Hz, 1.0, 100000.0);
-    s.force_std_N = f.number_or("force_std_N", s.force_std_N, 0.0, 100.0);
-    s.torque_std_Nm = f.number_or("torque_std_Nm", s.torque_std_Nm, 0.0, 10.0);
-    s.force_bias_N = vector3_or(f, "force_bias_N", s.force_bias_N, -1000.0, 1000.0);
-    s.torque_bias_Nm = vector3_or(f, "torque_bias_Nm", s.torque_bias_Nm, -100.0, 100.0);
-  }
-
-  if (p.has("tool")) {
-    const YamlReader t = p.at("tool");
-    t.allow_keys({"mass_kg", "com_m", "inertia_kgm2"});
-    c.tool.mass_kg = t.number_or("mass_kg", c.tool.mass_kg, 1e-4, 100.0);
-    c.tool.com_m = vector3_or(t, "com_m", c.tool.com_m, -1.0, 1.0);
-    c.tool.inertia_kgm2 = vector3_or(t, "inertia_kgm2", c.tool.inertia_kgm2, 1e-9, 10.0);
-  }
-
-  if (p.has("mismatch")) {
-    const YamlReader m = p.at("mismatch");
-    m.allow_keys({"enabled", "seed", "mass_fraction", "com_fraction", "inertia_fraction", "torque_constant_fraction"});
-    c.mismatch.enabled = m.boolean_or("enabled", false);
-    c.mismatch.seed = static_cast<std::uint64_t>(m.integer_or("seed", 7, 0, (1LL << 62)));
-    c.mismatch.mass_fraction = m.number_or("mass_fraction", c.mismatch.mass_fraction, 0.0, 0.5);
-    c.mismatch.com_fraction = m.number_or("com_fraction", c.mismatch.com_fraction, 0.0, 0.5);
-    c.mismatch.inertia_fraction = m.number_or("inertia_fraction", c.mismatch.inertia_fraction, 0.0, 0.5);
-    c.mismatch.torque_constant_fraction =
-        m.number_or("torque_constant_fraction", c.mismatch.torque_constant_fraction, 0.0, 0.5);
-  }
-
-  if (p.has("vendor")) {
-    const YamlReader v = p.at("vendor");
-    v.allow_keys({"position", "torque", "torque_high_velocity"});
-    if (v.has("position")) {
-      const YamlReader pos = v.at("position");
-      pos.allow_keys({"kp_Nm_per_rad", "kd_Nms_per_rad", "ki_Nm_per_rad_s", "integral_limit_Nm"});
-      if (pos.has("kp_Nm_per_rad")) c.vendor.position_kp_Nm_per_rad = per_joint(pos, "kp_Nm_per_rad", n, 0.0, 1e6);
-      if (pos.has("kd_Nms_per_rad")) c.vendor.position_kd_Nms_per_rad = per_joint(pos, "kd_Nms_per_rad", n, 0.0, 1e4);
-      if (pos.has("ki_Nm_per_rad_s")) c.vendor.position_ki_Nm_per_rad_s = per_joint(pos, "ki_Nm_per_rad_s", n, 0.0, 1e7);
-      if (pos.has("integral_limit_Nm")) c.vendor.position_integral_limit_Nm = per_joint(pos, "integral_limit_Nm", n, 0.0, 1e4);
-    }
-    if (v.has("torque")) {
-      const YamlReader t = v.at("torque");
-      t.allow_keys({"feedback_gain", "velocity_damping_Nms_per_rad"});
-      if (t.has("feedback_gain")) c.vendor.torque_feedback_gain = per_joint(t, "feedback_gain", n, 0.0, 0.95);
-      if (t.has("velocity_damping_Nms_per_rad")) {
-        c.vendor.torque_velocity_damping_Nms_per_rad = per_joint(t, "velocity_damping_Nms_per_rad", n, 0.0, 1e3);
-      }
-    }
-    if (v.has("torque_high_velocity")) {
-      const YamlReader h = v.at("torque_high_velocity");
-      h.allow_keys({"numerator", "denominator", "rate_Hz"});
-      if (h.has("numerator")) c.vendor.high_velocity_numerator = h.numbers("numerator", -1, -1e6, 1e6);
-      if (h.has("denominator")) c.vendor.high_velocity_denominator = h.numbers("denominator", -1, -1e6, 1e6);
-      c.vendor.high_velocity_rate_Hz = h.number_or("rate_Hz", c.vendor.high_velocity_rate_Hz, 1.0, 100000.0);
-    }
-  }
-
-  if (p.has("drop_test")) {
-    const YamlReader d = p.at("drop_test");
-    d.allow_keys({"enabled", "mass_kg", "radius_m", "cable_length_m", "cable_stiffness_N_per_m",
-                  "cable_damping_Ns_per_m", "anchor_m", "release_time_s", "latch_stiffness_N_per_m"});
-    auto& s = c.drop_test;
-    s.enabled = d.boolean_or("enabled", false);
-    s.mass_kg = d.number_or("mass_kg", s.mass_kg, 1e-3, 100.0);
-    s.radius_m = d.number_or("radius_m", s.radius_m, 1e-3, 0.5);
-    s.cable_length_m = d.number_or("cable_length_m", s.cable_length_m, 0.0, 10.0);
-    s.cable_stiffness_N_per_m = d.number_or("cable_stiffness_N_per_m", s.cable_stiffness_N_per_m, 1.0, 1e7);
-    s.cable_damping_Ns_per_m = d.number_or("cable_damping_Ns_per_m", s.cable_damping_Ns_per_m, 0.0, 1e5);
-    s.anchor_m = vector3_or(d, "anchor_m", s.anchor_m, -1.0, 1.0);
-    s.release_time_s = d.number_or("release_time_s", s.release_time_s, 0.0, kHuge);
-    s.latch_stiffness_N_per_m = d.number_or("latch_stiffness_N_per_m", s.latch_stiffness_N_per_m, 1.0, 1e7);
-  }
-
-  if (p.has("floor")) {
-    const YamlReader f = p.at("floor");
-    f.allow_keys({"enabled", "height_m"});
-    c.floor.enabled = f.boolean_or("enabled", false);
-    c.floor.height_m = f.number_or("height_m", 0.0, -10.0, 10.0);
-  }
-
-  if (p.has("disturbances")) {
-    const YamlReader list = p.at("disturbances");
-    list.expect_sequence();
-    for (std::size_t i = 0; i < list.size(); ++i) {
-      const YamlReader e = list.at(i);
-      e.allow_keys({"body", "point_m", "frame", "force_N", "torque_Nm", "profile", "start_s", "duration_s", "rise_s"});
-      ExternalForce f;
-      f.body = e.text("body");
-      f.point_m = vector3_or(e, "point_m", Eigen::Vector3d::Zero(), -10.0, 10.0);
-      f.frame = e.choice_or("frame", "world", {"world", "local"}) == "world" ? ExternalForce::Frame::kWorld
-                                                                            : ExternalForce::Frame::kLocal;
-      f.force_N = vector3_or(e, "force_N", Eigen::Vector3d::Zero(), -1e4, 1e4);
-      f.torque_Nm = vector3_or(e, "torque_Nm", Eigen::Vector3d::Zero(), -1e3, 1e3);
-      f.profile = parse_profile(e.choice("profile", {"step", "ramp", "half_sine"}));
-      f.start_s = e.number("start_s", 0.0, kHuge);
-      f.duration_s = e.number("duration_s", 1e-6, kHuge);
-      f.rise_s = e.number_or("rise_s", f.duration_s, 0.0, kHuge);
-      if (f.profile == ExternalForce::Profile::kRamp && f.rise_s > f.duration_s) {
-        throw e.error("rise_s", "must not exceed duration_s");
-      }
-      c.disturbances.push_back(f);
-    }
-  }
-
-  if (p.has("random_pushes")) {
-    const YamlReader r = p.at("random_pushes");
-    r.allow_keys({"enabled", "links", "start_s", "min_interval_s", "max_interval_s", "min_force_N", "max_force_N",
-                  "min_duration_s", "max_duration_s", "profile"});
-    auto& s = c.random_pushes;
-    s.enabled = r.boolean_or("enabled", false);
-    if (r.has("links")) {
-      const YamlReader links = r.at("links");
-      links.expect_sequence();
-      for (std::size_t i = 0; i < links.size(); ++i) s.links.push_back(links.at(i).as_text());
-    }
-    s.start_s = r.number_or("start_s", s.start_s, 0.0, kHuge);
-    s.min_interval_s = r.number_or("min_interval_s", s.min_interval_s, 0.0, kHuge);
-    s.max_interval_s = r.number_or("max_interval_s", s.max_interval_s, 0.0, kHuge);
-    s.min_force_N = r.number_or("min_force_N", s.min_force_N, 0.0, 1000.0);
-    s.max_force_N = r.number_or("max_force_N", s.max_force_N, 0.0, 1000.0);
-    s.min_duration_s = r.number_or("min_duration_s", s.min_duration_s, 1e-3, 10.0);
-    s.max_duration_s = r.number_or("max_duration_s", s.max_duration_s, 1e-3, 10.0);
-    s.profile = parse_profile(r.choice_or("profile", "half_sine", {"step", "ramp", "half_sine"}));
-    if (s.max_interval_s < s.min_interval_s) throw r.error("max_interval_s", "must be >= min_interval_s");
-    if (s.max_force_N < s.min_force_N) throw r.error("max_force_N", "must be >= min_force_N");
-    if (s.max_duration_s < s.min_duration_s) throw r.error("max_duration_s", "must be >= min_duration_s");
-  }
-
+  if (p.has("friction")) parse_friction(p.at("friction"), c.friction);
+  if (p.has("noise")) parse_noise(p.at("noise"), n, c.noise);
+  if (p.has("ft_sensor")) parse_ft_sensor(p.at("ft_sensor"), c.ft_sensor);
+  if (p.has("tool")) parse_tool(p.at("tool"), c.tool);
+  if (p.has("mismatch")) parse_mismatch(p.at("mismatch"), c.mismatch);
+  if (p.has("vendor")) parse_vendor(p.at("vendor"), n, c.vendor);
+  if (p.has("drop_test")) parse_drop_test(p.at("drop_test"), c.drop_test);
+  if (p.has("floor")) parse_floor(p.at("floor"), c.floor);
+  if (p.has("disturbances")) c.disturbances = parse_disturbances(p.at("disturbances"));
+  if (p.has("random_pushes")) parse_random_pushes(p.at("random_pushes"), c.random_pushes);
   c.fill_defaults();
   c.validate();
   return c;

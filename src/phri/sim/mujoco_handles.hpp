@@ -1,0 +1,23 @@
+#pragma once
+// Owning handles of MuJoCo's model and data: std::unique_ptr whose deleters call mj_deleteModel and
+// mj_deleteData. Only MuJoCo's forward declarations here, so that public headers holding a handle
+// (sim_robot.hpp) stay free of MuJoCo's headers.
+#include <memory>
+
+struct mjModel_;
+struct mjData_;
+
+namespace phri {
+
+struct MjModelDeleter {
+  void operator()(mjModel_* model) const noexcept;
+};
+
+struct MjDataDeleter {
+  void operator()(mjData_* data) const noexcept;
+};
+
+using MjModelPtr = std::unique_ptr<mjModel_, MjModelDeleter>;
+using MjDataPtr = std::unique_ptr<mjData_, MjDataDeleter>;
+
+}  // namespace phri
