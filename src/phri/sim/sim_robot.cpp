@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <cstring>
 #include <memory>
 
@@ -137,7 +138,7 @@ std::vector<int> SimRobot::bind_arm_joints() {
   vendor_torque_ = Eigen::VectorXd::Zero(n_);
   std::vector<int> arm_bodies;
   for (int i = 0; i < n_; ++i) arm_bodies.push_back(bind_joint(i));
-  quantum_ = config_.noise.encoder_counts_per_rev > 0.0 ? 2.0 * 3.14159265358979323846 / config_.noise.encoder_counts_per_rev
+  quantum_ = config_.noise.encoder_counts_per_rev > 0.0 ? 2.0 * std::numbers::pi / config_.noise.encoder_counts_per_rev
                                                          : 0.0;
   return arm_bodies;
 }
