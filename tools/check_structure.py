@@ -22,8 +22,9 @@ MODULE_DEPENDENCIES = {
     "robot": ["core"],
     "lowlevel": ["robot"],
     "control": ["model", "qp", "robot", "lowlevel"],
+    "trajectory": ["control"],
     "sim": ["robot"],
-    "app": ["control", "sim"],
+    "app": ["control", "trajectory", "sim"],
     "experiments": ["app", "control", "sim"],
 }
 
