@@ -15,6 +15,7 @@
 #include <phri/sim/sim_robot.hpp>
 
 #include "allocation_counter.hpp"
+#include "config_error.hpp"
 
 #include "hand_push.hpp"
 #include "temp_dir.hpp"
@@ -358,25 +359,32 @@ TEST(Fsm, StartupTimesOutAndStillHandsOver) {
   EXPECT_NEAR(rig.transitions_[1].time, 2.684 + 0.5, 0.01);
 }
 
-TEST(Fsm, BadSettingsAreConfigErrors) {
+TEST(Fsm, BadSettingsAreConfigErrorsNamingTheKey) {
   phri::Controller cycle(cycle_settings());
-  auto expect_error = [&](const std::function<void(phri::FsmSettings&)>& edit, const std::string& key) {
-    phri::FsmSettings s;
-    edit(s);
-    try {
+  // Building an Fsm from the default settings changed by `edit`, as a callable for expect_config_error.
+  const auto building = [&](const std::function<void(phri::FsmSettings&)>& edit) {
+    return [&cycle, edit] {
+      phri::FsmSettings s;
+      edit(s);
       phri::Fsm fsm(s, cycle);
-      ADD_FAILURE() << "no error for " << key;
-    } catch (const phri::ConfigError& e) {
-      EXPECT_EQ(e.element(), key) << e.what();
-    }
+    };
   };
-  expect_error([](auto& s) { s.startup.home_q_rad.pop_back(); }, "startup.home_q_rad");
-  expect_error([](auto& s) { s.static_scenario.posture_q_rad[2] = NAN; }, "static.posture_q_rad");
-  expect_error([](auto& s) { s.dynamic_scenario.horizontal_min_offset_m = 0.1; }, "dynamic.horizontal_min_offset_m");
-  expect_error([](auto& s) { s.dynamic_scenario.horizontal_turn_acceleration_m_s2 = 0.01; }, "dynamic.horizontal_speed_m_s");
-  expect_error([](auto& s) { s.torque_loop = phri::LowLevelMode::kPosition; }, "torque_loop");
-  expect_error([](auto& s) { s.stiffness_step = 0.5; }, "stiffness_step");
-  expect_error([](auto& s) { s.timeline = {{-1.0, phri::Event::kStop}}; }, "timeline[0].at");
+  using phri::test::expect_config_error;
+  expect_config_error(building([](auto& s) { s.startup.home_q_rad.pop_back(); }),
+                      {.element = "startup.home_q_rad", .mentions = {"7 values"}, .file = "FsmSettings"});
+  expect_config_error(building([](auto& s) { s.static_scenario.posture_q_rad[2] = NAN; }),
+                      {.element = "static.posture_q_rad", .mentions = {"finite"}});
+  expect_config_error(building([](auto& s) { s.dynamic_scenario.horizontal_min_offset_m = 0.1; }),
+                      {.element = "dynamic.horizontal_min_offset_m"});
+  expect_config_error(building([](auto& s) { s.dynamic_scenario.horizontal_turn_acceleration_m_s2 = 0.01; }),
+                      {.element = "dynamic.horizontal_speed_m_s", .mentions = {"span"}});
+  expect_config_error(building([](auto& s) { s.torque_loop = phri::LowLevelMode::kPosition; }),
+                      {.element = "torque_loop"});
+  expect_config_error(building([](auto& s) { s.stiffness_step = 0.5; }), {.element = "stiffness_step"});
+  expect_config_error(building([](auto& s) {
+                        s.timeline = {{-1.0, phri::Event::kStop}};
+                      }),
+                      {.element = "timeline[0].at"});
 }
 
 // configs/demo.yaml end to end, as the CLI wires it (lockstep): Config -> SimRobot + Controller

@@ -7,6 +7,7 @@
 #include <phri/lowlevel/low_level_controller.hpp>
 
 #include "allocation_counter.hpp"
+#include "config_error.hpp"
 
 #include <gtest/gtest.h>
 
@@ -124,13 +125,19 @@ TEST_F(CustomLoop, BumplessEntryAndNoAllocation) {
   EXPECT_LT(max_change, 0.05);  // A: the integrator leaks the entry offset away, no jump
 }
 
-TEST_F(CustomLoop, RejectsBadSettings) {
+TEST_F(CustomLoop, RejectsBadSettingsNamingTheKey) {
+  using phri::test::expect_config_error;
   phri::CustomTorqueSettings s;
   s.integral_leak = 0.0;
-  EXPECT_THROW(phri::CustomTorqueController(table_, s), phri::ConfigError);
+  expect_config_error([&] { phri::CustomTorqueController(table_, s); },
+                      {.element = "integral_leak", .mentions = {"> 0"}});
   s = {};
   s.transfer_gain = -1.0;
-  EXPECT_THROW(phri::CustomTorqueController(table_, s), phri::ConfigError);
+  expect_config_error([&] { phri::CustomTorqueController(table_, s); },
+                      {.element = "transfer_gain", .mentions = {">= 0"}});
+  s = {};
+  s.integral_limit_fraction = 1.5;
+  expect_config_error([&] { phri::CustomTorqueController(table_, s); }, {.element = "integral_limit_fraction"});
 }
 
 }  // namespace
