@@ -7,6 +7,7 @@
 #include <phri/model/collision_model.hpp>
 
 #include "allocation_counter.hpp"
+#include "config_error.hpp"
 
 #include <gtest/gtest.h>
 
@@ -145,31 +146,28 @@ TEST_F(Gen3Collision, DistancesDoNotAllocate) {
   EXPECT_EQ(count.allocations(), 0u);
 }
 
-void expect_collision_error(const std::string& yaml, const std::string& key, const phri::Model& model) {
-  try {
-    phri::CollisionModel::from_yaml_string(yaml, model, "bad.yaml");
-    ADD_FAILURE() << "expected an error about " << key;
-  } catch (const phri::ConfigError& e) {
-    EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << e.what();
-  }
-}
-
 TEST_F(Gen3Collision, BadYamlNamesTheKey) {
+  const auto loading = [this](const std::string& yaml) {
+    return [this, yaml] { (void)phri::CollisionModel::from_yaml_string(yaml, model_, "bad.yaml"); };
+  };
+  using phri::test::expect_config_error;
   const std::string capsule_a = "capsules:\n  - {link: base_link, p0: [0,0,0], p1: [0,0,0.1], radius: 0.05}\n";
   const std::string capsule_b = "  - {link: forearm_link, p0: [0,0,0], p1: [0,-0.2,0], radius: 0.04}\n";
-  expect_collision_error(capsule_a + capsule_b + "pairs:\n  - [base_link, forearm_link]\nextra: 1\n", "extra", model_);
-  expect_collision_error("capsules:\n  - {link: nowhere, p0: [0,0,0], p1: [0,0,1], radius: 0.1}\npairs: []\n",
-                         "capsules[0].link", model_);
-  expect_collision_error("capsules:\n  - {link: base_link, p0: [0,0,0], p1: [0,0,1], radius: -0.1}\npairs: []\n",
-                         "capsules[0].radius", model_);
-  expect_collision_error("capsules:\n  - {link: base_link, p0: [0,0], p1: [0,0,1], radius: 0.1}\npairs: []\n",
-                         "capsules[0].p0", model_);
-  expect_collision_error("capsules:\n  - {link: base_link, p0: [0,0,x], p1: [0,0,1], radius: 0.1}\npairs: []\n",
-                         "capsules[0].p0[2]", model_);
-  expect_collision_error(capsule_a + "pairs:\n  - [base_link, forearm_link]\n", "pairs[0][1]", model_);
-  expect_collision_error(capsule_a + capsule_b + "pairs:\n  - [base_link]\n", "pairs[0]", model_);
-  expect_collision_error("capsules: [ {link: base_link\n", "invalid YAML", model_);
-  expect_collision_error(capsule_a + capsule_b + "pairs:\n  - [forearm_link, forearm_link]\n", "same body", model_);
+  expect_config_error(loading(capsule_a + capsule_b + "pairs:\n  - [base_link, forearm_link]\nextra: 1\n"),
+                      {.element = "extra", .file = "bad.yaml"});
+  expect_config_error(loading("capsules:\n  - {link: nowhere, p0: [0,0,0], p1: [0,0,1], radius: 0.1}\npairs: []\n"),
+                      {.element = "capsules[0].link", .mentions = {"nowhere"}});
+  expect_config_error(loading("capsules:\n  - {link: base_link, p0: [0,0,0], p1: [0,0,1], radius: -0.1}\npairs: []\n"),
+                      {.element = "capsules[0].radius"});
+  expect_config_error(loading("capsules:\n  - {link: base_link, p0: [0,0], p1: [0,0,1], radius: 0.1}\npairs: []\n"),
+                      {.element = "capsules[0].p0"});
+  expect_config_error(loading("capsules:\n  - {link: base_link, p0: [0,0,x], p1: [0,0,1], radius: 0.1}\npairs: []\n"),
+                      {.element = "capsules[0].p0[2]"});
+  expect_config_error(loading(capsule_a + "pairs:\n  - [base_link, forearm_link]\n"), {.element = "pairs[0][1]"});
+  expect_config_error(loading(capsule_a + capsule_b + "pairs:\n  - [base_link]\n"), {.element = "pairs[0]"});
+  expect_config_error(loading("capsules: [ {link: base_link\n"), {.mentions = {"invalid YAML"}, .file = "bad.yaml"});
+  expect_config_error(loading(capsule_a + capsule_b + "pairs:\n  - [forearm_link, forearm_link]\n"),
+                      {.element = "pairs[0]", .mentions = {"same body"}});
 }
 
 }  // namespace

@@ -5,10 +5,13 @@
 #include <phri/app/config.hpp>
 #include <phri/core/error.hpp>
 
+#include "config_error.hpp"
+
 #include <gtest/gtest.h>
 
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <sstream>
 
 namespace {
@@ -31,21 +34,12 @@ phri::Config load_edited(const std::string& from, const std::string& to) {
   return phri::Config::from_yaml_string(yaml, "test.yaml", kRoot + "/configs");
 }
 
-// demo.yaml with `from` replaced by `to` must fail with a ConfigError on key path `key`.
-void expect_error(const std::string& from, const std::string& to, const std::string& key,
-                  const std::string& reason_part = "") {
-  SCOPED_TRACE(to);
-  try {
-    load_edited(from, to);
-    ADD_FAILURE() << "no ConfigError for '" << to << "'";
-  } catch (const phri::ConfigError& e) {
-    EXPECT_EQ(e.element(), key) << e.what();
-    EXPECT_EQ(e.file(), "test.yaml") << e.what();
-    if (!reason_part.empty()) {
-      EXPECT_NE(std::string(e.what()).find(reason_part), std::string::npos) << e.what();
-    }
-  }
+// Loading demo.yaml with `from` replaced by `to`, as a callable for expect_config_error.
+std::function<void()> loading_demo_with(const std::string& from, const std::string& to) {
+  return [from, to] { load_edited(from, to); };
 }
+
+using phri::test::expect_config_error;
 
 TEST(Config, LoadsTheDemo) {
   const phri::Config c = phri::Config::from_yaml_file(kDemo);
@@ -154,23 +148,30 @@ TEST(Config, InlinePlantResolvesItsPathsAgainstThisFile) {
 }
 
 TEST(Config, UnknownKeysNameTheirPath) {
-  expect_error("robot:                                   # the controller's",
-               "colour: red\nrobot:                                   # the controller's", "colour", "unknown key");
-  expect_error("    collision:                           # the same damper",
-               "    collision:\n      flavour: 1\n    # ", "controller.qp.collision.flavour", "unknown key");
-  expect_error("  seed: 1 ", "  colour: 1\n  seed: 1 ", "plant.colour", "unknown key");
-  expect_error("  - {at: 8.0, event: full_body_compliance}", "  - {at: 8.0, event: full_body_compliance, when: now}",
-               "events[0].when", "unknown key");
+  expect_config_error(loading_demo_with("robot:                                   # the controller's",
+                                        "colour: red\nrobot:                                   # the controller's"),
+                      {.element = "colour", .mentions = {"unknown key"}, .file = "test.yaml"});
+  expect_config_error(loading_demo_with("    collision:                           # the same damper",
+                                        "    collision:\n      flavour: 1\n    # "),
+                      {.element = "controller.qp.collision.flavour", .mentions = {"unknown key"}, .file = "test.yaml"});
+  expect_config_error(loading_demo_with("  seed: 1 ", "  colour: 1\n  seed: 1 "),
+                      {.element = "plant.colour", .mentions = {"unknown key"}, .file = "test.yaml"});
+  expect_config_error(loading_demo_with("  - {at: 8.0, event: full_body_compliance}",
+                                        "  - {at: 8.0, event: full_body_compliance, when: now}"),
+                      {.element = "events[0].when", .mentions = {"unknown key"}, .file = "test.yaml"});
 }
 
 TEST(Config, WrongTypesNameTheirPath) {
-  expect_error("observer_gain: 50.0", "observer_gain: fast", "controller.observer_gain", "expected a number");
-  expect_error("  enabled: true                          # no pad", "  enabled: maybe  #", "gamepad.enabled",
-               "true or false");
-  expect_error("home_q_rad: [0.0, 0.58, 3.14, -1.84, 0.0, 0.85, 1.57]", "home_q_rad: 0.58", "fsm.startup.home_q_rad");
-  expect_error("initial_mode: null_space", "initial_mode: floppy", "controller.compliance.initial_mode", "one of");
-  expect_error("{at: 12.0, event: dual_compliance}", "{at: 12.0, event: double_compliance}", "events[1].event",
-               "unknown event");
+  expect_config_error(loading_demo_with("observer_gain: 50.0", "observer_gain: fast"),
+                      {.element = "controller.observer_gain", .mentions = {"expected a number"}, .file = "test.yaml"});
+  expect_config_error(loading_demo_with("  enabled: true                          # no pad", "  enabled: maybe  #"),
+                      {.element = "gamepad.enabled", .mentions = {"true or false"}, .file = "test.yaml"});
+  expect_config_error(loading_demo_with("home_q_rad: [0.0, 0.58, 3.14, -1.84, 0.0, 0.85, 1.57]", "home_q_rad: 0.58"),
+                      {.element = "fsm.startup.home_q_rad", .file = "test.yaml"});
+  expect_config_error(loading_demo_with("initial_mode: null_space", "initial_mode: floppy"),
+                      {.element = "controller.compliance.initial_mode", .mentions = {"one of"}, .file = "test.yaml"});
+  expect_config_error(loading_demo_with("{at: 12.0, event: dual_compliance}", "{at: 12.0, event: double_compliance}"),
+                      {.element = "events[1].event", .mentions = {"unknown event"}, .file = "test.yaml"});
 }
 
 TEST(Config, SectionOfTheWrongKind) {
@@ -180,69 +181,86 @@ TEST(Config, SectionOfTheWrongKind) {
   for (const auto& [text, key] : {std::pair<std::string, std::string>{"controller: {compliance: 3}", "controller.compliance"},
                                   {"events: {at: 1}", "events"},
                                   {"fsm: [1, 2]", "fsm"}}) {
-    try {
-      phri::Config::from_yaml_string(head + text + "\n", "t.yaml", kRoot + "/configs");
-      ADD_FAILURE() << text;
-    } catch (const phri::ConfigError& e) {
-      EXPECT_EQ(e.element(), key) << e.what();
-    }
+    SCOPED_TRACE(text);
+    expect_config_error([&] { phri::Config::from_yaml_string(head + text + "\n", "t.yaml", kRoot + "/configs"); },
+                        {.element = key, .file = "t.yaml"});
   }
 }
 
 TEST(Config, OutOfRangeValuesNameTheirPath) {
-  expect_error("posture_damping: 9.0", "posture_damping: -9.0", "controller.compliance.posture_damping", "must be in");
-  expect_error("observer_gain: 50.0", "observer_gain: 0", "controller.observer_gain", "> 0");
-  expect_error("velocity_limit_fraction: 0.9", "velocity_limit_fraction: 1.5", "controller.qp.velocity_limit_fraction");
-  expect_error("      amortization: 1.8                  # [-] M >= 1 (overdamped)", "      amortization: 0.5",
-               "controller.qp.joint_limits.amortization");
-  expect_error("transfer_gain: 5.0", "transfer_gain: -1", "low_level.custom.transfer_gain");
-  expect_error("trigger_filter_s: 0.01", "trigger_filter_s: -0.01", "controller.compliance.trigger_filter_s");
-  expect_error("integral_limit_fraction: 0.05", "integral_limit_fraction: 2", "low_level.custom.integral_limit_fraction");
-  expect_error("stiffness_step: 1.25", "stiffness_step: 0.8", "fsm.stiffness_step");
-  expect_error("buffer_rows: 16384", "buffer_rows: 4", "logging.buffer_rows");
-  expect_error("{at: 32.0, event: stop}", "{at: 99.0, event: stop}", "events[9].at", "after the end of the run");
-  expect_error("{at: 8.0, event: full_body_compliance}", "{at: -1, event: full_body_compliance}", "events[0].at");
-  expect_error("torque_loop: custom", "torque_loop: position", "low_level.torque_loop", "one of");
-  expect_error("pacing: real_time", "pacing: leisurely", "run.pacing");
+  expect_config_error(
+      loading_demo_with("posture_damping: 9.0", "posture_damping: -9.0"),
+      {.element = "controller.compliance.posture_damping", .mentions = {"must be in"}, .file = "test.yaml"});
+  expect_config_error(loading_demo_with("observer_gain: 50.0", "observer_gain: 0"),
+                      {.element = "controller.observer_gain", .mentions = {"> 0"}, .file = "test.yaml"});
+  expect_config_error(loading_demo_with("velocity_limit_fraction: 0.9", "velocity_limit_fraction: 1.5"),
+                      {.element = "controller.qp.velocity_limit_fraction", .file = "test.yaml"});
+  expect_config_error(loading_demo_with("      amortization: 1.8                  # [-] M >= 1 (overdamped)",
+                                        "      amortization: 0.5"),
+                      {.element = "controller.qp.joint_limits.amortization", .file = "test.yaml"});
+  expect_config_error(loading_demo_with("transfer_gain: 5.0", "transfer_gain: -1"),
+                      {.element = "low_level.custom.transfer_gain", .file = "test.yaml"});
+  expect_config_error(loading_demo_with("trigger_filter_s: 0.01", "trigger_filter_s: -0.01"),
+                      {.element = "controller.compliance.trigger_filter_s", .file = "test.yaml"});
+  expect_config_error(loading_demo_with("integral_limit_fraction: 0.05", "integral_limit_fraction: 2"),
+                      {.element = "low_level.custom.integral_limit_fraction", .file = "test.yaml"});
+  expect_config_error(loading_demo_with("stiffness_step: 1.25", "stiffness_step: 0.8"),
+                      {.element = "fsm.stiffness_step", .file = "test.yaml"});
+  expect_config_error(loading_demo_with("buffer_rows: 16384", "buffer_rows: 4"),
+                      {.element = "logging.buffer_rows", .file = "test.yaml"});
+  expect_config_error(loading_demo_with("{at: 32.0, event: stop}", "{at: 99.0, event: stop}"),
+                      {.element = "events[9].at", .mentions = {"after the end of the run"}, .file = "test.yaml"});
+  expect_config_error(
+      loading_demo_with("{at: 8.0, event: full_body_compliance}", "{at: -1, event: full_body_compliance}"),
+      {.element = "events[0].at", .file = "test.yaml"});
+  expect_config_error(loading_demo_with("torque_loop: custom", "torque_loop: position"),
+                      {.element = "low_level.torque_loop", .mentions = {"one of"}, .file = "test.yaml"});
+  expect_config_error(loading_demo_with("pacing: real_time", "pacing: leisurely"),
+                      {.element = "run.pacing", .file = "test.yaml"});
   // ... inside the plant file's section, through the override.
-  expect_error("  seed: 1 ", "  noise: {torque_sensor_std_Nm: -1}\n  seed: 1 ", "plant.noise.torque_sensor_std_Nm");
+  expect_config_error(loading_demo_with("  seed: 1 ", "  noise: {torque_sensor_std_Nm: -1}\n  seed: 1 "),
+                      {.element = "plant.noise.torque_sensor_std_Nm", .file = "test.yaml"});
 }
 
 TEST(Config, InconsistentPairsNameTheKeyThatMustChange) {
-  expect_error("safety_distance_m: 0.015", "safety_distance_m: 0.03", "controller.qp.collision.safety_distance_m",
-               "d_s < d_i");
-  expect_error("safety_fraction: 0.01", "safety_fraction: 0.2", "controller.qp.joint_limits.safety_fraction", "d_s < d_i");
-  expect_error("release_threshold: 4.0", "release_threshold: 8.0", "controller.compliance.release_threshold",
-               "touch_threshold");
-  expect_error("trigger_release: 0.3", "trigger_release: 0.6", "gamepad.trigger_release");
-  expect_error("horizontal_turn_acceleration_m_s2: 0.5", "horizontal_turn_acceleration_m_s2: 0.01",
-               "fsm.dynamic.horizontal_speed_m_s", "span");
-  expect_error("posture_q_rad: [0.0, 0.58, 3.14, -1.84, 0.0, 0.85, 1.57]", "posture_q_rad: [0.0, 0.58, 3.14]",
-               "fsm.static.posture_q_rad", "expected 7 numbers");
-  expect_error("period_s: 0.001", "period_s: 0.002", "controller.period_s", "plant");
+  expect_config_error(
+      loading_demo_with("safety_distance_m: 0.015", "safety_distance_m: 0.03"),
+      {.element = "controller.qp.collision.safety_distance_m", .mentions = {"d_s < d_i"}, .file = "test.yaml"});
+  expect_config_error(
+      loading_demo_with("safety_fraction: 0.01", "safety_fraction: 0.2"),
+      {.element = "controller.qp.joint_limits.safety_fraction", .mentions = {"d_s < d_i"}, .file = "test.yaml"});
+  expect_config_error(
+      loading_demo_with("release_threshold: 4.0", "release_threshold: 8.0"),
+      {.element = "controller.compliance.release_threshold", .mentions = {"touch_threshold"}, .file = "test.yaml"});
+  expect_config_error(loading_demo_with("trigger_release: 0.3", "trigger_release: 0.6"),
+                      {.element = "gamepad.trigger_release", .file = "test.yaml"});
+  expect_config_error(
+      loading_demo_with("horizontal_turn_acceleration_m_s2: 0.5", "horizontal_turn_acceleration_m_s2: 0.01"),
+      {.element = "fsm.dynamic.horizontal_speed_m_s", .mentions = {"span"}, .file = "test.yaml"});
+  expect_config_error(
+      loading_demo_with("posture_q_rad: [0.0, 0.58, 3.14, -1.84, 0.0, 0.85, 1.57]", "posture_q_rad: [0.0, 0.58, 3.14]"),
+      {.element = "fsm.static.posture_q_rad", .mentions = {"expected 7 numbers"}, .file = "test.yaml"});
+  expect_config_error(loading_demo_with("period_s: 0.001", "period_s: 0.002"),
+                      {.element = "controller.period_s", .mentions = {"plant"}, .file = "test.yaml"});
 }
 
 TEST(Config, FilesAndSyntax) {
-  expect_error("urdf: ../robots/kinova_gen3/gen3.urdf", "urdf: ../robots/kinova_gen3/nothing.urdf", "robot.urdf",
-               "file not found");
-  expect_error("file: plant_gen3.yaml", "file: no_plant.yaml", "plant.file", "file not found");
-  expect_error("robot:                                   # the controller's model",
-               "robots:                                  # typo", "robots", "unknown key");
-  try {
-    phri::Config::from_yaml_string("robot: [unclosed", "broken.yaml", kRoot + "/configs");
-    ADD_FAILURE();
-  } catch (const phri::ConfigError& e) {
-    EXPECT_EQ(e.file(), "broken.yaml");
-    EXPECT_NE(std::string(e.what()).find("invalid YAML"), std::string::npos);
-  }
-  EXPECT_THROW(phri::Config::from_yaml_file(kRoot + "/configs/absent.yaml"), phri::ConfigError);
+  expect_config_error(
+      loading_demo_with("urdf: ../robots/kinova_gen3/gen3.urdf", "urdf: ../robots/kinova_gen3/nothing.urdf"),
+      {.element = "robot.urdf", .mentions = {"file not found"}, .file = "test.yaml"});
+  expect_config_error(loading_demo_with("file: plant_gen3.yaml", "file: no_plant.yaml"),
+                      {.element = "plant.file", .mentions = {"file not found"}, .file = "test.yaml"});
+  expect_config_error(loading_demo_with("robot:                                   # the controller's model",
+                                        "robots:                                  # typo"),
+                      {.element = "robots", .mentions = {"unknown key"}, .file = "test.yaml"});
+  expect_config_error([&] { phri::Config::from_yaml_string("robot: [unclosed", "broken.yaml", kRoot + "/configs"); },
+                      {.mentions = {"invalid YAML"}, .file = "broken.yaml"});
+  const std::string absent = kRoot + "/configs/absent.yaml";
+  expect_config_error([&] { phri::Config::from_yaml_file(absent); }, {.file = absent});
   // A missing required section.
-  try {
-    phri::Config::from_yaml_string("plant: {file: plant_gen3.yaml}\n", "t.yaml", kRoot + "/configs");
-    ADD_FAILURE();
-  } catch (const phri::ConfigError& e) {
-    EXPECT_EQ(e.element(), "robot");
-  }
+  expect_config_error(
+      [&] { phri::Config::from_yaml_string("plant: {file: plant_gen3.yaml}\n", "t.yaml", kRoot + "/configs"); },
+      {.element = "robot", .file = "t.yaml"});
 }
 
 }  // namespace

@@ -15,6 +15,7 @@
 #include <phri/sim/sim_robot.hpp>
 
 #include "allocation_counter.hpp"
+#include "config_error.hpp"
 
 #include "hand_push.hpp"
 #include "temp_dir.hpp"
@@ -22,9 +23,11 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <optional>
 #include <unistd.h>
 #include <vector>
 
@@ -33,6 +36,10 @@ namespace {
 std::string temp_path(const std::string& name) { return phri::test::temp_path("phri_test_fsm", name); }
 
 const std::string kRoot = PHRI_SOURCE_DIR;
+
+// The control cycle whose state has robot time `t` (1 ms period; RobotState::cycle counts from
+// 1 at 1 ms): samples are taken by cycle index, exactly once, not by comparing floating-point times.
+constexpr std::uint64_t cycle_at(double t) { return static_cast<std::uint64_t>(t * 1000.0 + 0.5); }
 
 phri::ControllerSettings cycle_settings() {
   phri::ControllerSettings s;
@@ -213,17 +220,24 @@ TEST(Fsm, ScriptedSessionThroughEveryStateLoggedAndAllocationFree) {
   EXPECT_EQ(rig.fsm_.state(), phri::FsmState::kDynamic);
   // Loop toggles (16 s: position, 17 s: custom) and stiffness while moving.
   double max_error_switching = 0.0;
+  int samples = 0;
   rig.run(3.0, [&]() {
     log();
     max_error_switching = std::max(max_error_switching, rig.ee_error());
-    if (std::abs(rig.time() - 16.5) < 5e-4) {
+    const std::uint64_t cycle = rig.robot_.state().cycle;
+    if (cycle == cycle_at(16.5)) {
+      ++samples;
+      EXPECT_NEAR(rig.time(), 16.5, 1e-9);
       EXPECT_EQ(rig.cycle_.low_level().loop(), phri::LowLevelMode::kPosition);
     }
-    if (std::abs(rig.time() - 17.7) < 5e-4) {
+    if (cycle == cycle_at(17.7)) {
+      ++samples;
+      EXPECT_NEAR(rig.time(), 17.7, 1e-9);
       EXPECT_EQ(rig.cycle_.low_level().loop(), phri::LowLevelMode::kCurrent);
       EXPECT_NEAR(rig.cycle_.compliance().stiffness_scale(), 0.8, 1e-12);
     }
   });
+  EXPECT_EQ(samples, 2) << "the loop and stiffness were sampled at 16.5 s and 17.7 s";
   EXPECT_NEAR(rig.cycle_.compliance().stiffness_scale(), 1.0, 1e-12);
   rig.run(7.0, log);  // to 25.9 s: toggle to static (brake, move), stop (brake), at rest
   const phri::LoggerStats stats = logger.close();
@@ -358,25 +372,32 @@ TEST(Fsm, StartupTimesOutAndStillHandsOver) {
   EXPECT_NEAR(rig.transitions_[1].time, 2.684 + 0.5, 0.01);
 }
 
-TEST(Fsm, BadSettingsAreConfigErrors) {
+TEST(Fsm, BadSettingsAreConfigErrorsNamingTheKey) {
   phri::Controller cycle(cycle_settings());
-  auto expect_error = [&](const std::function<void(phri::FsmSettings&)>& edit, const std::string& key) {
-    phri::FsmSettings s;
-    edit(s);
-    try {
+  // Building an Fsm from the default settings changed by `edit`, as a callable for expect_config_error.
+  const auto building = [&](const std::function<void(phri::FsmSettings&)>& edit) {
+    return [&cycle, edit] {
+      phri::FsmSettings s;
+      edit(s);
       phri::Fsm fsm(s, cycle);
-      ADD_FAILURE() << "no error for " << key;
-    } catch (const phri::ConfigError& e) {
-      EXPECT_EQ(e.element(), key) << e.what();
-    }
+    };
   };
-  expect_error([](auto& s) { s.startup.home_q_rad.pop_back(); }, "startup.home_q_rad");
-  expect_error([](auto& s) { s.static_scenario.posture_q_rad[2] = NAN; }, "static.posture_q_rad");
-  expect_error([](auto& s) { s.dynamic_scenario.horizontal_min_offset_m = 0.1; }, "dynamic.horizontal_min_offset_m");
-  expect_error([](auto& s) { s.dynamic_scenario.horizontal_turn_acceleration_m_s2 = 0.01; }, "dynamic.horizontal_speed_m_s");
-  expect_error([](auto& s) { s.torque_loop = phri::LowLevelMode::kPosition; }, "torque_loop");
-  expect_error([](auto& s) { s.stiffness_step = 0.5; }, "stiffness_step");
-  expect_error([](auto& s) { s.timeline = {{-1.0, phri::Event::kStop}}; }, "timeline[0].at");
+  using phri::test::expect_config_error;
+  expect_config_error(building([](auto& s) { s.startup.home_q_rad.pop_back(); }),
+                      {.element = "startup.home_q_rad", .mentions = {"7 values"}, .file = "FsmSettings"});
+  expect_config_error(building([](auto& s) { s.static_scenario.posture_q_rad[2] = NAN; }),
+                      {.element = "static.posture_q_rad", .mentions = {"finite"}});
+  expect_config_error(building([](auto& s) { s.dynamic_scenario.horizontal_min_offset_m = 0.1; }),
+                      {.element = "dynamic.horizontal_min_offset_m"});
+  expect_config_error(building([](auto& s) { s.dynamic_scenario.horizontal_turn_acceleration_m_s2 = 0.01; }),
+                      {.element = "dynamic.horizontal_speed_m_s", .mentions = {"span"}});
+  expect_config_error(building([](auto& s) { s.torque_loop = phri::LowLevelMode::kPosition; }),
+                      {.element = "torque_loop"});
+  expect_config_error(building([](auto& s) { s.stiffness_step = 0.5; }), {.element = "stiffness_step"});
+  expect_config_error(building([](auto& s) {
+                        s.timeline = {{-1.0, phri::Event::kStop}};
+                      }),
+                      {.element = "timeline[0].at"});
 }
 
 // configs/demo.yaml end to end, as the CLI wires it (lockstep): Config -> SimRobot + Controller
@@ -395,8 +416,8 @@ TEST(Fsm, DemoYamlSession) {
   std::vector<Transition> transitions;
   double elbow_ee_error = 0.0, dynamic_error = 0.0, position_loop_error = 0.0;
   bool all_ok = true, saw_position = false, saw_dual_touch = false;
-  Eigen::Vector3d before_hand = Eigen::Vector3d::Zero(), after_hand = Eigen::Vector3d::Zero();
-  Eigen::Vector3d ee_before_push = Eigen::Vector3d::Zero();
+  // Sampled once each, at the cycles of 8.9 s, 12.9 s and 15 s.
+  std::optional<Eigen::Vector3d> ee_before_push, before_hand, after_hand;
   double full_body_yield = 0.0;
   while (robot.state().time_s < config.run.duration_s && !fsm.finished()) {
     const phri::RobotState& state = robot.read();
@@ -410,12 +431,22 @@ TEST(Fsm, DemoYamlSession) {
     if (transitions.empty() || transitions.back().state != fsm.state()) transitions.push_back({t, fsm.state()});
     const double error = cycle.qp().end_effector().error().head<3>().norm();
     if (t > 3.5 && t < 7.5) elbow_ee_error = std::max(elbow_ee_error, error);
-    if (std::abs(t - 8.9) < 5e-4) ee_before_push = cycle.qp().end_effector().pose().translation();
-    if (t > 9.0 && t < 11.0) {
-      full_body_yield = std::max(full_body_yield, (cycle.qp().end_effector().pose().translation() - ee_before_push).norm());
+    if (state.cycle == cycle_at(8.9)) {
+      EXPECT_NEAR(t, 8.9, 1e-9);
+      ee_before_push = cycle.qp().end_effector().pose().translation();
     }
-    if (std::abs(t - 12.9) < 5e-4) before_hand = cycle.qp().end_effector().target_pose().translation();
-    if (std::abs(t - 15.0) < 5e-4) after_hand = cycle.qp().end_effector().target_pose().translation();
+    if (t > 9.0 && t < 11.0 && ee_before_push) {
+      full_body_yield =
+          std::max(full_body_yield, (cycle.qp().end_effector().pose().translation() - *ee_before_push).norm());
+    }
+    if (state.cycle == cycle_at(12.9)) {
+      EXPECT_NEAR(t, 12.9, 1e-9);
+      before_hand = cycle.qp().end_effector().target_pose().translation();
+    }
+    if (state.cycle == cycle_at(15.0)) {
+      EXPECT_NEAR(t, 15.0, 1e-9);
+      after_hand = cycle.qp().end_effector().target_pose().translation();
+    }
     saw_dual_touch |= cycle.compliance().touched();
     if (t > 22.0 && t < 25.0) dynamic_error = std::max(dynamic_error, error);
     if (t > 25.0 && t < 27.0) {
@@ -424,13 +455,15 @@ TEST(Fsm, DemoYamlSession) {
     }
   }
   const phri::LoggerStats stats = logger.close();
+  ASSERT_TRUE(ee_before_push && before_hand && after_hand) << "a sample was not taken";
+  const double hand_move = (*after_hand - *before_hand).norm();
   std::printf("demo.yaml: %s; finished at %.3f s\n", describe(transitions).c_str(), robot.state().time_s);
-  std::printf("demo.yaml: EE error under the elbow pushes %.2f mm; full-body push moved the EE %.1f mm; the hand moved "
-              "the held pose %.1f mm; dynamic EE error %.2f mm (custom), %.2f mm (position); log %llu rows, %llu "
-              "dropped\n",
-              1e3 * elbow_ee_error, 1e3 * full_body_yield, 1e3 * (after_hand - before_hand).norm(), 1e3 * dynamic_error,
-              1e3 * position_loop_error, static_cast<unsigned long long>(stats.written),
-              static_cast<unsigned long long>(stats.dropped));
+  std::printf(
+      "demo.yaml: EE error under the elbow pushes %.2f mm; full-body push moved the EE %.1f mm; the hand moved "
+      "the held pose %.1f mm; dynamic EE error %.2f mm (custom), %.2f mm (position); log %llu rows, %llu "
+      "dropped\n",
+      1e3 * elbow_ee_error, 1e3 * full_body_yield, 1e3 * hand_move, 1e3 * dynamic_error, 1e3 * position_loop_error,
+      static_cast<unsigned long long>(stats.written), static_cast<unsigned long long>(stats.dropped));
   using S = phri::FsmState;
   const std::vector<S> expected = {S::kStartup, S::kStatic, S::kDynamic, S::kStatic, S::kStopped};
   ASSERT_EQ(transitions.size(), expected.size()) << describe(transitions);
@@ -441,7 +474,7 @@ TEST(Fsm, DemoYamlSession) {
   EXPECT_LT(elbow_ee_error, 0.003);
   EXPECT_GT(full_body_yield, 0.01);
   EXPECT_TRUE(saw_dual_touch);
-  EXPECT_GT((after_hand - before_hand).norm(), 0.02);
+  EXPECT_GT(hand_move, 0.02);
   EXPECT_LT(dynamic_error, 0.005);
   EXPECT_TRUE(saw_position);
   EXPECT_LT(position_loop_error, 0.01);

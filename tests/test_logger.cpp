@@ -9,6 +9,7 @@
 #include <phri/core/error.hpp>
 
 #include "allocation_counter.hpp"
+#include "config_error.hpp"
 
 #include "temp_dir.hpp"
 
@@ -260,13 +261,15 @@ TEST(Logger, FullRingDropsAndCounts) {
   EXPECT_NE(logger.summary().find("dropped"), std::string::npos);
 }
 
-TEST(Logger, UnwritablePathIsAConfigError) {
+TEST(Logger, UnwritablePathAndTooManyJointsAreConfigErrorsNamingTheFile) {
+  using phri::test::expect_config_error;
   phri::LoggerSettings settings;
   settings.path = "/nonexistent_phri_dir/run.csv";
-  EXPECT_THROW(phri::Logger logger(settings), phri::ConfigError);
+  expect_config_error([&] { phri::Logger logger(settings); },
+                      {.mentions = {"cannot create the log file"}, .file = settings.path});
   settings.path = temp_path("dof.csv");
   settings.dof = 8;
-  EXPECT_THROW(phri::Logger logger(settings), phri::ConfigError);
+  expect_config_error([&] { phri::Logger logger(settings); }, {.element = "dof", .file = settings.path});
 }
 
 }  // namespace

@@ -7,8 +7,13 @@
 #include <phri/lowlevel/low_level_controller.hpp>
 
 #include "allocation_counter.hpp"
+#include "config_error.hpp"
 
 #include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
 
 namespace {
 
@@ -41,31 +46,57 @@ protected:
   Eigen::VectorXd zero_ = Eigen::VectorXd::Zero(7);
 };
 
-TEST_F(CustomLoop, CurrentLawIsTheSumOfItsTermsOverKtGr) {
-  phri::CustomTorqueSettings s;
+// The whole current law against hand-computed values from actuators.yaml's numbers (K_T G_r 11 and
+// 7.6 N.m/A, I_r G_r^2 0.03 kg.m^2, friction 2.15 + 2.00 qd (large) and 1.60 + 1.36 qd (small),
+// thresholds 0.1 rad/s and 1 rad/s^2, integrator clamp 5 % of 95 / 26 / 45 N.m) and the paper's
+// H(z) = (0.020175 - 0.036975 z^-1 + 0.016917 z^-2) / (1 - 1.975063 z^-1 + 0.97518 z^-2), for a
+// constant torque error e = tau_d - tau_s: its first two output samples b0 e and
+// (b0 + b1 - a1 b0) e, and after 6 s (slow pole 0.9937: the transient is down by e^-37) its DC
+// value H(1) e (both coefficient sums cancel to 1.17e-4: rounding leaves ~1e-12, hence 1e-9);
+// the leaky integrator's ZOH samples (K_I / theta) e (1 - exp(-theta k T)), or its clamp.
+TEST_F(CustomLoop, CurrentLawMatchesHandComputedTermsAtStartAndInSteadyState) {
+  phri::CustomTorqueSettings s;  // lambda 5, K_I 20, theta 1, clamp 5 %, both feed-forwards
   phri::CustomTorqueController loop(table_, s);
-  phri::DiscreteTransferFunction reference = phri::DiscreteTransferFunction::kinova_high_velocity();
   Eigen::VectorXd tau_d(7), qdd(7), tau_s(7), qd(7);
   tau_d << 10, -5, 3, 8, 1, -0.5, 0.2;
   qdd << 2, -1.5, 0.3, 0.5, 4, -0.2, 0.1;
-  tau_s = tau_d * 0.9;
+  tau_s = tau_d * 0.9;  // e = 0.1 tau_d
   qd << 0.5, -0.01, 0.0, 0.2, -0.05, 0.0, 0.3;
-  const double a = std::exp(-s.integral_leak * s.period_s);
-  double integral = 0.0;
-  for (int k = 0; k < 20; ++k) {
-    loop.update(tau_d, qdd, tau_s, qd);
-    const double e = tau_d[0] - tau_s[0];
-    const double y = reference.step(e);
-    integral = a * integral + s.integral_gain * (1.0 - a) / s.integral_leak * e;
-    const auto& j = table_[0];
-    const double friction = phri::friction_compensation(j.friction, qd[0], qdd[0]);
-    const double expected = (tau_d[0] + j.reflected_inertia_kgm2 * qdd[0] + friction + s.transfer_gain * y + integral) /
-                            j.torque_per_amp();
-    EXPECT_NEAR(loop.current()[0], expected, 1e-12);
-  }
-  // Joint 2 (|qd| < threshold, |qdd_d| > threshold): the static case, against the motion asked.
-  EXPECT_EQ(loop.friction_cases()[1], phri::FrictionCase::kStatic);
-  EXPECT_DOUBLE_EQ(loop.friction_term()[1], -table_[1].friction.static_Nm);
+  const double e[7] = {1.0, -0.5, 0.3, 0.8, 0.1, -0.05, 0.02};
+  // Friction, case by case: sliding (|qd| >= 0.1): coulomb sign(qd) + viscous qd; static
+  // (|qd| < 0.1, |qdd_d| >= 1): static sign(qdd_d); otherwise none.
+  const double friction[7] = {2.15 + 2.0 * 0.5, -2.15, 0.0, 2.15 + 2.0 * 0.2, 1.60, 0.0, 1.60 + 1.36 * 0.3};
+  const phri::FrictionCase cases[7] = {phri::FrictionCase::kSliding, phri::FrictionCase::kStatic,
+                                       phri::FrictionCase::kNone,    phri::FrictionCase::kSliding,
+                                       phri::FrictionCase::kStatic,  phri::FrictionCase::kNone,
+                                       phri::FrictionCase::kSliding};
+  const double torque_per_amp[7] = {11.0, 11.0, 11.0, 11.0, 7.6, 7.6, 7.6};
+  const double clamp[7] = {0.05 * 95, 0.05 * 95, 0.05 * 95, 0.05 * 95, 0.05 * 26, 0.05 * 45, 0.05 * 26};
+  const double b0 = 0.020175, b1 = -0.036975, b2 = 0.016917, a1 = -1.975063, a2 = 0.97518;
+  const double h_dc = (b0 + b1 + b2) / (1.0 + a1 + a2);
+
+  // k: number of updates; h: H(z)'s response to a unit step after k samples.
+  auto check = [&](int k, double h) {
+    for (int i = 0; i < 7; ++i) {
+      SCOPED_TRACE("joint " + std::to_string(i + 1) + " after " + std::to_string(k) + " periods");
+      const double integral = std::clamp(20.0 * e[i] * (1.0 - std::exp(-1e-3 * k)), -clamp[i], clamp[i]);
+      const double torque = tau_d[i] + 0.03 * qdd[i] + friction[i] + 5.0 * h * e[i] + integral;
+      EXPECT_NEAR(loop.friction_term()[i], friction[i], 1e-12);
+      EXPECT_EQ(loop.friction_cases()[static_cast<std::size_t>(i)], cases[i]);
+      EXPECT_NEAR(loop.rotor_term()[i], 0.03 * qdd[i], 1e-12);
+      EXPECT_NEAR(loop.filter_term()[i], 5.0 * h * e[i], 1e-9);
+      EXPECT_NEAR(loop.integral_term()[i], integral, 1e-9);
+      EXPECT_NEAR(loop.current()[i], torque / torque_per_amp[i], 1e-9);
+    }
+  };
+  loop.update(tau_d, qdd, tau_s, qd);
+  check(1, b0);
+  loop.update(tau_d, qdd, tau_s, qd);
+  check(2, b0 + b1 - a1 * b0);
+  for (int k = 3; k <= 6000; ++k) loop.update(tau_d, qdd, tau_s, qd);
+  check(6000, h_dc);
+  // Nothing saturated: the largest command, joint 1, is 10 + 0.06 + 3.15 + 5 + 4.75 N.m << 105 N.m.
+  EXPECT_EQ(loop.saturated_count(), 0);
 }
 
 TEST_F(CustomLoop, LeakyIntegratorStepResponseAndLeak) {
@@ -124,13 +155,19 @@ TEST_F(CustomLoop, BumplessEntryAndNoAllocation) {
   EXPECT_LT(max_change, 0.05);  // A: the integrator leaks the entry offset away, no jump
 }
 
-TEST_F(CustomLoop, RejectsBadSettings) {
+TEST_F(CustomLoop, RejectsBadSettingsNamingTheKey) {
+  using phri::test::expect_config_error;
   phri::CustomTorqueSettings s;
   s.integral_leak = 0.0;
-  EXPECT_THROW(phri::CustomTorqueController(table_, s), phri::ConfigError);
+  expect_config_error([&] { phri::CustomTorqueController(table_, s); },
+                      {.element = "integral_leak", .mentions = {"> 0"}});
   s = {};
   s.transfer_gain = -1.0;
-  EXPECT_THROW(phri::CustomTorqueController(table_, s), phri::ConfigError);
+  expect_config_error([&] { phri::CustomTorqueController(table_, s); },
+                      {.element = "transfer_gain", .mentions = {">= 0"}});
+  s = {};
+  s.integral_limit_fraction = 1.5;
+  expect_config_error([&] { phri::CustomTorqueController(table_, s); }, {.element = "integral_limit_fraction"});
 }
 
 }  // namespace

@@ -15,10 +15,13 @@
 #include <phri/sim/sim_robot_config.hpp>
 #include <phri/sim/stick_slip_friction.hpp>
 
+#include "config_error.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <fstream>
+#include <functional>
 #include <numbers>
 #include <sstream>
 #include <string>
@@ -36,21 +39,31 @@ std::string read_file(const std::string& path) {
   return s.str();
 }
 
-// Loads the shipped plant YAML with `from` replaced by `to` (must occur), expecting a ConfigError
-// whose key path is `key`.
-void expect_config_error(const std::string& from, const std::string& to, const std::string& key) {
-  std::string yaml = read_file(kPlantYaml);
-  const auto pos = yaml.find(from);
-  ASSERT_NE(pos, std::string::npos) << from;
-  yaml.replace(pos, from.size(), to);
-  try {
-    phri::SimRobotConfig::from_yaml_string(yaml, "test.yaml", kRoot + "/configs");
-    FAIL() << "no ConfigError for " << to;
-  } catch (const phri::ConfigError& e) {
-    EXPECT_EQ(e.element(), key) << e.what();
-    EXPECT_EQ(e.file(), "test.yaml");
-  }
+// `text` with `from` replaced by `to` (which must occur: a test bug otherwise).
+std::string edited(std::string text, const std::string& from, const std::string& to) {
+  const auto pos = text.find(from);
+  if (pos == std::string::npos) throw std::runtime_error("test bug: '" + from + "' not found");
+  text.replace(pos, from.size(), to);
+  return text;
 }
+
+// Loading the shipped plant YAML with `from` replaced by `to` (named "test.yaml" in errors), as a
+// callable for expect_config_error.
+std::function<void()> loading_plant_with(const std::string& from, const std::string& to) {
+  return [from, to] {
+    (void)phri::SimRobotConfig::from_yaml_string(edited(read_file(kPlantYaml), from, to), "test.yaml",
+                                                 kRoot + "/configs");
+  };
+}
+
+// The same for the Gen3 actuators.yaml (named "act.yaml").
+std::function<void()> loading_actuators_with(const std::string& from, const std::string& to) {
+  return [from, to] {
+    (void)phri::ActuatorTable::from_yaml_string(edited(read_file(kActuatorsYaml), from, to), "act.yaml");
+  };
+}
+
+using phri::test::expect_config_error;
 
 // ------------------------------------------------------------------------------------ loaders
 TEST(ActuatorTable, LoadsTheGen3File) {
@@ -76,25 +89,18 @@ TEST(ActuatorTable, LoadsTheGen3File) {
 }
 
 TEST(ActuatorTable, ValidationNamesTheKey) {
-  const std::string good = read_file(kActuatorsYaml);
-  auto expect_error = [&](const std::string& from, const std::string& to, const std::string& key) {
-    std::string yaml = good;
-    const auto pos = yaml.find(from);
-    ASSERT_NE(pos, std::string::npos);
-    yaml.replace(pos, from.size(), to);
-    try {
-      phri::ActuatorTable::from_yaml_string(yaml, "act.yaml");
-      FAIL() << to;
-    } catch (const phri::ConfigError& e) {
-      EXPECT_EQ(e.element(), key) << e.what();
-    }
-  };
-  expect_error("gear_ratio: 100", "gear_ratio: -1", "joints[0].gear_ratio");
-  expect_error("coulomb_Nm: 2.15", "coulomb_Nm: abc", "joints[0].friction.coulomb_Nm");
-  expect_error("reflected_inertia_kgm2: 0.03 ", "reflected_inertia_kgm2: 0.05 ", "joints[0].reflected_inertia_kgm2");
-  expect_error("size: large", "size: huge", "joints[0].size");
-  expect_error("static_Nm: 2.15", "static_Nm: 1.0", "joints[0].friction.static_Nm");
-  expect_error("    gear_ratio: 100", "    gear_ratios: 100", "joints[0].gear_ratios");
+  expect_config_error(loading_actuators_with("gear_ratio: 100", "gear_ratio: -1"),
+                      {.element = "joints[0].gear_ratio", .file = "act.yaml"});
+  expect_config_error(loading_actuators_with("coulomb_Nm: 2.15", "coulomb_Nm: abc"),
+                      {.element = "joints[0].friction.coulomb_Nm", .file = "act.yaml"});
+  expect_config_error(loading_actuators_with("reflected_inertia_kgm2: 0.03 ", "reflected_inertia_kgm2: 0.05 "),
+                      {.element = "joints[0].reflected_inertia_kgm2", .file = "act.yaml"});
+  expect_config_error(loading_actuators_with("size: large", "size: huge"),
+                      {.element = "joints[0].size", .file = "act.yaml"});
+  expect_config_error(loading_actuators_with("static_Nm: 2.15", "static_Nm: 1.0"),
+                      {.element = "joints[0].friction.static_Nm", .file = "act.yaml"});
+  expect_config_error(loading_actuators_with("    gear_ratio: 100", "    gear_ratios: 100"),
+                      {.element = "joints[0].gear_ratios", .file = "act.yaml"});
 }
 
 TEST(SimRobotConfig, LoadsTheShippedPlant) {
@@ -119,28 +125,43 @@ TEST(SimRobotConfig, LoadsTheShippedPlant) {
 }
 
 TEST(SimRobotConfig, ErrorsNameTheKeyPath) {
-  expect_config_error("torque_sensor_std_Nm: 0.05", "torque_sensor_std_Nm: -1", "plant.noise.torque_sensor_std_Nm");
-  expect_config_error("torque_sensor_std_Nm: 0.05", "torque_sensor_std_Nm: loud", "plant.noise.torque_sensor_std_Nm");
-  expect_config_error("torque_sensor_std_Nm: 0.05", "torque_sensor_stdev_Nm: 0.05", "plant.noise.torque_sensor_stdev_Nm");
-  expect_config_error("physics_rate_Hz: 4000", "physics_rate_Hz: 4500", "plant.timing.physics_rate_Hz");
-  expect_config_error("control_period_s: 0.001", "control_period_s: 0.0011", "plant.timing.control_period_s");
-  expect_config_error("mass_kg: 0.3", "mass_kg: [0.3]", "plant.tool.mass_kg");
-  expect_config_error("force_bias_N: [0.4, -0.3, 0.6]", "force_bias_N: [0.4, -0.3]", "plant.ft_sensor.force_bias_N");
-  expect_config_error("feedback_gain: [0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5]",
-                      "feedback_gain: [0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 1.5]", "plant.vendor.torque.feedback_gain[6]");
-  expect_config_error("q_rad: [0.0, 0.26179939,", "q_rad: [0.26179939,", "plant.initial.q_rad");
-  expect_config_error("actuator_overrides: {}", "actuator_overrides: {joint_9: {static_Nm: 3}}",
-                      "plant.actuator_overrides.joint_9");
-  expect_config_error("actuator_overrides: {}", "actuator_overrides: {joint_2: {static_Nm: 1.0}}",
-                      "plant.actuator_overrides.joint_2.static_Nm");
-  expect_config_error("enabled: false\n    mass_kg: 1.25", "enabled: maybe\n    mass_kg: 1.25", "plant.drop_test.enabled");
-  expect_config_error("disturbances: []", "disturbances:\n    - {body: forearm_link, profile: wobble, start_s: 1, duration_s: 1}",
-                      "plant.disturbances[0].profile");
-  expect_config_error("disturbances: []", "disturbances:\n    - {body: forearm_link, profile: step, start_s: 1}",
-                      "plant.disturbances[0].duration_s");
-  expect_config_error("max_force_N: 200.0", "max_force_N: 2000.0", "plant.random_pushes.max_force_N");
-  expect_config_error("rate_Hz: 1000                    # [Hz] sample rate", "rate_Hz: 3000", "plant.ft_sensor.rate_Hz");
-  expect_config_error("plant:", "plants:", "plants");
+  expect_config_error(loading_plant_with("torque_sensor_std_Nm: 0.05", "torque_sensor_std_Nm: -1"),
+                      {.element = "plant.noise.torque_sensor_std_Nm", .file = "test.yaml"});
+  expect_config_error(loading_plant_with("torque_sensor_std_Nm: 0.05", "torque_sensor_std_Nm: loud"),
+                      {.element = "plant.noise.torque_sensor_std_Nm", .file = "test.yaml"});
+  expect_config_error(loading_plant_with("torque_sensor_std_Nm: 0.05", "torque_sensor_stdev_Nm: 0.05"),
+                      {.element = "plant.noise.torque_sensor_stdev_Nm", .file = "test.yaml"});
+  expect_config_error(loading_plant_with("physics_rate_Hz: 4000", "physics_rate_Hz: 4500"),
+                      {.element = "plant.timing.physics_rate_Hz", .file = "test.yaml"});
+  expect_config_error(loading_plant_with("control_period_s: 0.001", "control_period_s: 0.0011"),
+                      {.element = "plant.timing.control_period_s", .file = "test.yaml"});
+  expect_config_error(loading_plant_with("mass_kg: 0.3", "mass_kg: [0.3]"),
+                      {.element = "plant.tool.mass_kg", .file = "test.yaml"});
+  expect_config_error(loading_plant_with("force_bias_N: [0.4, -0.3, 0.6]", "force_bias_N: [0.4, -0.3]"),
+                      {.element = "plant.ft_sensor.force_bias_N", .file = "test.yaml"});
+  expect_config_error(loading_plant_with("feedback_gain: [0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5]",
+                                         "feedback_gain: [0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 1.5]"),
+                      {.element = "plant.vendor.torque.feedback_gain[6]", .file = "test.yaml"});
+  expect_config_error(loading_plant_with("q_rad: [0.0, 0.26179939,", "q_rad: [0.26179939,"),
+                      {.element = "plant.initial.q_rad", .file = "test.yaml"});
+  expect_config_error(loading_plant_with("actuator_overrides: {}", "actuator_overrides: {joint_9: {static_Nm: 3}}"),
+                      {.element = "plant.actuator_overrides.joint_9", .file = "test.yaml"});
+  expect_config_error(loading_plant_with("actuator_overrides: {}", "actuator_overrides: {joint_2: {static_Nm: 1.0}}"),
+                      {.element = "plant.actuator_overrides.joint_2.static_Nm", .file = "test.yaml"});
+  expect_config_error(loading_plant_with("enabled: false\n    mass_kg: 1.25", "enabled: maybe\n    mass_kg: 1.25"),
+                      {.element = "plant.drop_test.enabled", .file = "test.yaml"});
+  expect_config_error(
+      loading_plant_with("disturbances: []",
+                         "disturbances:\n    - {body: forearm_link, profile: wobble, start_s: 1, duration_s: 1}"),
+      {.element = "plant.disturbances[0].profile", .file = "test.yaml"});
+  expect_config_error(
+      loading_plant_with("disturbances: []", "disturbances:\n    - {body: forearm_link, profile: step, start_s: 1}"),
+      {.element = "plant.disturbances[0].duration_s", .file = "test.yaml"});
+  expect_config_error(loading_plant_with("max_force_N: 200.0", "max_force_N: 2000.0"),
+                      {.element = "plant.random_pushes.max_force_N", .file = "test.yaml"});
+  expect_config_error(loading_plant_with("rate_Hz: 1000                    # [Hz] sample rate", "rate_Hz: 3000"),
+                      {.element = "plant.ft_sensor.rate_Hz", .file = "test.yaml"});
+  expect_config_error(loading_plant_with("plant:", "plants:"), {.element = "plants", .file = "test.yaml"});
 }
 
 TEST(SimRobotConfig, CodeBuiltConfigGetsDefaults) {
@@ -148,7 +169,8 @@ TEST(SimRobotConfig, CodeBuiltConfigGetsDefaults) {
   c.mjcf_path = kRoot + "/robots/kinova_gen3/gen3_plant.xml";
   c.actuators = phri::ActuatorTable::from_yaml_file(kActuatorsYaml);
   c.initial_q_rad.assign(7, 0.0);
-  EXPECT_THROW(c.validate(), phri::ConfigError);  // vendor gains missing
+  // The per-joint defaults (sensor offsets, vendor gains) missing: the first one checked is named.
+  expect_config_error([&] { c.validate(); }, {.mentions = {"expected 7 values (one per joint), got 0"}});
   c.fill_defaults();
   EXPECT_NO_THROW(c.validate());
   EXPECT_DOUBLE_EQ(c.vendor.position_kp_Nm_per_rad[0], 12000.0);
@@ -213,8 +235,16 @@ TEST(DiscreteTransferFunction, KinovaFilterMatchesItsDifferenceEquation) {
 }
 
 TEST(DiscreteTransferFunction, RejectsBadCoefficients) {
-  EXPECT_THROW(phri::DiscreteTransferFunction({1.0}, {0.0, 1.0}), phri::ConfigError);
-  EXPECT_THROW(phri::DiscreteTransferFunction({1, 1, 1, 1, 1, 1, 1}, {1.0}), phri::ConfigError);
+  expect_config_error(
+      [] {
+        phri::DiscreteTransferFunction({1.0}, {0.0, 1.0});
+      },
+      {.element = "coefficients", .mentions = {"a0 must be non-zero"}});
+  expect_config_error(
+      [] {
+        phri::DiscreteTransferFunction({1, 1, 1, 1, 1, 1, 1}, {1.0});
+      },
+      {.element = "coefficients", .mentions = {"order above 5"}});
   phri::DiscreteTransferFunction identity;
   EXPECT_DOUBLE_EQ(identity.step(3.5), 3.5);
 }

@@ -9,6 +9,7 @@
 #include <phri/model/algorithms.hpp>
 
 #include "allocation_counter.hpp"
+#include "config_error.hpp"
 
 #include <gtest/gtest.h>
 
@@ -219,11 +220,12 @@ TEST_F(WholeBodyQpTest, TargetGovernorReachesAJumpedTargetWithBoundedSpeedAndTra
   }
 }
 
-TEST(ComplianceControllerTest, SchmittTriggerAndValidation) {
+TEST(ComplianceControllerTest, ReleaseThresholdAboveTheTouchThresholdIsAConfigError) {
   phri::ComplianceSettings inverted;
   inverted.touch_threshold = 4.0;
   inverted.release_threshold = 8.0;
-  EXPECT_THROW(phri::ComplianceController{inverted}, phri::ConfigError);
+  phri::test::expect_config_error([&] { phri::ComplianceController controller{inverted}; },
+                                  {.element = "release_threshold", .mentions = {"touch_threshold"}});
 }
 
 }  // namespace

@@ -1,0 +1,299 @@
+// ctest-labels: unit
+// phri::run_session, the loop of `phri run`, driven through phri::FakeRobot (a deterministic
+// unit-inertia arm, no MuJoCo) with the Gen3 Controller (URDF, actuators.yaml, collision.yaml) and
+// the demo's Fsm, in lockstep: it runs ceil(duration / period) cycles, one read and one write each;
+// stale, invalid or non-finite joint data are held cycles, counted in the summary, and put the
+// session in a safe hold reported once (the FSM is told to stop); refused writes leave the arm on
+// its last accepted command; the loop ends at the cycle where the FSM has finished; the logger
+// gets one row per cycle; phases split the summary at their start times.
+//
+// The arm starts at the plant's home posture (configs/plant_gen3.yaml), so the FSM's start-up is a
+// 2.7 s minimum-jerk joint move in the Position loop; the sessions here stay inside it, where the
+// FakeRobot's ideal position servo is the whole plant (no gravity to compensate).
+#include <phri/app/fsm.hpp>
+#include <phri/app/logger.hpp>
+#include <phri/app/run_session.hpp>
+#include <phri/app/scenario.hpp>
+#include <phri/control/controller.hpp>
+#include <phri/robot/actuator_table.hpp>
+#include <phri/robot/fake_robot.hpp>
+
+#include "temp_dir.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <fstream>
+#include <functional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace {
+
+const std::string kRoot = PHRI_SOURCE_DIR;
+const std::string kGen3 = kRoot + "/robots/kinova_gen3/";
+
+phri::ControllerSettings gen3_settings() {
+  phri::ControllerSettings s;
+  s.urdf_path = kGen3 + "gen3.urdf";
+  s.actuators_path = kGen3 + "actuators.yaml";
+  s.collision_path = kGen3 + "collision.yaml";
+  s.initial_compliance = phri::ComplianceMode::kNullSpace;
+  s.initial_loop = phri::LowLevelMode::kPosition;
+  return s;
+}
+
+// The plant's home posture (configs/plant_gen3.yaml, initial.q_rad), the start-up's starting point.
+Eigen::VectorXd plant_home() {
+  Eigen::VectorXd q(7);
+  q << 0.0, 0.26179939, 3.14159265, -2.26892803, 0.0, 0.95993109, 1.57079633;
+  return q;
+}
+
+phri::FakeRobotSettings fake_gen3() {
+  const phri::ActuatorTable table = phri::ActuatorTable::from_yaml_file(kGen3 + "actuators.yaml");
+  phri::FakeRobotSettings s;
+  s.dof = 7;
+  s.period_s = 1e-3;
+  s.initial_q_rad = plant_home();
+  s.torque_per_amp_Nm_per_A.resize(7);
+  for (int i = 0; i < 7; ++i) s.torque_per_amp_Nm_per_A[i] = table[i].torque_per_amp();
+  return s;
+}
+
+// Occurrences of `needle` in `text`.
+int count(const std::string& text, const std::string& needle) {
+  int n = 0;
+  for (std::size_t at = text.find(needle); at != std::string::npos; at = text.find(needle, at + needle.size())) ++n;
+  return n;
+}
+
+// One session: the fake arm, the Gen3 controller, the FSM, and what the loop printed. Every write
+// is recorded: its status, its position set-point, the q of the state read in the same cycle, and
+// whether the FSM had finished by then.
+class Session {
+ public:
+  explicit Session(phri::FsmSettings fsm_settings = {})
+      : controller_(gen3_settings()), fsm_(fsm_settings, controller_) {
+    robot_.set_write_observer([this](const phri::RobotCommand& command, phri::WriteStatus status) {
+      statuses_.push_back(status);
+      positions_.push_back(command.q_rad);
+      read_q_.push_back(robot_.state().q_rad);
+      finished_at_write_.push_back(fsm_.finished());
+    });
+  }
+
+  phri::RunSummary run(double duration_s, std::vector<phri::PhaseMark> phases = {}, phri::Logger* logger = nullptr,
+                       bool real_time = false) {
+    phri::RunOptions options;
+    options.duration_s = duration_s;
+    options.real_time = real_time;
+    options.status_line = false;
+    options.phases = std::move(phases);
+    return phri::run_session(robot_, controller_, fsm_, nullptr, logger, options, out_);
+  }
+
+  phri::FakeRobot robot_{fake_gen3()};
+  phri::Controller controller_;
+  phri::Fsm fsm_;
+  std::ostringstream out_;
+  std::vector<phri::WriteStatus> statuses_;
+  std::vector<Eigen::VectorXd> positions_;
+  std::vector<Eigen::VectorXd> read_q_;
+  std::vector<bool> finished_at_write_;
+};
+
+TEST(RunSession, RunsDurationOverPeriodCyclesOneReadAndOneWriteEach) {
+  Session session;
+  const phri::RunSummary summary = session.run(0.25);
+  EXPECT_EQ(summary.cycles, 250u);
+  EXPECT_EQ(session.robot_.reads(), 250u);
+  EXPECT_EQ(session.robot_.writes(), 250u);
+  EXPECT_EQ(session.robot_.refused_writes(), 0u);
+  EXPECT_NEAR(summary.simulated_s, 0.25, 1e-12);
+  EXPECT_EQ(summary.held_cycles, 0);
+  EXPECT_EQ(summary.overruns, 0u);
+  EXPECT_FALSE(summary.safe_hold);
+  EXPECT_EQ(count(session.out_.str(), "SAFE HOLD"), 0);
+  EXPECT_EQ(session.fsm_.state(), phri::FsmState::kStartup);
+  EXPECT_FALSE(session.fsm_.finished());
+  // The Position loop's reference is what the arm was sent, and the last state shows it reached.
+  EXPECT_EQ(session.robot_.last_accepted().mode, phri::LowLevelMode::kPosition);
+  EXPECT_EQ(session.robot_.last_accepted().q_rad, session.controller_.low_level().position_reference());
+  // A partial period is one more cycle: ceil(0.2505 / 0.001) = 251.
+  Session longer;
+  EXPECT_EQ(longer.run(0.2505).cycles, 251u);
+}
+
+// The start-up's move, through the loop: after 0.5 s the arm has moved toward the home posture, at
+// most the move's 0.3 rad/s peak joint speed (the fake servo's velocity is the reference's).
+TEST(RunSession, TheStartupMoveReachesTheArmThroughTheLoop) {
+  Session session;
+  session.run(0.5);
+  Eigen::VectorXd home(7);
+  for (int i = 0; i < 7; ++i) home[i] = phri::paper_posture_target()[static_cast<std::size_t>(i)];
+  const double start_error = (home - plant_home()).norm();
+  const double error = (home - session.robot_.true_q()).norm();
+  EXPECT_LT(error, start_error - 0.01) << "the arm moved toward home";
+  double peak_speed = 0.0;
+  for (std::size_t k = 1; k < session.positions_.size(); ++k) {
+    peak_speed = std::max(peak_speed, (session.positions_[k] - session.positions_[k - 1]).cwiseAbs().maxCoeff() / 1e-3);
+  }
+  EXPECT_GT(peak_speed, 0.01);
+  EXPECT_LT(peak_speed, 0.3 * 1.05);
+}
+
+TEST(RunSession, PhasesSplitTheSummaryAtTheirStartTimes) {
+  Session session;
+  const phri::RunSummary summary = session.run(0.3, {{0.0, "settle"}, {0.1, "move"}, {0.25, "end"}});
+  ASSERT_EQ(summary.phases.size(), 3u);
+  EXPECT_EQ(summary.phases[0].name, "settle");
+  EXPECT_EQ(summary.phases[1].name, "move");
+  EXPECT_EQ(summary.phases[2].name, "end");
+  EXPECT_DOUBLE_EQ(summary.phases[0].end_s, 0.1);
+  EXPECT_DOUBLE_EQ(summary.phases[1].start_s, 0.1);
+  EXPECT_DOUBLE_EQ(summary.phases[1].end_s, 0.25);
+  EXPECT_NEAR(summary.phases[2].end_s, 0.3, 1e-12);
+  // Each phase change announced once (not on a terminal: plain lines).
+  EXPECT_EQ(count(session.out_.str(), "phase: move\n"), 1);
+  EXPECT_EQ(count(session.out_.str(), "phase: end\n"), 1);
+  EXPECT_EQ(count(session.out_.str(), "phase: settle"), 0) << "the first phase is where the run starts";
+}
+
+struct BadData {
+  std::string name;
+  std::function<void(phri::FakeRobot&)> inject;
+  long held;
+  std::string status;
+  std::string at;  // time of the first bad read, as the reason prints it
+};
+
+// Joint data that cannot be used, three ways: each bad read is one held cycle in which the
+// previous command is written again; the first one puts the session in a safe hold, reported
+// once, and the FSM stops: it brakes the start-up move and the loop ends when the arm is at rest.
+TEST(RunSession, BadJointDataAreHeldCyclesCountedInTheSummaryAndStopTheSessionOnce) {
+  const std::vector<BadData> cases = {
+      {"NaN in q", [](phri::FakeRobot& r) { r.inject_nan({.first = 101, .count = 10}, 3); }, 10, "invalid_state",
+       "0.101"},
+      {"joints.valid false", [](phri::FakeRobot& r) { r.invalidate_joints({.first = 201, .count = 3}); }, 3,
+       "invalid_state", "0.201"},
+      {"frozen joint frames", [](phri::FakeRobot& r) { r.freeze_joints({.first = 151, .count = 5}); }, 5, "stale_state",
+       "0.151"},
+  };
+  for (const BadData& c : cases) {
+    SCOPED_TRACE(c.name);
+    Session session;
+    c.inject(session.robot_);
+    const phri::RunSummary summary = session.run(3.0);
+
+    EXPECT_EQ(summary.held_cycles, c.held);
+    ASSERT_TRUE(summary.safe_hold);
+    EXPECT_NE(summary.safe_hold_reason.find(c.status), std::string::npos) << summary.safe_hold_reason;
+    EXPECT_NE(summary.safe_hold_reason.find("t = " + c.at), std::string::npos) << summary.safe_hold_reason;
+    EXPECT_EQ(count(session.out_.str(), "SAFE HOLD"), 1) << session.out_.str();
+    std::ostringstream report;
+    phri::print_run_summary(summary, report);
+    EXPECT_NE(report.str().find(std::to_string(c.held) + " held cycles ; SAFE HOLD: sensor data " + c.status),
+              std::string::npos)
+        << report.str();
+
+    // A write every cycle; during the held cycles, the command of the cycle before, unchanged.
+    EXPECT_EQ(session.robot_.writes(), summary.cycles);
+    const std::size_t first = static_cast<std::size_t>(std::stoul(c.at.substr(2))) - 1;  // write index (0-based)
+    for (std::size_t k = first; k < first + static_cast<std::size_t>(c.held); ++k) {
+      EXPECT_EQ(session.positions_[k], session.positions_[first - 1]) << "write " << k + 1;
+    }
+    EXPECT_NE(session.positions_[first + static_cast<std::size_t>(c.held)], session.positions_[first - 1])
+        << "the loop resumes after the bad data";
+
+    // The stop: braked, at rest, finished; the loop ended at the cycle where it finished.
+    EXPECT_TRUE(session.fsm_.stop_requested());
+    EXPECT_TRUE(session.fsm_.finished());
+    EXPECT_EQ(session.fsm_.state(), phri::FsmState::kStopped);
+    EXPECT_LT(summary.cycles, 3000u);
+    EXPECT_LT(session.robot_.true_qd().cwiseAbs().maxCoeff(), 0.01);
+  }
+}
+
+// Writes the robot refuses (here writes 100 to 149) do not stop the loop and are not held
+// cycles; the arm stays on its last accepted command meanwhile, and the state counts the refusals.
+// (run_session does not look at WriteStatus: neither its summary nor the controller learn of them.)
+TEST(RunSession, RefusedWritesLeaveTheArmOnItsLastAcceptedCommandAndTheLoopRunning) {
+  Session session;
+  session.robot_.refuse_writes({.first = 100, .count = 50}, phri::WriteStatus::kFault);
+  const phri::RunSummary summary = session.run(0.3);
+  EXPECT_EQ(summary.cycles, 300u);
+  EXPECT_EQ(summary.held_cycles, 0);
+  EXPECT_FALSE(summary.safe_hold);
+  EXPECT_EQ(session.robot_.refused_writes(), 50u);
+  EXPECT_EQ(session.robot_.state().rejected_writes, 50u);
+  ASSERT_EQ(session.statuses_.size(), 300u);
+  for (std::size_t k = 0; k < 300; ++k) {
+    EXPECT_EQ(session.statuses_[k], k >= 99 && k < 149 ? phri::WriteStatus::kFault : phri::WriteStatus::kOk) << k + 1;
+  }
+  // Reads 101 to 150 (after the refused writes 100 to 149) show write 99's set-point; read 151
+  // shows write 150's, the first accepted again.
+  for (std::size_t k = 100; k < 150; ++k) EXPECT_EQ(session.read_q_[k], session.positions_[98]) << "read " << k + 1;
+  EXPECT_EQ(session.read_q_[150], session.positions_[149]);
+  const double step = (session.positions_[149] - session.positions_[98]).cwiseAbs().maxCoeff();
+  std::printf("refused writes: the reference ran %.2e rad ahead of the arm over the 50 refused writes\n", step);
+  EXPECT_GT(step, 0.0) << "the controller kept moving its reference, unaware";
+}
+
+// A scripted stop: the FSM brakes the start-up move, holds, and the loop stops at the cycle where
+// the arm is at rest, long before the 5 s asked.
+TEST(RunSession, TheLoopStopsAtTheCycleWhereTheFsmHasFinished) {
+  phri::FsmSettings settings;
+  settings.timeline = {{0.3, phri::Event::kStop}};
+  Session session(settings);
+  const phri::RunSummary summary = session.run(5.0);
+  ASSERT_TRUE(session.fsm_.finished());
+  EXPECT_FALSE(summary.safe_hold);
+  EXPECT_EQ(summary.held_cycles, 0);
+  // The stop at 0.3 s brakes the move (joint speeds ~0.05 rad/s then) for max(0.2 s, speed / 1 rad/s^2)
+  // = 0.2 s: stopped, and at rest, at 0.5 s.
+  EXPECT_NEAR(static_cast<double>(summary.cycles), 500.0, 1.0);
+  // finished() turned true in the last cycle (its update precedes the write), never before it.
+  ASSERT_EQ(session.finished_at_write_.size(), summary.cycles);
+  for (std::size_t k = 0; k + 1 < summary.cycles; ++k) ASSERT_FALSE(session.finished_at_write_[k]) << k + 1;
+  EXPECT_TRUE(session.finished_at_write_.back());
+  EXPECT_EQ(session.robot_.reads(), summary.cycles);
+  EXPECT_NEAR(summary.simulated_s, 1e-3 * static_cast<double>(summary.cycles), 1e-12);
+  EXPECT_LT(session.robot_.true_qd().cwiseAbs().maxCoeff(), settings.rest_speed_rad_s);
+}
+
+TEST(RunSession, TheLoggerGetsOneRowPerCycle) {
+  Session session;
+  phri::LoggerSettings log;
+  log.path = phri::test::temp_path("phri_test_run_session", "run.csv");
+  log.write_legend = false;
+  phri::Logger logger(log);
+  const phri::RunSummary summary = session.run(0.2, {}, &logger);
+  const phri::LoggerStats stats = logger.close();
+  EXPECT_EQ(stats.written, summary.cycles);
+  EXPECT_EQ(stats.dropped, 0u);
+  std::ifstream in(log.path);
+  std::string line;
+  std::getline(in, line);  // header
+  ASSERT_EQ(line.rfind("time_s,", 0), 0u) << line;
+  long rows = 0;
+  double last_time = 0.0;
+  while (std::getline(in, line)) {
+    ++rows;
+    last_time = std::stod(line.substr(0, line.find(',')));
+    ASSERT_NEAR(last_time, 1e-3 * static_cast<double>(rows), 1e-12) << rows;
+  }
+  EXPECT_EQ(rows, 200);
+}
+
+// Paced by the real-time clock: the same cycles, and never ahead of the wall clock (a late cycle
+// is counted, not caught up, so the run can only take longer).
+TEST(RunSession, RealTimePacingRunsTheSameCyclesNoFasterThanTheClock) {
+  Session session;
+  const phri::RunSummary summary = session.run(0.05, {}, nullptr, true);
+  EXPECT_EQ(summary.cycles, 50u);
+  EXPECT_GE(summary.wall_s, 0.049);
+}
+
+}  // namespace
