@@ -3,10 +3,10 @@
 
 1. Layering: a file of module M includes <phri/N/...> only for N == M or a module below M
    (MODULE_DEPENDENCIES, the same graph as the top-level CMakeLists.txt).
-2. Function length: no function in src/ longer than MAX_FUNCTION_LINES, counted from the first line
-   of its declaration (template and initializer list included) to its closing brace.
+2. Function length: no function in src/ or apps/ longer than MAX_FUNCTION_LINES, counted from the
+   first line of its declaration (template and initializer list included) to its closing brace.
 
-    tools/check_structure.py [SRC_DIR]          (default: the src/ beside tools/)
+    tools/check_structure.py [ROOT]          (default: the project root, the folder above tools/)
 """
 import pathlib
 import re
@@ -30,7 +30,7 @@ MODULE_DEPENDENCIES = {
 
 INCLUDE = re.compile(r'^\s*#\s*include\s*[<"]phri/([A-Za-z0-9_]+)/', re.M)
 SCOPE_KEYWORD = re.compile(r"\b(namespace|class|struct|enum|union)\b|^\s*extern\s*\"C\"")
-FUNCTION_TAIL = re.compile(r"(\)|\bconst|\bnoexcept|\boverride|\bfinal|\bmutable|->\s*[\w:<>,\s*&]+)\s*$")
+FUNCTION_TAIL = re.compile(r"(\)|\}|\bconst|\bnoexcept|\boverride|\bfinal|\bmutable|->\s*[\w:<>,\s*&]+)\s*$")
 
 
 def reachable(module):
@@ -60,6 +60,23 @@ def layering_findings(src):
                 line = text.count("\n", 0, match.start()) + 1
                 findings.append(f"{path}:{line}: module '{module}' includes phri/{target}/, which is not below it")
     return findings
+
+
+def cmake_graph_findings(cmake_lists):
+    """The module graph in CMakeLists.txt (phri_add_module) must be MODULE_DEPENDENCIES."""
+    if not cmake_lists.is_file():
+        return []
+    graph = {}
+    for match in re.finditer(r"phri_add_module\(\s*(\w+)([^)]*)\)", cmake_lists.read_text()):
+        words = match.group(2).split()
+        deps = words[words.index("DEPENDS") + 1:] if "DEPENDS" in words else []
+        if "PRIVATE_DEPENDS" in deps:
+            deps = deps[:deps.index("PRIVATE_DEPENDS")]
+        graph[match.group(1)] = sorted(deps)
+    expected = {module: sorted(deps) for module, deps in MODULE_DEPENDENCIES.items()}
+    if graph != expected:
+        return [f"{cmake_lists}: module graph {graph} differs from tools/check_structure.py's {expected}"]
+    return []
 
 
 def strip_comments_and_strings(text):
@@ -182,14 +199,19 @@ def length_findings(src):
 
 
 def main(argv):
-    src = pathlib.Path(argv[1]) if len(argv) > 1 else pathlib.Path(__file__).resolve().parent.parent / "src"
+    root = pathlib.Path(argv[1]) if len(argv) > 1 else pathlib.Path(__file__).resolve().parent.parent
+    src = root / "src"
     if not (src / "phri").is_dir():
         print(f"check_structure: {src}/phri is not a directory", file=sys.stderr)
         return 2
     findings = layering_findings(src) + length_findings(src)
+    if (root / "CMakeLists.txt").is_file():
+        findings += cmake_graph_findings(root / "CMakeLists.txt")
+    if (root / "apps").is_dir():
+        findings += length_findings(root / "apps")
     for finding in findings:
         print(finding)
-    print(f"check_structure: {len(findings)} finding(s) in {src}")
+    print(f"check_structure: {len(findings)} finding(s) in {src} and {root / 'apps'}")
     return 1 if findings else 0
 
 

@@ -6,9 +6,9 @@
 //
 // Names (timeline YAML, log legend) and meaning:
 //   stiff_compliance, null_space_compliance, full_body_compliance, dual_compliance
-//                          compliance mode (Controller::set_compliance_mode)
+//                          compliance mode (ControllerTargets::compliance_mode)
 //   position_loop, kinova_torque_loop, kinova_torque_high_velocity_loop, custom_loop
-//                          low-level loop (Controller::set_low_level_loop)
+//                          low-level loop (ControllerTargets::low_level_mode)
 //   toggle_loop            position <-> the last torque loop used (custom at first)
 //   static_scenario, dynamic_scenario
 //                          start a scenario (the FSM brakes the current motion first)
