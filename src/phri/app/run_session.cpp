@@ -2,6 +2,7 @@
 
 #include <phri/app/log_row.hpp>
 #include <phri/app/loop_clock.hpp>
+#include <phri/core/statistics.hpp>
 
 #include <algorithm>
 #include <chrono>
@@ -12,13 +13,6 @@
 
 namespace phri {
 namespace {
-
-double percentile(std::vector<double>& values, double p) {
-  if (values.empty()) return 0.0;
-  const std::size_t k = static_cast<std::size_t>(std::clamp(p, 0.0, 1.0) * static_cast<double>(values.size() - 1));
-  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(k), values.end());
-  return values[k];
-}
 
 struct PhaseAccumulator {
   double pos_max = 0, pos_sq = 0, ori_max = 0, ori_sq = 0, wrench_max = 0;

@@ -32,11 +32,4 @@ bool run_figure_script(const std::string& script, const std::vector<std::string>
 void report_files_and_figure(const std::vector<std::string>& files, const std::string& output_dir,
                              const std::string& figure_script, const std::string& figure_name, std::ostream& out);
 
-/// The p-quantile (p in [0, 1]) of `values`, interpolated linearly between order statistics
-/// (p = 0.5: the median, the mean of the middle two for an even count); 0 when empty.
-double percentile(std::vector<double> values, double p);
-
-/// Formats a double with `digits` decimals ("%.*f"), for tables and CSV.
-std::string format_fixed(double value, int digits);
-
 }  // namespace phri

@@ -2,6 +2,7 @@
 
 #include <phri/control/controller_settings.hpp>
 #include <phri/core/error.hpp>
+#include <phri/core/format.hpp>
 #include <phri/experiments/experiment_files.hpp>
 #include <phri/experiments/friction_perturbation.hpp>
 #include <phri/model/algorithms.hpp>

@@ -2,6 +2,8 @@
 
 #include <phri/control/controller.hpp>
 #include <phri/core/error.hpp>
+#include <phri/core/format.hpp>
+#include <phri/core/statistics.hpp>
 #include <phri/experiments/experiment_files.hpp>
 #include <phri/experiments/friction_perturbation.hpp>
 #include <phri/model/algorithms.hpp>
@@ -147,12 +149,6 @@ SimRobotConfig plant_config(const TorqueTrackingOptions& o, TrackingScenario sce
     c.tool.inertia_kgm2 *= scale;
   }
   return c;
-}
-
-double rms(const std::vector<double>& values) {
-  double sum = 0.0;
-  for (double v : values) sum += v * v;
-  return values.empty() ? 0.0 : std::sqrt(sum / static_cast<double>(values.size()));
 }
 
 std::string loop_name(LowLevelMode loop) { return std::string(to_string(loop)); }

@@ -1,6 +1,8 @@
 #include <phri/experiments/torque_tracking_sweep.hpp>
 
 #include <phri/core/error.hpp>
+#include <phri/core/format.hpp>
+#include <phri/core/statistics.hpp>
 #include <phri/experiments/experiment_files.hpp>
 
 #include <algorithm>
