@@ -8,8 +8,11 @@
 #include <phri/app/config.hpp>
 #include <phri/app/run_session.hpp>
 #include <phri/core/error.hpp>
+#include <phri/core/format.hpp>
+#include <phri/core/process.hpp>
 #include <phri/sim/sim_robot.hpp>
 #include <phri/core/version.hpp>
+#include <phri/experiments/experiment_files.hpp>
 #include <phri/experiments/friction_identification.hpp>
 #include <phri/experiments/torque_tracking.hpp>
 #include <phri/experiments/torque_tracking_sweep.hpp>
@@ -25,6 +28,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace {
 
@@ -65,6 +69,24 @@ std::string locate(const std::string& relative) {
     return relative;
   }
   return std::string(PHRI_SOURCE_DIR) + "/" + relative;
+}
+
+// The figure of a run's log (tools/report/demo_figure.py), drawn by the system python through
+// run_process: the paths reach the script as arguments, never through a shell. A failure is a warning.
+void draw_demo_figure(const std::string& log_path, const std::string& png, const phri::ComplianceSettings& compliance) {
+  const std::string script = locate("tools/report/demo_figure.py");
+  if (!std::filesystem::exists(phri::kSystemPython) || !std::filesystem::exists(script)) {
+    std::printf("no figure: %s or %s missing\n", phri::kSystemPython, script.c_str());
+    return;
+  }
+  const std::vector<std::string> argv = {phri::kSystemPython, script, log_path, png,
+                                         "--touch", phri::format_fixed(compliance.touch_threshold, 6),
+                                         "--release", phri::format_fixed(compliance.release_threshold, 6)};
+  try {
+    if (phri::run_process(argv) != 0) std::fprintf(stderr, "phri: warning: the figure script failed\n");
+  } catch (const phri::IoError& e) {
+    std::fprintf(stderr, "phri: warning: the figure script failed: %s\n", e.what());
+  }
 }
 
 struct RunArguments {
@@ -120,16 +142,7 @@ int run_command(const RunArguments& args) {
     const phri::LoggerStats stats = logger->close();
     std::printf("%s\n", logger->summary().c_str());
     if (stats.dropped > 0 || stats.write_error) std::fprintf(stderr, "phri: warning: log incomplete\n");
-    const std::string script = locate("tools/report/demo_figure.py");
-    const std::string png = (out / "demo.png").string();
-    if (args.figure && std::filesystem::exists("/usr/bin/python3") && std::filesystem::exists(script)) {
-      const std::string command = "/usr/bin/python3 '" + script + "' '" + logger->path() + "' '" + png + "' --touch " +
-                                  std::to_string(config.controller.compliance.touch_threshold) + " --release " +
-                                  std::to_string(config.controller.compliance.release_threshold);
-      if (std::system(command.c_str()) != 0) std::fprintf(stderr, "phri: warning: the figure script failed\n");
-    } else if (args.figure) {
-      std::printf("no figure: /usr/bin/python3 or %s missing\n", script.c_str());
-    }
+    if (args.figure) draw_demo_figure(logger->path(), (out / "demo.png").string(), config.controller.compliance);
   }
   return summary.safe_hold ? 3 : 0;
 }

@@ -1,14 +1,13 @@
 #include <phri/experiments/experiment_files.hpp>
 
 #include <phri/core/error.hpp>
+#include <phri/core/process.hpp>
 
 #include <algorithm>
-#include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <ostream>
+#include <string_view>
 #include <system_error>
 
 namespace phri {
@@ -36,18 +35,14 @@ std::string output_path(const std::string& dir, const std::string& name) {
 }
 
 namespace {
-// Single-quoted for /bin/sh: every ' becomes '\''.
-std::string shell_quote(const std::string& s) {
-  std::string q(1, '\'');
-  for (char c : s) {
-    if (c == '\'') {
-      q.append("'\\''");
-    } else {
-      q.push_back(c);
-    }
+// The script's output, each line indented under ours.
+void print_indented(const std::string& text, std::ostream& out) {
+  std::size_t start = 0;
+  while (start < text.size()) {
+    const std::size_t end = std::min(text.find('\n', start), text.size() - 1) + 1;
+    out << "  " << std::string_view(text).substr(start, end - start);
+    start = end;
   }
-  q.push_back('\'');
-  return q;
 }
 }  // namespace
 
@@ -71,19 +66,17 @@ bool run_figure_script(const std::string& script, const std::vector<std::string>
     out << "figure: skipped (script " << script << " not found)\n";
     return false;
   }
-  std::string command = "MPLBACKEND=Agg ";
-  command.append(kSystemPython).append(" ").append(shell_quote(script));
-  for (const std::string& a : args) command.append(" ").append(shell_quote(a));
-  command.append(" 2>&1");
-  out.flush();
-  std::FILE* pipe = ::popen(command.c_str(), "r");
-  if (pipe == nullptr) {
-    out << "figure: could not start " << kSystemPython << "\n";
+  std::string output;
+  int status = 0;
+  try {
+    std::vector<std::string> argv = {kSystemPython, script};
+    argv.insert(argv.end(), args.begin(), args.end());
+    status = run_process(argv, {{"MPLBACKEND=Agg"}, &output});  // headless
+  } catch (const IoError& e) {
+    out << "figure: could not start " << kSystemPython << " (" << e.what() << ")\n";
     return false;
   }
-  char buffer[512];
-  while (std::fgets(buffer, sizeof(buffer), pipe) != nullptr) out << "  " << buffer;
-  const int status = ::pclose(pipe);
+  print_indented(output, out);
   if (status != 0) {
     out << "figure: " << script << " failed (status " << status << ")\n";
     return false;

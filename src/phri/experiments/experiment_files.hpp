@@ -21,8 +21,8 @@ std::string output_path(const std::string& dir, const std::string& name);
 /// The python interpreter that has numpy/scipy/matplotlib on Debian (the system one).
 inline constexpr const char* kSystemPython = "/usr/bin/python3";
 
-/// Runs `kSystemPython script args...` (headless: MPLBACKEND=Agg; each argument shell-quoted),
-/// copying the script's output to `out`.
+/// Runs `kSystemPython script args...` (headless: MPLBACKEND=Agg; through run_process, no shell),
+/// copying the script's output, indented, to `out`.
 /// Returns true when the script ran and exited with 0; false, with a line on `out`, when the
 /// script or the interpreter is missing or the script failed. Never throws.
 bool run_figure_script(const std::string& script, const std::vector<std::string>& args, std::ostream& out);
