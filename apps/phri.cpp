@@ -4,7 +4,8 @@
 //   phri info --urdf FILE                      model summary of a robot description
 //   phri identify-friction [options]           the paper's friction identification (simulated arm)
 //   phri experiment torque-tracking [options]  the paper's torque-tracking comparison
-// Every bad argument or file gives one line naming what is wrong and a non-zero exit status.
+// Every bad argument or file, and every failure of a run or an experiment (phri::Error: ConfigError,
+// IoError, ExperimentError), gives one line on stderr naming what is wrong and a non-zero exit status.
 #include <phri/app/config.hpp>
 #include <phri/app/run_session.hpp>
 #include <phri/core/error.hpp>
@@ -23,7 +24,7 @@
 
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
+#include <sstream>
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -104,9 +105,7 @@ int run_command(const RunArguments& args) {
   if (args.lockstep) config.run.pacing = phri::LoopClock::Pacing::kLockstep;
   if (args.real_time) config.run.pacing = phri::LoopClock::Pacing::kRealTime;
   if (args.duration_s > 0.0) config.run.duration_s = args.duration_s;
-  std::error_code ec;
-  std::filesystem::create_directories(args.out_dir, ec);
-  if (ec) throw phri::ConfigError(args.out_dir, "--out", "cannot create the folder: " + ec.message());
+  phri::ensure_output_directory(args.out_dir);
   const std::filesystem::path out(args.out_dir);
   config.logging.path = (out / std::filesystem::path(config.logging.path).filename()).string();
 
@@ -132,11 +131,10 @@ int run_command(const RunArguments& args) {
   if (gamepad) gamepad->stop();
   std::printf("\n");
   phri::print_run_summary(summary, std::cout);
-  {
-    std::ofstream md(out / "summary.md");
-    md << "# phri run: " << args.config_path << "\n\n";
-    phri::print_run_summary(summary, md);
-  }
+  std::ostringstream md;
+  md << "# phri run: " << args.config_path << "\n\n";
+  phri::print_run_summary(summary, md);
+  phri::write_text_file((out / "summary.md").string(), md.str());
   std::printf("\nwrote %s\n", (out / "summary.md").c_str());
   if (logger) {
     const phri::LoggerStats stats = logger->close();
@@ -250,10 +248,10 @@ int main(int argc, char** argv) {
       }
       return phri::run_torque_tracking_command(torque, std::cout);
     }
-  } catch (const phri::ConfigError& e) {
+  } catch (const phri::Error& e) {
     std::fprintf(stderr, "phri: error: %s\n", e.what());
     return 2;
-  } catch (const std::exception& e) {
+  } catch (const std::exception& e) {  // from a library below (yaml-cpp, the standard library)
     std::fprintf(stderr, "phri: error: %s\n", e.what());
     return 2;
   }

@@ -17,16 +17,16 @@ void ensure_output_directory(const std::string& dir) {
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
   if (ec || !std::filesystem::is_directory(dir)) {
-    throw ConfigError(dir, "", "cannot create the output directory: " + ec.message());
+    throw IoError(dir, "cannot create the output directory: " + ec.message());
   }
 }
 
 void write_text_file(const std::string& path, const std::string& text) {
   std::ofstream file(path, std::ios::binary | std::ios::trunc);
-  if (!file) throw ConfigError(path, "", "cannot open for writing");
+  if (!file) throw IoError(path, "cannot open for writing");
   file << text;
   file.close();
-  if (!file) throw ConfigError(path, "", "write failed");
+  if (!file) throw IoError(path, "write failed");
 }
 
 std::string output_path(const std::string& dir, const std::string& name) {

@@ -2,17 +2,17 @@
 // Small file helpers shared by the paper's experiments (src/phri/experiments): the output
 // directory, CSV/text files, and the figure scripts of tools/report run through /usr/bin/python3.
 // Experiments are drivers around the control cycle, not part of it: these helpers may allocate
-// and throw (ConfigError when a file cannot be written).
+// and throw (IoError when a file cannot be written).
 #include <iosfwd>
 #include <string>
 #include <vector>
 
 namespace phri {
 
-/// Creates `dir` (and its parents) when missing; throws ConfigError when that fails.
+/// Creates `dir` (and its parents) when missing; throws IoError when that fails.
 void ensure_output_directory(const std::string& dir);
 
-/// Writes `text` to `path`, replacing it; throws ConfigError when the file cannot be written.
+/// Writes `text` to `path`, replacing it; throws IoError when the file cannot be written.
 void write_text_file(const std::string& path, const std::string& text);
 
 /// `dir` joined with `name` ("dir/name"; `name` alone when `dir` is empty).

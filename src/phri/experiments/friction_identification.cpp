@@ -72,7 +72,7 @@ public:
   /// nominal friction and of the reference's acceleration.
   const RobotState& step(int j, Drive drive, double target, double acceleration = 0.0) {
     const RobotState& s = robot_.read();
-    if (s.fault) throw ConfigError("SimRobot", "friction identification", "the simulated plant faulted");
+    if (s.fault) throw ExperimentError("friction identification", "the simulated plant faulted");
     compute_gravity(model_, data_, s.q_rad);
     const ActuatorTable& nominal = robot_.config().actuators;
     for (int i = 0; i < n_; ++i) {
@@ -109,7 +109,7 @@ public:
     }
     const WriteStatus status = robot_.write(command_);
     if (status != WriteStatus::kOk) {
-      throw ConfigError("SimRobot", "friction identification", "the plant refused a current command");
+      throw ExperimentError("friction identification", "the plant refused a current command");
     }
     return s;
   }
@@ -240,8 +240,8 @@ double find_static(FrictionRig& rig, int j, int direction, const FrictionIdentif
     lo = hi;
     hi *= 1.5;
     if (hi > max_torque) {
-      throw ConfigError("SimRobot", "friction identification",
-                        "joint " + std::to_string(j + 1) + " does not start below half its maximum torque");
+      throw ExperimentError("friction identification",
+                            "joint " + std::to_string(j + 1) + " does not start below half its maximum torque");
     }
   }
   for (int k = 0; k < o.static_bisection_steps; ++k) {
@@ -405,8 +405,8 @@ FrictionIdentificationResult identify_friction(const FrictionIdentificationOptio
     e.levels_used = used;
     e.identified = nominal.friction;
     if (used < 4) {
-      throw ConfigError("SimRobot", "friction identification",
-                        "joint " + std::to_string(joint) + ": only " + std::to_string(used) + " steady levels");
+      throw ExperimentError("friction identification",
+                            "joint " + std::to_string(joint) + ": only " + std::to_string(used) + " steady levels");
     }
     Eigen::MatrixXd a(used, 3);
     Eigen::VectorXd b(used);
@@ -522,19 +522,14 @@ std::string friction_identification_yaml(const FrictionIdentificationResult& r, 
 }
 
 int run_friction_identification_command(const FrictionIdentificationOptions& options, std::ostream& out) {
-  try {
-    out << "friction identification: plant " << options.plant_config_path << ", friction perturbation "
-        << options.friction_perturbation << ", seed " << options.seed << ", joints";
-    for (int j : options.joints) out << ' ' << j;
-    out << std::endl;
-    const FrictionIdentificationResult r = identify_friction(options, &out);
-    out << "\n" << friction_identification_table(r);
-    report_files_and_figure(r.files, options.output_dir, options.figure_script, "friction_identification.png", out);
-    return 0;
-  } catch (const ConfigError& e) {
-    out << "error: " << e.what() << std::endl;
-    return 1;
-  }
+  out << "friction identification: plant " << options.plant_config_path << ", friction perturbation "
+      << options.friction_perturbation << ", seed " << options.seed << ", joints";
+  for (int j : options.joints) out << ' ' << j;
+  out << std::endl;
+  const FrictionIdentificationResult r = identify_friction(options, &out);
+  out << "\n" << friction_identification_table(r);
+  report_files_and_figure(r.files, options.output_dir, options.figure_script, "friction_identification.png", out);
+  return 0;
 }
 
 }  // namespace phri

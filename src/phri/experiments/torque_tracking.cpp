@@ -376,16 +376,11 @@ std::string torque_tracking_table(const TorqueTrackingResult& r, const TorqueTra
 }
 
 int run_torque_tracking_command(const TorqueTrackingOptions& options, std::ostream& out) {
-  try {
-    out << "torque tracking: plant " << options.plant_config_path << ", seed " << options.seed << std::endl;
-    const TorqueTrackingResult r = run_torque_tracking(options, &out);
-    out << "\n" << torque_tracking_table(r, options);
-    report_files_and_figure(r.files, options.output_dir, options.figure_script, "torque_tracking.png", out);
-    return 0;
-  } catch (const ConfigError& e) {
-    out << "error: " << e.what() << std::endl;
-    return 1;
-  }
+  out << "torque tracking: plant " << options.plant_config_path << ", seed " << options.seed << std::endl;
+  const TorqueTrackingResult r = run_torque_tracking(options, &out);
+  out << "\n" << torque_tracking_table(r, options);
+  report_files_and_figure(r.files, options.output_dir, options.figure_script, "torque_tracking.png", out);
+  return 0;
 }
 
 }  // namespace phri

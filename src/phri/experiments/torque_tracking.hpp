@@ -158,7 +158,8 @@ struct TorqueTrackingResult {
 /// (may be null). Writes into options.output_dir (when not empty) one CSV per run,
 /// torque_tracking_<scenario>_<loop>.csv (t_s, error_norm_Nm, error_norm_true_Nm, per-joint
 /// measured errors, ee_error_mm), torque_tracking_summary.csv (the statistics) and
-/// torque_tracking.md (the table). Throws ConfigError on bad options or files.
+/// torque_tracking.md (the table). Throws ConfigError on bad options or input files, IoError when
+/// an output cannot be written, ExperimentError when the plant faults.
 TorqueTrackingResult run_torque_tracking(const TorqueTrackingOptions& options, std::ostream* progress = nullptr);
 
 /// The markdown table: RMS and p95 per loop and scenario, and the ratios.
@@ -166,7 +167,7 @@ std::string torque_tracking_table(const TorqueTrackingResult& result, const Torq
 
 /// Everything the CLI's `phri experiment torque-tracking` needs: simulate, write the files, run
 /// the figure script (when /usr/bin/python3 and the script exist), print the table on `out`.
-/// Returns 0 on success, 1 on a configuration error (printed on `out`).
+/// Returns 0; failures throw (phri::Error, as run_torque_tracking).
 int run_torque_tracking_command(const TorqueTrackingOptions& options, std::ostream& out);
 
 }  // namespace phri

@@ -109,18 +109,13 @@ std::string static_sweep_table(const StaticSweepResult& r, const StaticSweepOpti
 }
 
 int run_static_sweep_command(const StaticSweepOptions& options, std::ostream& out) {
-  try {
-    out << "static torque tracking vs drive gain error: plant " << options.tracking.plant_config_path << ", "
-        << options.torque_constant_errors.size() << " errors x " << options.mismatch_seeds.size() << " mismatch seeds x 2 loops"
-        << std::endl;
-    const StaticSweepResult r = run_static_sweep(options, &out);
-    out << "\n" << static_sweep_table(r, options);
-    report_files_and_figure(r.files, options.output_dir, options.figure_script, "static_sweep.png", out);
-    return 0;
-  } catch (const ConfigError& e) {
-    out << "error: " << e.what() << std::endl;
-    return 1;
-  }
+  out << "static torque tracking vs drive gain error: plant " << options.tracking.plant_config_path << ", "
+      << options.torque_constant_errors.size() << " errors x " << options.mismatch_seeds.size() << " mismatch seeds x 2 loops"
+      << std::endl;
+  const StaticSweepResult r = run_static_sweep(options, &out);
+  out << "\n" << static_sweep_table(r, options);
+  report_files_and_figure(r.files, options.output_dir, options.figure_script, "static_sweep.png", out);
+  return 0;
 }
 
 }  // namespace phri
