@@ -9,12 +9,10 @@
 #include <phri/model/algorithms.hpp>
 #include <phri/sim/sim_robot.hpp>
 
-#include <yaml-cpp/yaml.h>
-
 #include <algorithm>
 #include <chrono>
-#include <filesystem>
 #include <cmath>
+#include <optional>
 #include <ostream>
 #include <sstream>
 
@@ -76,46 +74,39 @@ struct Trajectory {
   }
 };
 
-// actuators.yaml as the controller reads it: the options' file, or a copy of it with the friction
-// compensation thresholds replaced (written next to the results, so a run documents its controller).
-std::string controller_actuators(const TorqueTrackingOptions& o) {
-  if (!(o.friction_velocity_threshold_rad_s > 0.0) && !(o.friction_acceleration_threshold_rad_s2 > 0.0)) {
-    return o.actuators_path;
-  }
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(o.actuators_path);
-  } catch (const YAML::Exception& e) {
-    throw ConfigError(o.actuators_path, "", e.what());
-  }
-  if (!root["joints"] || !root["joints"].IsSequence()) throw ConfigError(o.actuators_path, "joints", "missing");
-  for (std::size_t i = 0; i < root["joints"].size(); ++i) {
-    YAML::Node friction = root["joints"][i]["friction"];
-    if (o.friction_velocity_threshold_rad_s > 0.0) friction["velocity_threshold_rad_s"] = o.friction_velocity_threshold_rad_s;
-    if (o.friction_acceleration_threshold_rad_s2 > 0.0) {
-      friction["acceleration_threshold_rad_s2"] = o.friction_acceleration_threshold_rad_s2;
-    }
-  }
-  YAML::Emitter out;
-  out << root;
-  const std::string dir = o.output_dir.empty() ? std::filesystem::temp_directory_path().string() : o.output_dir;
-  const std::string path = output_path(dir, o.output_dir.empty() ? "phri_controller_actuators.yaml" : "controller_actuators.yaml");
-  write_text_file(path, std::string("# ") + o.actuators_path +
-                            " with the torque-tracking experiment's friction compensation thresholds\n" + out.c_str() + "\n");
-  return path;
-}
-
-ControllerSettings cycle_settings(const TorqueTrackingOptions& o, TrackingScenario scenario, ComplianceMode mode,
-                                   const std::string& actuators) {
+ControllerSettings cycle_settings(const TorqueTrackingOptions& o, TrackingScenario scenario, ComplianceMode mode) {
   ControllerSettings s;
-  s.urdf_path = o.urdf_path;
-  s.actuators_path = actuators;
-  s.collision_path = o.collision_path;
   s.initial_compliance = mode;
   s.initial_loop = LowLevelMode::kPosition;
   s.custom_torque = o.custom_torque;
   if (scenario == TrackingScenario::kStatic) s.external_torque_source = o.static_external_torque;
   return s;
+}
+
+// What the controller is built from, loaded once: every run's Controller starts from a copy.
+struct ControllerRobot {
+  Model model;
+  ActuatorTable actuators;
+  std::optional<CollisionModel> collision;
+};
+
+// The options' files as the controller uses them, with actuators.yaml's friction compensation
+// thresholds replaced in memory when the options set them.
+ControllerRobot load_controller_robot(const TorqueTrackingOptions& o) {
+  // The model options do not depend on the scenario (frame names, F/T offset and payloads only).
+  const ControllerSettings settings = cycle_settings(o, TrackingScenario::kStatic, o.static_compliance);
+  Model model = Model::from_urdf_file(o.urdf_path, Controller::model_options(settings));
+  ActuatorTable actuators = ActuatorTable::from_yaml_file(o.actuators_path);
+  for (int i = 0; i < actuators.size(); ++i) {
+    FrictionParameters& f = actuators[i].friction;
+    if (o.friction_velocity_threshold_rad_s > 0.0) f.velocity_threshold_rad_s = o.friction_velocity_threshold_rad_s;
+    if (o.friction_acceleration_threshold_rad_s2 > 0.0) {
+      f.acceleration_threshold_rad_s2 = o.friction_acceleration_threshold_rad_s2;
+    }
+  }
+  std::optional<CollisionModel> collision;
+  if (!o.collision_path.empty()) collision = CollisionModel::from_yaml_file(o.collision_path, model);
+  return {std::move(model), std::move(actuators), std::move(collision)};
 }
 
 SimRobotConfig plant_config(const TorqueTrackingOptions& o, TrackingScenario scenario) {
@@ -154,10 +145,11 @@ SimRobotConfig plant_config(const TorqueTrackingOptions& o, TrackingScenario sce
 std::string loop_name(LowLevelMode loop) { return std::string(to_string(loop)); }
 
 TorqueTrackingRun run_one(const TorqueTrackingOptions& o, TrackingScenario scenario, LowLevelMode loop,
-                          const std::string& actuators, std::ostream* progress, double& simulated) {
+                          const ControllerRobot& controller_robot, std::ostream* progress, double& simulated) {
   const ComplianceMode mode = scenario == TrackingScenario::kStatic ? o.static_compliance : o.dynamic_compliance;
   SimRobot robot(plant_config(o, scenario));
-  Controller cycle(cycle_settings(o, scenario, mode, actuators));
+  Controller cycle(controller_robot.model, controller_robot.actuators, controller_robot.collision,
+                   cycle_settings(o, scenario, mode));
   const int n = robot.dof();
   RobotCommand command(n);
   Data truth_data(cycle.model());  // FK of the plant's true joint angles (same kinematics)
@@ -298,8 +290,7 @@ TorqueTrackingResult run_torque_tracking(const TorqueTrackingOptions& o, std::os
   const auto wall_start = std::chrono::steady_clock::now();
   if (!o.output_dir.empty()) ensure_output_directory(o.output_dir);
   TorqueTrackingResult result;
-  const std::string actuators = controller_actuators(o);
-  if (actuators != o.actuators_path && !o.output_dir.empty()) result.files.push_back(actuators);
+  const ControllerRobot controller_robot = load_controller_robot(o);
   for (TrackingScenario scenario : o.scenarios) {
     for (LowLevelMode loop : o.loops) {
       if (progress) {
@@ -308,7 +299,7 @@ TorqueTrackingResult run_torque_tracking(const TorqueTrackingOptions& o, std::os
                    << format_fixed(scenario == TrackingScenario::kStatic ? o.static_duration_s : o.dynamic_duration_s, 1)
                    << " s" << std::endl;
       }
-      result.runs.push_back(run_one(o, scenario, loop, actuators, progress, result.simulated_s));
+      result.runs.push_back(run_one(o, scenario, loop, controller_robot, progress, result.simulated_s));
       if (!result.runs.back().csv_path.empty()) result.files.push_back(result.runs.back().csv_path);
     }
   }
