@@ -34,6 +34,17 @@ std::string output_path(const std::string& dir, const std::string& name) {
   return (std::filesystem::path(dir) / name).string();
 }
 
+std::vector<std::string> write_output_files(const std::string& dir, const std::vector<OutputFile>& files) {
+  std::vector<std::string> paths;
+  if (dir.empty()) return paths;
+  ensure_output_directory(dir);
+  for (const OutputFile& file : files) {
+    paths.push_back(output_path(dir, file.name));
+    write_text_file(paths.back(), file.text);
+  }
+  return paths;
+}
+
 namespace {
 // The script's output, each line indented under ours.
 void print_indented(const std::string& text, std::ostream& out) {
@@ -46,12 +57,12 @@ void print_indented(const std::string& text, std::ostream& out) {
 }
 }  // namespace
 
-void report_files_and_figure(const std::vector<std::string>& files, const std::string& output_dir,
-                             const std::string& figure_script, const std::string& figure_name, std::ostream& out) {
-  for (const std::string& f : files) out << "wrote " << f << "\n";
-  if (!output_dir.empty() && !figure_script.empty()) {
-    const std::string png = output_path(output_dir, figure_name);
-    if (run_figure_script(figure_script, {output_dir, png}, out)) out << "wrote " << png << "\n";
+void report_experiment(const ExperimentReport& report, std::ostream& out) {
+  out << "\n" << report.table;
+  for (const std::string& f : report.files) out << "wrote " << f << "\n";
+  if (!report.output_dir.empty() && !report.figure_script.empty()) {
+    const std::string png = output_path(report.output_dir, report.figure_name);
+    if (run_figure_script(report.figure_script, {report.output_dir, png}, out)) out << "wrote " << png << "\n";
   }
   out.flush();
 }

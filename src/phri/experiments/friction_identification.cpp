@@ -455,22 +455,12 @@ FrictionIdentificationResult identify_friction(const FrictionIdentificationOptio
   result.simulated_s = rig.time();
   result.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
 
-  if (!o.output_dir.empty()) {
-    ensure_output_directory(o.output_dir);
-    const std::pair<std::string, std::string> files[] = {
-        {"friction_levels.csv", levels_csv(result)},
-        {"friction_samples.csv", samples_csv(result)},
-        {"friction_static.csv", static_csv(result)},
-        {"friction_models.csv", models_csv(result)},
-        {"friction_identified.yaml", friction_identification_yaml(result, o)},
-        {"friction_identification.md", friction_identification_table(result)},
-    };
-    for (const auto& [name, text] : files) {
-      const std::string path = output_path(o.output_dir, name);
-      write_text_file(path, text);
-      result.files.push_back(path);
-    }
-  }
+  result.files = write_output_files(o.output_dir, {{"friction_levels.csv", levels_csv(result)},
+                                                   {"friction_samples.csv", samples_csv(result)},
+                                                   {"friction_static.csv", static_csv(result)},
+                                                   {"friction_models.csv", models_csv(result)},
+                                                   {"friction_identified.yaml", friction_identification_yaml(result, o)},
+                                                   {"friction_identification.md", friction_identification_table(result)}});
   return result;
 }
 
@@ -527,8 +517,9 @@ int run_friction_identification_command(const FrictionIdentificationOptions& opt
   for (int j : options.joints) out << ' ' << j;
   out << std::endl;
   const FrictionIdentificationResult r = identify_friction(options, &out);
-  out << "\n" << friction_identification_table(r);
-  report_files_and_figure(r.files, options.output_dir, options.figure_script, "friction_identification.png", out);
+  report_experiment({friction_identification_table(r), r.files, options.output_dir, options.figure_script,
+                     "friction_identification.png"},
+                    out);
   return 0;
 }
 

@@ -241,8 +241,8 @@ TorqueTrackingRun run_one(const TorqueTrackingOptions& o, TrackingScenario scena
   run.samples = static_cast<int>(norms.size());
   run.qp_fallbacks = fallbacks;
   if (!o.output_dir.empty()) {
-    run.csv_path = output_path(o.output_dir, std::string("torque_tracking_") + to_string(scenario) + "_" + loop_name(loop) + ".csv");
-    write_text_file(run.csv_path, csv.str());
+    const std::string name = std::string("torque_tracking_") + to_string(scenario) + "_" + loop_name(loop) + ".csv";
+    run.csv_path = write_output_files(o.output_dir, {{name, csv.str()}}).front();
   }
   if (progress) {
     *progress << "  " << to_string(scenario) << " / " << loop_name(loop) << ": ||tau_d - tau_s|| RMS "
@@ -251,6 +251,19 @@ TorqueTrackingRun run_one(const TorqueTrackingOptions& o, TrackingScenario scena
               << " mm" << std::endl;
   }
   return run;
+}
+
+// The statistics of every run, one row each.
+std::string summary_csv(const TorqueTrackingResult& result, const TorqueTrackingOptions& o) {
+  std::ostringstream summary;
+  summary << "scenario,loop,rms_Nm,p95_Nm,max_Nm,bias_Nm,rms_true_Nm,p95_true_Nm,window_start_s,samples\n";
+  for (const TorqueTrackingRun& run : result.runs) {
+    summary << to_string(run.scenario) << ',' << loop_name(run.loop) << ',' << format_fixed(run.rms_Nm, 6) << ','
+            << format_fixed(run.p95_Nm, 6) << ',' << format_fixed(run.max_Nm, 6) << ',' << format_fixed(run.bias_Nm, 6) << ','
+            << format_fixed(run.rms_true_Nm, 6) << ',' << format_fixed(run.p95_true_Nm, 6) << ','
+            << format_fixed(o.transient_s, 3) << ',' << run.samples << '\n';
+  }
+  return summary.str();
 }
 
 void validate(const TorqueTrackingOptions& o) {
@@ -305,20 +318,9 @@ TorqueTrackingResult run_torque_tracking(const TorqueTrackingOptions& o, std::os
   }
   result.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   if (!o.output_dir.empty()) {
-    std::ostringstream summary;
-    summary << "scenario,loop,rms_Nm,p95_Nm,max_Nm,bias_Nm,rms_true_Nm,p95_true_Nm,window_start_s,samples\n";
-    for (const TorqueTrackingRun& run : result.runs) {
-      summary << to_string(run.scenario) << ',' << loop_name(run.loop) << ',' << format_fixed(run.rms_Nm, 6) << ','
-              << format_fixed(run.p95_Nm, 6) << ',' << format_fixed(run.max_Nm, 6) << ',' << format_fixed(run.bias_Nm, 6) << ','
-              << format_fixed(run.rms_true_Nm, 6)
-              << ',' << format_fixed(run.p95_true_Nm, 6) << ',' << format_fixed(o.transient_s, 3) << ',' << run.samples << '\n';
-    }
-    const std::string csv = output_path(o.output_dir, "torque_tracking_summary.csv");
-    write_text_file(csv, summary.str());
-    result.files.push_back(csv);
-    const std::string md = output_path(o.output_dir, "torque_tracking.md");
-    write_text_file(md, torque_tracking_table(result, o));
-    result.files.push_back(md);
+    const std::vector<std::string> written = write_output_files(
+        o.output_dir, {{"torque_tracking_summary.csv", summary_csv(result, o)}, {"torque_tracking.md", torque_tracking_table(result, o)}});
+    result.files.insert(result.files.end(), written.begin(), written.end());
   }
   return result;
 }
@@ -369,8 +371,9 @@ std::string torque_tracking_table(const TorqueTrackingResult& r, const TorqueTra
 int run_torque_tracking_command(const TorqueTrackingOptions& options, std::ostream& out) {
   out << "torque tracking: plant " << options.plant_config_path << ", seed " << options.seed << std::endl;
   const TorqueTrackingResult r = run_torque_tracking(options, &out);
-  out << "\n" << torque_tracking_table(r, options);
-  report_files_and_figure(r.files, options.output_dir, options.figure_script, "torque_tracking.png", out);
+  report_experiment({torque_tracking_table(r, options), r.files, options.output_dir, options.figure_script,
+                     "torque_tracking.png"},
+                    out);
   return 0;
 }
 
