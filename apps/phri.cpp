@@ -145,33 +145,32 @@ int run_command(const RunArguments& args) {
   return summary.safe_hold ? 3 : 0;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  CLI::App app{"phri: control framework for physical human-robot interaction"};
-  app.set_version_flag("--version", std::string("phri ") + phri::version());
-  app.require_subcommand(1);
-  // One line per error, naming what is wrong.
-  app.failure_message([](const CLI::App*, const CLI::Error& e) { return std::string("phri: error: ") + e.what() + "\n"; });
-
-  RunArguments run_args;
+CLI::App* add_run_command(CLI::App& app, RunArguments& args) {
   auto* run = app.add_subcommand("run", "Run a session on the simulated arm from one configuration file");
-  run->add_option("--config", run_args.config_path, "configuration YAML (e.g. configs/demo.yaml)")
+  run->add_option("--config", args.config_path, "configuration YAML (e.g. configs/demo.yaml)")
       ->required()
       ->check(CLI::ExistingFile);
-  auto* lockstep = run->add_flag("--lockstep", run_args.lockstep, "as fast as possible (same code path)");
-  run->add_flag("--realtime", run_args.real_time, "paced by the 1 ms real-time clock")->excludes(lockstep);
-  run->add_option("--duration", run_args.duration_s, "robot time to run [s]")->check(CLI::Range(0.001, 86400.0));
-  run->add_option("--out", run_args.out_dir, "output folder (log, summary, figure)")->capture_default_str();
-  run->add_flag("!--no-figure", run_args.figure, "skip the figure");
+  auto* lockstep = run->add_flag("--lockstep", args.lockstep, "as fast as possible (same code path)");
+  run->add_flag("--realtime", args.real_time, "paced by the 1 ms real-time clock")->excludes(lockstep);
+  run->add_option("--duration", args.duration_s, "robot time to run [s]")->check(CLI::Range(0.001, 86400.0));
+  run->add_option("--out", args.out_dir, "output folder (log, summary, figure)")->capture_default_str();
+  run->add_flag("!--no-figure", args.figure, "skip the figure");
+  return run;
+}
 
-  auto* info = app.add_subcommand("info", "Load a robot description and print a summary of its model");
+struct InfoArguments {
   std::string urdf_path, tip, frame;
-  info->add_option("--urdf", urdf_path, "URDF file")->required();
-  info->add_option("--tip", tip, "tip link of the chain (default: end of the movable chain)");
-  info->add_option("--frame", frame, "frame whose position is printed (default: the tip)");
+};
 
-  phri::FrictionIdentificationOptions friction;
+CLI::App* add_info_command(CLI::App& app, InfoArguments& args) {
+  auto* info = app.add_subcommand("info", "Load a robot description and print a summary of its model");
+  info->add_option("--urdf", args.urdf_path, "URDF file")->required();
+  info->add_option("--tip", args.tip, "tip link of the chain (default: end of the movable chain)");
+  info->add_option("--frame", args.frame, "frame whose position is printed (default: the tip)");
+  return info;
+}
+
+CLI::App* add_identify_command(CLI::App& app, phri::FrictionIdentificationOptions& friction) {
   auto* identify = app.add_subcommand("identify-friction",
                                       "Identify joint friction on the simulated arm (paper: friction identification)");
   identify->add_option("--out", friction.output_dir, "output folder")->capture_default_str();
@@ -182,37 +181,96 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   identify->add_option("--joints", friction.joints, "joints to identify (1-based)")->check(CLI::Range(1, 7));
   identify->add_option("--plant", friction.plant_config_path, "plant configuration")->check(CLI::ExistingFile);
+  return identify;
+}
 
-  auto* experiment = app.add_subcommand("experiment", "Run one of the paper's experiments on the simulated arm");
-  experiment->require_subcommand(1);
-  auto* tracking = experiment->add_subcommand("torque-tracking", "Custom vs Kinova high-velocity torque loop");
+struct TrackingArguments {
   phri::TorqueTrackingOptions torque;
-  tracking->add_option("--out", torque.output_dir, "output folder")->capture_default_str();
+  bool static_ft = false;
+  std::uint64_t mismatch_seed = 0;
+  CLI::Option* mismatch_seed_option = nullptr;  // given or not: the plant file's seed otherwise
+  CLI::Option* out_option = nullptr;            // given or not: the sweep has its own default folder
+  bool static_sweep = false;
+  phri::StaticSweepOptions sweep;
+};
+
+CLI::App* add_torque_tracking_command(CLI::App& experiment, TrackingArguments& args) {
+  auto* tracking = experiment.add_subcommand("torque-tracking", "Custom vs Kinova high-velocity torque loop");
+  phri::TorqueTrackingOptions& torque = args.torque;
+  args.out_option = tracking->add_option("--out", torque.output_dir, "output folder")->capture_default_str();
   tracking->add_option("--seed", torque.seed, "seed of the plant's noise")->capture_default_str();
   tracking->add_option("--static-s", torque.static_duration_s, "static scenario duration")->check(CLI::Range(1.0, 600.0));
   tracking->add_option("--dynamic-s", torque.dynamic_duration_s, "dynamic scenario duration")->check(CLI::Range(1.0, 600.0));
   tracking->add_option("--plant", torque.plant_config_path, "plant configuration")->check(CLI::ExistingFile);
-  bool static_ft = false;
-  tracking->add_flag("--static-ft", static_ft,
+  tracking->add_flag("--static-ft", args.static_ft,
                      "static scenario as in the paper: the weight is hung after the switch and compensated through the "
                      "F/T sensor (J^T F), not the joint-torque observer");
   tracking->add_option("--torque-constant-error", torque.torque_constant_error,
                        "plant drive gain error: each joint's true K_T G_r off the nominal by up to this fraction "
                        "(default: the plant file's mismatch.torque_constant_fraction)")
       ->check(CLI::Range(0.0, 0.5));
-  std::uint64_t mismatch_seed = 0;
-  auto* mismatch_seed_option =
-      tracking->add_option("--mismatch-seed", mismatch_seed, "seed of the plant's inertial and drive-gain mismatch "
-                                                             "(default: the plant file's mismatch.seed)");
-  phri::StaticSweepOptions sweep;
-  bool static_sweep = false;
-  tracking->add_flag("--static-sweep", static_sweep,
+  args.mismatch_seed_option =
+      tracking->add_option("--mismatch-seed", args.mismatch_seed, "seed of the plant's inertial and drive-gain mismatch "
+                                                                  "(default: the plant file's mismatch.seed)");
+  tracking->add_flag("--static-sweep", args.static_sweep,
                      "instead: the static scenario at several drive gain errors x mismatch seeds (why the static "
                      "ratio depends on the arm; see src/phri/experiments/torque_tracking_sweep.hpp)");
-  tracking->add_option("--sweep-errors", sweep.torque_constant_errors, "drive gain errors of the sweep")
+  tracking->add_option("--sweep-errors", args.sweep.torque_constant_errors, "drive gain errors of the sweep")
       ->check(CLI::Range(0.0, 0.5))
       ->capture_default_str();
-  tracking->add_option("--sweep-seeds", sweep.mismatch_seeds, "mismatch seeds of the sweep")->capture_default_str();
+  tracking->add_option("--sweep-seeds", args.sweep.mismatch_seeds, "mismatch seeds of the sweep")->capture_default_str();
+  return tracking;
+}
+
+// `phri identify-friction`: the experiment with its files found (see locate).
+int friction_identification_command(phri::FrictionIdentificationOptions friction) {
+  for (std::string* path : {&friction.plant_config_path, &friction.urdf_path, &friction.figure_script}) *path = locate(*path);
+  return phri::run_friction_identification_command(friction, std::cout);
+}
+
+// `phri experiment torque-tracking [--static-sweep]`: the options completed from the flags, the
+// files found (see locate).
+int torque_tracking_command(TrackingArguments& args) {
+  phri::TorqueTrackingOptions& torque = args.torque;
+  if (args.static_ft) {
+    torque.static_external_torque = phri::ExternalTorqueSource::kForceTorqueSensor;
+    torque.payload_mode = phri::PayloadMode::kHungAfterSwitch;
+  }
+  if (args.mismatch_seed_option->count() > 0) torque.mismatch_seed = args.mismatch_seed;
+  for (std::string* path : {&torque.plant_config_path, &torque.urdf_path, &torque.actuators_path, &torque.collision_path,
+                            &torque.figure_script, &args.sweep.figure_script}) {
+    *path = locate(*path);
+  }
+  if (!args.static_sweep) return phri::run_torque_tracking_command(torque, std::cout);
+  args.sweep.tracking = torque;
+  if (args.out_option->count() > 0) args.sweep.output_dir = torque.output_dir;
+  return phri::run_static_sweep_command(args.sweep, std::cout);
+}
+
+int print_error(const char* what) {
+  std::fprintf(stderr, "phri: error: %s\n", what);
+  return 2;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"phri: control framework for physical human-robot interaction"};
+  app.set_version_flag("--version", std::string("phri ") + phri::version());
+  app.require_subcommand(1);
+  // One line per error, naming what is wrong.
+  app.failure_message([](const CLI::App*, const CLI::Error& e) { return std::string("phri: error: ") + e.what() + "\n"; });
+
+  RunArguments run_args;
+  InfoArguments info_args;
+  phri::FrictionIdentificationOptions friction;
+  TrackingArguments tracking_args;
+  const CLI::App* run = add_run_command(app, run_args);
+  const CLI::App* info = add_info_command(app, info_args);
+  const CLI::App* identify = add_identify_command(app, friction);
+  auto* experiment = app.add_subcommand("experiment", "Run one of the paper's experiments on the simulated arm");
+  experiment->require_subcommand(1);
+  const CLI::App* tracking = add_torque_tracking_command(*experiment, tracking_args);
   auto* friction_alias = experiment->add_subcommand("friction-identification", "Same as 'phri identify-friction'");
   friction_alias->add_option("--out", friction.output_dir, "output folder");
   friction_alias->add_option("--seed", friction.seed, "seed");
@@ -224,36 +282,13 @@ int main(int argc, char** argv) {
   }
   try {
     if (run->parsed()) return run_command(run_args);
-    if (info->parsed()) return print_model_summary(urdf_path, tip, frame);
-    if (identify->parsed() || friction_alias->parsed()) {
-      for (std::string* path : {&friction.plant_config_path, &friction.urdf_path, &friction.figure_script}) {
-        *path = locate(*path);
-      }
-      return phri::run_friction_identification_command(friction, std::cout);
-    }
-    if (tracking->parsed()) {
-      if (static_ft) {
-        torque.static_external_torque = phri::ExternalTorqueSource::kForceTorqueSensor;
-        torque.payload_mode = phri::PayloadMode::kHungAfterSwitch;
-      }
-      if (mismatch_seed_option->count() > 0) torque.mismatch_seed = mismatch_seed;
-      for (std::string* path : {&torque.plant_config_path, &torque.urdf_path, &torque.actuators_path,
-                                &torque.collision_path, &torque.figure_script, &sweep.figure_script}) {
-        *path = locate(*path);
-      }
-      if (static_sweep) {
-        sweep.tracking = torque;
-        if (tracking->get_option("--out")->count() > 0) sweep.output_dir = torque.output_dir;
-        return phri::run_static_sweep_command(sweep, std::cout);
-      }
-      return phri::run_torque_tracking_command(torque, std::cout);
-    }
+    if (info->parsed()) return print_model_summary(info_args.urdf_path, info_args.tip, info_args.frame);
+    if (identify->parsed() || friction_alias->parsed()) return friction_identification_command(friction);
+    if (tracking->parsed()) return torque_tracking_command(tracking_args);
   } catch (const phri::Error& e) {
-    std::fprintf(stderr, "phri: error: %s\n", e.what());
-    return 2;
+    return print_error(e.what());
   } catch (const std::exception& e) {  // from a library below (yaml-cpp, the standard library)
-    std::fprintf(stderr, "phri: error: %s\n", e.what());
-    return 2;
+    return print_error(e.what());
   }
   return 0;
 }
