@@ -4,12 +4,16 @@
 //   phri info --urdf FILE                      model summary of a robot description
 //   phri identify-friction [options]           the paper's friction identification (simulated arm)
 //   phri experiment torque-tracking [options]  the paper's torque-tracking comparison
-// Every bad argument or file gives one line naming what is wrong and a non-zero exit status.
+// Every bad argument or file, and every failure of a run or an experiment (phri::Error: ConfigError,
+// IoError, ExperimentError), gives one line on stderr naming what is wrong and a non-zero exit status.
 #include <phri/app/config.hpp>
 #include <phri/app/run_session.hpp>
 #include <phri/core/error.hpp>
+#include <phri/core/format.hpp>
+#include <phri/core/process.hpp>
 #include <phri/sim/sim_robot.hpp>
 #include <phri/core/version.hpp>
+#include <phri/experiments/experiment_files.hpp>
 #include <phri/experiments/friction_identification.hpp>
 #include <phri/experiments/torque_tracking.hpp>
 #include <phri/experiments/torque_tracking_sweep.hpp>
@@ -20,11 +24,12 @@
 
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
+#include <sstream>
 #include <iostream>
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace {
 
@@ -67,6 +72,24 @@ std::string locate(const std::string& relative) {
   return std::string(PHRI_SOURCE_DIR) + "/" + relative;
 }
 
+// The figure of a run's log (tools/report/demo_figure.py), drawn by the system python through
+// run_process: the paths reach the script as arguments, never through a shell. A failure is a warning.
+void draw_demo_figure(const std::string& log_path, const std::string& png, const phri::ComplianceSettings& compliance) {
+  const std::string script = locate("tools/report/demo_figure.py");
+  if (!std::filesystem::exists(phri::kSystemPython) || !std::filesystem::exists(script)) {
+    std::printf("no figure: %s or %s missing\n", phri::kSystemPython, script.c_str());
+    return;
+  }
+  const std::vector<std::string> argv = {phri::kSystemPython, script, log_path, png,
+                                         "--touch", phri::format_fixed(compliance.touch_threshold, 6),
+                                         "--release", phri::format_fixed(compliance.release_threshold, 6)};
+  try {
+    if (phri::run_process(argv) != 0) std::fprintf(stderr, "phri: warning: the figure script failed\n");
+  } catch (const phri::IoError& e) {
+    std::fprintf(stderr, "phri: warning: the figure script failed: %s\n", e.what());
+  }
+}
+
 struct RunArguments {
   std::string config_path;
   bool lockstep = false;
@@ -82,9 +105,7 @@ int run_command(const RunArguments& args) {
   if (args.lockstep) config.run.pacing = phri::LoopClock::Pacing::kLockstep;
   if (args.real_time) config.run.pacing = phri::LoopClock::Pacing::kRealTime;
   if (args.duration_s > 0.0) config.run.duration_s = args.duration_s;
-  std::error_code ec;
-  std::filesystem::create_directories(args.out_dir, ec);
-  if (ec) throw phri::ConfigError(args.out_dir, "--out", "cannot create the folder: " + ec.message());
+  phri::ensure_output_directory(args.out_dir);
   const std::filesystem::path out(args.out_dir);
   config.logging.path = (out / std::filesystem::path(config.logging.path).filename()).string();
 
@@ -110,28 +131,125 @@ int run_command(const RunArguments& args) {
   if (gamepad) gamepad->stop();
   std::printf("\n");
   phri::print_run_summary(summary, std::cout);
-  {
-    std::ofstream md(out / "summary.md");
-    md << "# phri run: " << args.config_path << "\n\n";
-    phri::print_run_summary(summary, md);
-  }
+  std::ostringstream md;
+  md << "# phri run: " << args.config_path << "\n\n";
+  phri::print_run_summary(summary, md);
+  phri::write_text_file((out / "summary.md").string(), md.str());
   std::printf("\nwrote %s\n", (out / "summary.md").c_str());
   if (logger) {
     const phri::LoggerStats stats = logger->close();
     std::printf("%s\n", logger->summary().c_str());
     if (stats.dropped > 0 || stats.write_error) std::fprintf(stderr, "phri: warning: log incomplete\n");
-    const std::string script = locate("tools/report/demo_figure.py");
-    const std::string png = (out / "demo.png").string();
-    if (args.figure && std::filesystem::exists("/usr/bin/python3") && std::filesystem::exists(script)) {
-      const std::string command = "/usr/bin/python3 '" + script + "' '" + logger->path() + "' '" + png + "' --touch " +
-                                  std::to_string(config.controller.compliance.touch_threshold) + " --release " +
-                                  std::to_string(config.controller.compliance.release_threshold);
-      if (std::system(command.c_str()) != 0) std::fprintf(stderr, "phri: warning: the figure script failed\n");
-    } else if (args.figure) {
-      std::printf("no figure: /usr/bin/python3 or %s missing\n", script.c_str());
-    }
+    if (args.figure) draw_demo_figure(logger->path(), (out / "demo.png").string(), config.controller.compliance);
   }
   return summary.safe_hold ? 3 : 0;
+}
+
+CLI::App* add_run_command(CLI::App& app, RunArguments& args) {
+  auto* run = app.add_subcommand("run", "Run a session on the simulated arm from one configuration file");
+  run->add_option("--config", args.config_path, "configuration YAML (e.g. configs/demo.yaml)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  auto* lockstep = run->add_flag("--lockstep", args.lockstep, "as fast as possible (same code path)");
+  run->add_flag("--realtime", args.real_time, "paced by the 1 ms real-time clock")->excludes(lockstep);
+  run->add_option("--duration", args.duration_s, "robot time to run [s]")->check(CLI::Range(0.001, 86400.0));
+  run->add_option("--out", args.out_dir, "output folder (log, summary, figure)")->capture_default_str();
+  run->add_flag("!--no-figure", args.figure, "skip the figure");
+  return run;
+}
+
+struct InfoArguments {
+  std::string urdf_path, tip, frame;
+};
+
+CLI::App* add_info_command(CLI::App& app, InfoArguments& args) {
+  auto* info = app.add_subcommand("info", "Load a robot description and print a summary of its model");
+  info->add_option("--urdf", args.urdf_path, "URDF file")->required();
+  info->add_option("--tip", args.tip, "tip link of the chain (default: end of the movable chain)");
+  info->add_option("--frame", args.frame, "frame whose position is printed (default: the tip)");
+  return info;
+}
+
+CLI::App* add_identify_command(CLI::App& app, phri::FrictionIdentificationOptions& friction) {
+  auto* identify = app.add_subcommand("identify-friction",
+                                      "Identify joint friction on the simulated arm (paper: friction identification)");
+  identify->add_option("--out", friction.output_dir, "output folder")->capture_default_str();
+  identify->add_option("--seed", friction.seed, "seed of the plant's friction perturbation and noise")->capture_default_str();
+  identify->add_option("--perturbation", friction.friction_perturbation,
+                       "plant friction off actuators.yaml by up to this fraction")
+      ->check(CLI::Range(0.0, 0.9))
+      ->capture_default_str();
+  identify->add_option("--joints", friction.joints, "joints to identify (1-based)")->check(CLI::Range(1, 7));
+  identify->add_option("--plant", friction.plant_config_path, "plant configuration")->check(CLI::ExistingFile);
+  return identify;
+}
+
+struct TrackingArguments {
+  phri::TorqueTrackingOptions torque;
+  bool static_ft = false;
+  std::uint64_t mismatch_seed = 0;
+  CLI::Option* mismatch_seed_option = nullptr;  // given or not: the plant file's seed otherwise
+  CLI::Option* out_option = nullptr;            // given or not: the sweep has its own default folder
+  bool static_sweep = false;
+  phri::StaticSweepOptions sweep;
+};
+
+CLI::App* add_torque_tracking_command(CLI::App& experiment, TrackingArguments& args) {
+  auto* tracking = experiment.add_subcommand("torque-tracking", "Custom vs Kinova high-velocity torque loop");
+  phri::TorqueTrackingOptions& torque = args.torque;
+  args.out_option = tracking->add_option("--out", torque.output_dir, "output folder")->capture_default_str();
+  tracking->add_option("--seed", torque.seed, "seed of the plant's noise")->capture_default_str();
+  tracking->add_option("--static-s", torque.static_duration_s, "static scenario duration")->check(CLI::Range(1.0, 600.0));
+  tracking->add_option("--dynamic-s", torque.dynamic_duration_s, "dynamic scenario duration")->check(CLI::Range(1.0, 600.0));
+  tracking->add_option("--plant", torque.plant_config_path, "plant configuration")->check(CLI::ExistingFile);
+  tracking->add_flag("--static-ft", args.static_ft,
+                     "static scenario as in the paper: the weight is hung after the switch and compensated through the "
+                     "F/T sensor (J^T F), not the joint-torque observer");
+  tracking->add_option("--torque-constant-error", torque.torque_constant_error,
+                       "plant drive gain error: each joint's true K_T G_r off the nominal by up to this fraction "
+                       "(default: the plant file's mismatch.torque_constant_fraction)")
+      ->check(CLI::Range(0.0, 0.5));
+  args.mismatch_seed_option =
+      tracking->add_option("--mismatch-seed", args.mismatch_seed, "seed of the plant's inertial and drive-gain mismatch "
+                                                                  "(default: the plant file's mismatch.seed)");
+  tracking->add_flag("--static-sweep", args.static_sweep,
+                     "instead: the static scenario at several drive gain errors x mismatch seeds (why the static "
+                     "ratio depends on the arm; see src/phri/experiments/torque_tracking_sweep.hpp)");
+  tracking->add_option("--sweep-errors", args.sweep.torque_constant_errors, "drive gain errors of the sweep")
+      ->check(CLI::Range(0.0, 0.5))
+      ->capture_default_str();
+  tracking->add_option("--sweep-seeds", args.sweep.mismatch_seeds, "mismatch seeds of the sweep")->capture_default_str();
+  return tracking;
+}
+
+// `phri identify-friction`: the experiment with its files found (see locate).
+int friction_identification_command(phri::FrictionIdentificationOptions friction) {
+  for (std::string* path : {&friction.plant_config_path, &friction.urdf_path, &friction.figure_script}) *path = locate(*path);
+  return phri::run_friction_identification_command(friction, std::cout);
+}
+
+// `phri experiment torque-tracking [--static-sweep]`: the options completed from the flags, the
+// files found (see locate).
+int torque_tracking_command(TrackingArguments& args) {
+  phri::TorqueTrackingOptions& torque = args.torque;
+  if (args.static_ft) {
+    torque.static_external_torque = phri::ExternalTorqueSource::kForceTorqueSensor;
+    torque.payload_mode = phri::PayloadMode::kHungAfterSwitch;
+  }
+  if (args.mismatch_seed_option->count() > 0) torque.mismatch_seed = args.mismatch_seed;
+  for (std::string* path : {&torque.plant_config_path, &torque.urdf_path, &torque.actuators_path, &torque.collision_path,
+                            &torque.figure_script, &args.sweep.figure_script}) {
+    *path = locate(*path);
+  }
+  if (!args.static_sweep) return phri::run_torque_tracking_command(torque, std::cout);
+  args.sweep.tracking = torque;
+  if (args.out_option->count() > 0) args.sweep.output_dir = torque.output_dir;
+  return phri::run_static_sweep_command(args.sweep, std::cout);
+}
+
+int print_error(const char* what) {
+  std::fprintf(stderr, "phri: error: %s\n", what);
+  return 2;
 }
 
 }  // namespace
@@ -144,64 +262,15 @@ int main(int argc, char** argv) {
   app.failure_message([](const CLI::App*, const CLI::Error& e) { return std::string("phri: error: ") + e.what() + "\n"; });
 
   RunArguments run_args;
-  auto* run = app.add_subcommand("run", "Run a session on the simulated arm from one configuration file");
-  run->add_option("--config", run_args.config_path, "configuration YAML (e.g. configs/demo.yaml)")
-      ->required()
-      ->check(CLI::ExistingFile);
-  auto* lockstep = run->add_flag("--lockstep", run_args.lockstep, "as fast as possible (same code path)");
-  run->add_flag("--realtime", run_args.real_time, "paced by the 1 ms real-time clock")->excludes(lockstep);
-  run->add_option("--duration", run_args.duration_s, "robot time to run [s]")->check(CLI::Range(0.001, 86400.0));
-  run->add_option("--out", run_args.out_dir, "output folder (log, summary, figure)")->capture_default_str();
-  run->add_flag("!--no-figure", run_args.figure, "skip the figure");
-
-  auto* info = app.add_subcommand("info", "Load a robot description and print a summary of its model");
-  std::string urdf_path, tip, frame;
-  info->add_option("--urdf", urdf_path, "URDF file")->required();
-  info->add_option("--tip", tip, "tip link of the chain (default: end of the movable chain)");
-  info->add_option("--frame", frame, "frame whose position is printed (default: the tip)");
-
+  InfoArguments info_args;
   phri::FrictionIdentificationOptions friction;
-  auto* identify = app.add_subcommand("identify-friction",
-                                      "Identify joint friction on the simulated arm (paper: friction identification)");
-  identify->add_option("--out", friction.output_dir, "output folder")->capture_default_str();
-  identify->add_option("--seed", friction.seed, "seed of the plant's friction perturbation and noise")->capture_default_str();
-  identify->add_option("--perturbation", friction.friction_perturbation,
-                       "plant friction off actuators.yaml by up to this fraction")
-      ->check(CLI::Range(0.0, 0.9))
-      ->capture_default_str();
-  identify->add_option("--joints", friction.joints, "joints to identify (1-based)")->check(CLI::Range(1, 7));
-  identify->add_option("--plant", friction.plant_config_path, "plant configuration")->check(CLI::ExistingFile);
-
+  TrackingArguments tracking_args;
+  const CLI::App* run = add_run_command(app, run_args);
+  const CLI::App* info = add_info_command(app, info_args);
+  const CLI::App* identify = add_identify_command(app, friction);
   auto* experiment = app.add_subcommand("experiment", "Run one of the paper's experiments on the simulated arm");
   experiment->require_subcommand(1);
-  auto* tracking = experiment->add_subcommand("torque-tracking", "Custom vs Kinova high-velocity torque loop");
-  phri::TorqueTrackingOptions torque;
-  tracking->add_option("--out", torque.output_dir, "output folder")->capture_default_str();
-  tracking->add_option("--seed", torque.seed, "seed of the plant's noise")->capture_default_str();
-  tracking->add_option("--static-s", torque.static_duration_s, "static scenario duration")->check(CLI::Range(1.0, 600.0));
-  tracking->add_option("--dynamic-s", torque.dynamic_duration_s, "dynamic scenario duration")->check(CLI::Range(1.0, 600.0));
-  tracking->add_option("--plant", torque.plant_config_path, "plant configuration")->check(CLI::ExistingFile);
-  bool static_ft = false;
-  tracking->add_flag("--static-ft", static_ft,
-                     "static scenario as in the paper: the weight is hung after the switch and compensated through the "
-                     "F/T sensor (J^T F), not the joint-torque observer");
-  tracking->add_option("--torque-constant-error", torque.torque_constant_error,
-                       "plant drive gain error: each joint's true K_T G_r off the nominal by up to this fraction "
-                       "(default: the plant file's mismatch.torque_constant_fraction)")
-      ->check(CLI::Range(0.0, 0.5));
-  std::uint64_t mismatch_seed = 0;
-  auto* mismatch_seed_option =
-      tracking->add_option("--mismatch-seed", mismatch_seed, "seed of the plant's inertial and drive-gain mismatch "
-                                                             "(default: the plant file's mismatch.seed)");
-  phri::StaticSweepOptions sweep;
-  bool static_sweep = false;
-  tracking->add_flag("--static-sweep", static_sweep,
-                     "instead: the static scenario at several drive gain errors x mismatch seeds (why the static "
-                     "ratio depends on the arm; see src/phri/experiments/torque_tracking_sweep.hpp)");
-  tracking->add_option("--sweep-errors", sweep.torque_constant_errors, "drive gain errors of the sweep")
-      ->check(CLI::Range(0.0, 0.5))
-      ->capture_default_str();
-  tracking->add_option("--sweep-seeds", sweep.mismatch_seeds, "mismatch seeds of the sweep")->capture_default_str();
+  const CLI::App* tracking = add_torque_tracking_command(*experiment, tracking_args);
   auto* friction_alias = experiment->add_subcommand("friction-identification", "Same as 'phri identify-friction'");
   friction_alias->add_option("--out", friction.output_dir, "output folder");
   friction_alias->add_option("--seed", friction.seed, "seed");
@@ -213,36 +282,13 @@ int main(int argc, char** argv) {
   }
   try {
     if (run->parsed()) return run_command(run_args);
-    if (info->parsed()) return print_model_summary(urdf_path, tip, frame);
-    if (identify->parsed() || friction_alias->parsed()) {
-      for (std::string* path : {&friction.plant_config_path, &friction.urdf_path, &friction.figure_script}) {
-        *path = locate(*path);
-      }
-      return phri::run_friction_identification_command(friction, std::cout);
-    }
-    if (tracking->parsed()) {
-      if (static_ft) {
-        torque.static_external_torque = phri::ExternalTorqueSource::kForceTorqueSensor;
-        torque.payload_mode = phri::PayloadMode::kHungAfterSwitch;
-      }
-      if (mismatch_seed_option->count() > 0) torque.mismatch_seed = mismatch_seed;
-      for (std::string* path : {&torque.plant_config_path, &torque.urdf_path, &torque.actuators_path,
-                                &torque.collision_path, &torque.figure_script, &sweep.figure_script}) {
-        *path = locate(*path);
-      }
-      if (static_sweep) {
-        sweep.tracking = torque;
-        if (tracking->get_option("--out")->count() > 0) sweep.output_dir = torque.output_dir;
-        return phri::run_static_sweep_command(sweep, std::cout);
-      }
-      return phri::run_torque_tracking_command(torque, std::cout);
-    }
-  } catch (const phri::ConfigError& e) {
-    std::fprintf(stderr, "phri: error: %s\n", e.what());
-    return 2;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "phri: error: %s\n", e.what());
-    return 2;
+    if (info->parsed()) return print_model_summary(info_args.urdf_path, info_args.tip, info_args.frame);
+    if (identify->parsed() || friction_alias->parsed()) return friction_identification_command(friction);
+    if (tracking->parsed()) return torque_tracking_command(tracking_args);
+  } catch (const phri::Error& e) {
+    return print_error(e.what());
+  } catch (const std::exception& e) {  // from a library below (yaml-cpp, the standard library)
+    return print_error(e.what());
   }
   return 0;
 }

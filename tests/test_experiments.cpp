@@ -3,7 +3,10 @@
 // joints with few current levels must find the plant's friction within 5 % when the plant's friction
 // differs from actuators.yaml by a random 20 %; a short torque-tracking run must show the custom
 // loop tracking the moving task's torque better than Kinova's high-velocity loop. The numbers of
-// the full runs come from the commands (run_*_command).
+// the full runs come from the commands (run_*_command). Also: the friction compensation thresholds
+// reach the controller through its loaded actuator table, and the error family (bad options:
+// ConfigError, an unwritable output folder: IoError).
+#include <phri/core/error.hpp>
 #include <phri/experiments/friction_identification.hpp>
 #include <phri/experiments/torque_tracking.hpp>
 #include <phri/experiments/torque_tracking_sweep.hpp>
@@ -94,6 +97,34 @@ TEST(TorqueTracking, CustomLoopTracksTheMovingTaskBetterThanTheHighVelocityLoop)
   EXPECT_LT(custom->p95_Nm, hv->p95_Nm);
   EXPECT_EQ(custom->qp_fallbacks, 0);
   EXPECT_EQ(hv->qp_fallbacks, 0);
+}
+
+TEST(TorqueTracking, FrictionThresholdsReachTheControllerWithoutARewrittenActuatorsFile) {
+  // The controller is built from the loaded actuator table with the thresholds set on it; no copy
+  // of actuators.yaml is written anywhere.
+  phri::TorqueTrackingOptions o = short_tracking();
+  o.scenarios = {phri::TrackingScenario::kDynamic};
+  o.loops = {phri::LowLevelMode::kCurrent};
+  const phri::test::TempDir dir("phri_test_tracking_thresholds");
+  o.output_dir = dir.path.string();
+  const phri::TorqueTrackingResult nominal = phri::run_torque_tracking(o);
+  o.friction_velocity_threshold_rad_s = 0.05;
+  o.friction_acceleration_threshold_rad_s2 = 0.7;
+  const phri::TorqueTrackingResult changed = phri::run_torque_tracking(o);
+  std::printf("dynamic (2.5 s), custom loop: RMS %.4f N.m with actuators.yaml's thresholds, %.4f N.m with 0.05 / 0.7\n",
+              nominal.runs[0].rms_Nm, changed.runs[0].rms_Nm);
+  EXPECT_NE(nominal.runs[0].rms_Nm, changed.runs[0].rms_Nm);
+  EXPECT_FALSE(std::filesystem::exists(dir.path / "controller_actuators.yaml"));
+  EXPECT_EQ(changed.files.size(), 3u);  // the run's series, the summary and the table
+}
+
+TEST(TorqueTracking, BadOptionsAreConfigErrorsAndAnUnwritableFolderAnIoError) {
+  phri::TorqueTrackingOptions o = short_tracking();
+  o.scenarios.clear();
+  EXPECT_THROW(phri::run_torque_tracking(o), phri::ConfigError);
+  o = short_tracking();
+  o.output_dir = "/proc/phri_cannot_write_here";
+  EXPECT_THROW(phri::run_torque_tracking(o), phri::IoError);
 }
 
 TEST(TorqueTracking, StaticHoldIsAtTheSensorNoiseFloorWithEitherLoop) {

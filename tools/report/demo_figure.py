@@ -7,11 +7,8 @@ usage: tools/report/demo_figure.py LOG.csv OUT.png [--touch 8 --release 4]
 import argparse
 import sys
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt
 import numpy as np
+from report_common import plt, save_figure
 
 
 def main():
@@ -30,8 +27,6 @@ def main():
     touched = data["touched"] > 0.5
     for ax in axes[:3]:
         # Shade the dual-compliance "touched" intervals.
-        edges = np.flatnonzero(np.diff(touched.astype(int)))
-        starts = list(t[edges[::2] + 1]) if touched[0] == 0 else [t[0]] + list(t[edges[1::2] + 1])
         spans, inside, start = [], False, None
         for k in range(len(t)):
             if touched[k] and not inside:
@@ -70,9 +65,7 @@ def main():
     axes[3].set_xlabel("time [s]")
     axes[3].legend(loc="upper left", fontsize=8)
     axes[3].grid(True, alpha=0.3)
-    fig.suptitle("phri demo on the simulated Kinova Gen3 (shaded: dual compliance, end effector touched)")
-    fig.tight_layout()
-    fig.savefig(args.out, dpi=110)
+    save_figure(fig, args.out, 110, "phri demo on the simulated Kinova Gen3 (shaded: dual compliance, end effector touched)")
     print(f"wrote {args.out}")
 
 

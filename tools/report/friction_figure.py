@@ -12,20 +12,11 @@ into its Coulomb part (green) and viscous part (yellow), the static estimate (re
 plant's true model (dashed). The torque sensor offset found by the fit is removed from the data.
 Headless (Agg backend).
 """
-import csv
 import math
 import sys
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-
-
-def read_rows(path):
-    with open(path, newline="") as f:
-        return list(csv.DictReader(f))
+import numpy as np
+from report_common import plt, read_rows, save_figure
 
 
 def main(argv):
@@ -88,11 +79,8 @@ def main(argv):
             ax.legend(fontsize=7, loc="upper left")
     for index in range(count, rows * cols):
         axes[index // cols][index % cols].axis("off")
-    fig.suptitle("Friction identification (constant current at the upright stance; sensor offset removed)",
-                 fontsize=11)
-    fig.tight_layout()
-    fig.savefig(output, dpi=130)
-    print(f"friction figure: {output}")
+    save_figure(fig, output, 130, "Friction identification (constant current at the upright stance; sensor offset removed)",
+                11, "friction figure")
     return 0
 
 

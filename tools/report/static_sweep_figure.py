@@ -9,15 +9,11 @@ left, the RMS of ||tau_d - tau_s|| of both loops (dots: seeds, line: median; log
 right, the high-velocity / custom ratio (dots and median) with the paper's 10x line.
 Headless (Agg backend).
 """
-import csv
 import os
 import sys
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
+import numpy as np
+from report_common import finish_axes, plt, read_rows, save_figure
 
 
 def main():
@@ -25,8 +21,7 @@ def main():
         print(__doc__)
         return 2
     path = os.path.join(sys.argv[1], "static_sweep.csv")
-    with open(path, newline="") as f:
-        rows = list(csv.DictReader(f))
+    rows = read_rows(path)
     if not rows:
         print("static_sweep_figure: no rows in " + path)
         return 1
@@ -44,24 +39,15 @@ def main():
                                  (hv, "Kinova high-velocity loop", "tab:orange")):
         ax1.scatter(err, values, s=14, color=color, alpha=0.5)
         ax1.plot(levels, medians(values), "-o", color=color, label=label + " (median)")
-    ax1.set_yscale("log")
-    ax1.set_xlabel("drive gain error bound f [%] (K_T G_r off by up to +-f)")
-    ax1.set_ylabel("RMS of ||tau_d - tau_s|| [N.m]")
-    ax1.set_title("static scenario: torque tracking error")
-    ax1.grid(True, which="both", alpha=0.3)
-    ax1.legend(fontsize=8)
+    finish_axes(ax1, "drive gain error bound f [%] (K_T G_r off by up to +-f)", "RMS of ||tau_d - tau_s|| [N.m]",
+                "static scenario: torque tracking error", log_y=True, fontsize=8)
 
     ax2.scatter(err, ratio, s=14, color="k", alpha=0.5, label="one mismatch seed")
     ax2.plot(levels, medians(ratio), "-o", color="k", label="median")
     ax2.axhline(10.0, color="tab:red", ls="--", label="paper's target 10x")
-    ax2.set_yscale("log")
-    ax2.set_xlabel("drive gain error bound f [%]")
-    ax2.set_ylabel("RMS high-velocity / RMS custom")
-    ax2.set_title("static scenario: ratio")
-    ax2.grid(True, which="both", alpha=0.3)
-    ax2.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(sys.argv[2], dpi=120)
+    finish_axes(ax2, "drive gain error bound f [%]", "RMS high-velocity / RMS custom", "static scenario: ratio",
+                log_y=True, fontsize=8)
+    save_figure(fig, sys.argv[2], 120)
     return 0
 
 

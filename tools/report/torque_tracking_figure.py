@@ -12,15 +12,11 @@ the raw 1 kHz samples. The legend gives RMS and 95th percentile over the statist
 torque_tracking_summary.csv (the window starts after the switch transient, shaded). Headless (Agg
 backend).
 """
-import csv
 import os
 import sys
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
+import numpy as np
+from report_common import plt, read_rows, save_figure
 
 SCENARIOS = ["static", "dynamic"]
 LOOPS = [("custom", "custom torque loop", "tab:blue"),
@@ -28,8 +24,7 @@ LOOPS = [("custom", "custom torque loop", "tab:blue"),
 
 
 def read_series(path):
-    with open(path, newline="") as f:
-        rows = list(csv.DictReader(f))
+    rows = read_rows(path)
     t = np.array([float(r["t_s"]) for r in rows])
     e = np.array([float(r["error_norm_Nm"]) for r in rows])
     return t, e
@@ -46,8 +41,7 @@ def moving_average(x, n):
 def read_summary(path):
     if not os.path.exists(path):
         return {}
-    with open(path, newline="") as f:
-        return {(r["scenario"], r["loop"]): r for r in csv.DictReader(f)}
+    return {(r["scenario"], r["loop"]): r for r in read_rows(path)}
 
 
 def main(argv):
@@ -84,10 +78,8 @@ def main(argv):
         ax.set_ylabel(r"$\|\tau_d - \tau_s\|$ [N.m]")
         ax.grid(which="both", alpha=0.3)
         ax.legend(fontsize=8, loc="upper right")
-    fig.suptitle("Joint torque tracking error (thin: 1 kHz samples, thick: 50 ms moving average)", fontsize=11)
-    fig.tight_layout()
-    fig.savefig(output, dpi=130)
-    print(f"torque tracking figure: {output}")
+    save_figure(fig, output, 130, "Joint torque tracking error (thin: 1 kHz samples, thick: 50 ms moving average)", 11,
+                "torque tracking figure")
     return 0
 
 

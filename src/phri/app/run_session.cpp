@@ -2,163 +2,235 @@
 
 #include <phri/app/log_row.hpp>
 #include <phri/app/loop_clock.hpp>
+#include <phri/core/statistics.hpp>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <ostream>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
 #include <unistd.h>
 
 namespace phri {
 namespace {
 
-double percentile(std::vector<double>& values, double p) {
-  if (values.empty()) return 0.0;
-  const std::size_t k = static_cast<std::size_t>(std::clamp(p, 0.0, 1.0) * static_cast<double>(values.size() - 1));
-  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(k), values.end());
-  return values[k];
-}
-
+// The sums of one phase, for its row of the summary table.
 struct PhaseAccumulator {
   double pos_max = 0, pos_sq = 0, ori_max = 0, ori_sq = 0, wrench_max = 0;
   long n = 0;
   int compliance_switches = 0, loop_switches = 0;
   std::size_t first_cycle = 0;
+
+  void add(double pos, double ori, double wrench) {
+    pos_max = std::max(pos_max, pos);
+    pos_sq += pos * pos;
+    ori_max = std::max(ori_max, ori);
+    ori_sq += ori * ori;
+    wrench_max = std::max(wrench_max, wrench);
+    ++n;
+  }
+};
+
+// One run of the loop: its state between cycles, one method per job of a cycle. Everything the
+// loop touches is sized in the constructor: a cycle allocates nothing (but a safe-hold message).
+class Session {
+public:
+  Session(RobotInterface& robot, Controller& cycle, Fsm& fsm, Gamepad* gamepad, Logger* logger, const RunOptions& options,
+          std::ostream& out)
+      : robot_(robot),
+        cycle_(cycle),
+        fsm_(fsm),
+        gamepad_(gamepad),
+        logger_(logger),
+        options_(options),
+        out_(out),
+        period_(robot.period_s()),
+        max_cycles_(static_cast<std::size_t>(std::ceil(options.duration_s / period_))),
+        micros_(max_cycles_, 0.0),
+        phases_(options.phases.empty() ? std::vector<PhaseMark>{{0.0, "run"}} : options.phases),
+        acc_(phases_.size()),
+        tty_(options.status_line && isatty(fileno(stdout))),
+        command_(robot.dof()),
+        clock_(period_, options.real_time ? LoopClock::Pacing::kRealTime : LoopClock::Pacing::kLockstep),
+        last_mode_(cycle.compliance().mode()),
+        last_touches_(cycle.compliance().touch_count()),
+        last_loop_switches_(cycle.low_level().switch_count()) {}
+
+  RunSummary run() {
+    const auto wall_start = std::chrono::steady_clock::now();
+    std::size_t k = 0;
+    for (; k < max_cycles_; ++k) {
+      const RobotState& state = robot_.read();
+      const double t = state.time_s;
+      enter_phases(t, k);
+      const CycleStatus status = control_cycle(state, k);
+      const double pos = accumulate_phase();
+      check_sensor_data(status, t);
+      check_overruns(clock_.wait_next(), t);
+      print_status(t, pos, micros_[k]);
+      if (fsm_.finished()) {
+        ++k;
+        break;
+      }
+    }
+    if (tty_) out_ << "\n";
+    summary_.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+    summarize(k);
+    return summary_;
+  }
+
+private:
+  // Moves to the phases that have started by t; without a status line, says so.
+  void enter_phases(double t, std::size_t k) {
+    while (phase_ + 1 < phases_.size() && t >= phases_[phase_ + 1].start_s) {
+      ++phase_;
+      acc_[phase_].first_cycle = k;
+      if (!tty_) out_ << "[" << t << " s] phase: " << phases_[phase_].name << "\n";
+    }
+  }
+
+  // Gamepad -> FSM -> Controller -> robot and log; the compute time is cycle k's entry of micros_.
+  CycleStatus control_cycle(const RobotState& state, std::size_t k) {
+    const auto start = std::chrono::steady_clock::now();
+    if (gamepad_) {
+      Event event;
+      while (gamepad_->poll(event)) fsm_.post(event);
+    }
+    const CycleStatus status = cycle_.step(state, fsm_.update(state.time_s, state, cycle_), command_);
+    const double us = std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count();
+    micros_[k] = us;
+    robot_.write(command_);
+    if (logger_) {
+      fill_log_row(row_, state, cycle_, fsm_);
+      row_.cycle_time_s = 1e-6 * us;
+      logger_->push(row_);
+    }
+    return status;
+  }
+
+  // Adds the cycle to its phase's sums; returns the end-effector position error [mm].
+  double accumulate_phase() {
+    PhaseAccumulator& a = acc_[phase_];
+    const Vector6d& error = cycle_.qp().end_effector().error();
+    const double pos = 1e3 * error.head<3>().norm(), ori = error.tail<3>().norm() * 180.0 / M_PI;
+    a.add(pos, ori, cycle_.wrench().norm());
+    const ComplianceController& compliance = cycle_.compliance();
+    if (compliance.mode() != last_mode_ || compliance.touch_count() != last_touches_) ++a.compliance_switches;
+    if (cycle_.low_level().switch_count() != last_loop_switches_) ++a.loop_switches;
+    last_mode_ = compliance.mode();
+    last_touches_ = compliance.touch_count();
+    last_loop_switches_ = cycle_.low_level().switch_count();
+    return pos;
+  }
+
+  // Stale or invalid sensor data: brake to rest and hold.
+  void check_sensor_data(CycleStatus status, double t) {
+    if (summary_.safe_hold || (status != CycleStatus::kStaleState && status != CycleStatus::kInvalidState)) return;
+    safe_hold(std::string("sensor data ") + std::string(to_string(status)) + " at t = " + std::to_string(t) + " s");
+  }
+
+  // Two overruns of the period in a row (`late` > 0: this cycle overran): brake to rest and hold.
+  void check_overruns(double late, double t) {
+    consecutive_overruns_ = late > 0.0 ? consecutive_overruns_ + 1 : 0;
+    if (consecutive_overruns_ < 2 || summary_.safe_hold) return;
+    safe_hold("two consecutive overruns of the " + std::to_string(1e3 * period_) + " ms period at t = " + std::to_string(t) +
+              " s");
+  }
+
+  void safe_hold(std::string reason) {
+    summary_.safe_hold = true;
+    summary_.safe_hold_reason = std::move(reason);
+    fsm_.post(Event::kStop);
+    out_ << "phri: SAFE HOLD: " << summary_.safe_hold_reason << "; braking to rest\n";
+  }
+
+  // ~5 Hz on a terminal (one refreshed line), every 5 s otherwise.
+  void print_status(double t, double pos, double us) {
+    if (!options_.status_line || t < next_status_) return;
+    next_status_ = t + (tty_ ? 0.2 : 5.0);
+    char line[200];  // string_views printed with %.*s: no allocation in the loop
+    const std::string_view mode = to_string(cycle_.compliance().mode());
+    const std::string_view loop = to_string(cycle_.low_level().loop());
+    std::snprintf(line, sizeof line, "t %6.2f s | %-10.*s | loop %-27.*s | EE error %6.2f mm | wrench %5.1f | cycle %5.1f us",
+                  t, static_cast<int>(mode.size()), mode.data(), static_cast<int>(loop.size()), loop.data(), pos,
+                  cycle_.wrench().norm(), us);
+    if (tty_) {
+      out_ << "\r" << line << std::flush;
+    } else {
+      out_ << line << "\n";
+    }
+  }
+
+  // The cycle-time statistics and the per-phase table of the `cycles` cycles run.
+  void summarize(std::size_t cycles) {
+    summary_.cycles = cycles;
+    summary_.simulated_s = static_cast<double>(cycles) * period_;
+    summary_.overruns = clock_.overruns();
+    summary_.held_cycles = cycle_.held_cycles();
+    for (std::size_t p = 0; p < phases_.size(); ++p) summary_.phases.push_back(phase_summary(p));
+    const std::vector<double> all(micros_.begin(), micros_.begin() + static_cast<std::ptrdiff_t>(cycles));
+    summary_.cycle_median_us = percentile(all, 0.5);
+    summary_.cycle_p99_us = percentile(all, 0.99);
+    summary_.cycle_p999_us = percentile(all, 0.999);
+    summary_.cycle_max_us = all.empty() ? 0.0 : *std::max_element(all.begin(), all.end());
+  }
+
+  PhaseSummary phase_summary(std::size_t p) const {
+    PhaseSummary s;
+    s.name = phases_[p].name;
+    s.start_s = phases_[p].start_s;
+    s.end_s = p + 1 < phases_.size() ? phases_[p + 1].start_s : summary_.simulated_s;
+    const PhaseAccumulator& a = acc_[p];
+    if (a.n == 0) return s;
+    s.ee_position_error_max_mm = a.pos_max;
+    s.ee_position_error_rms_mm = std::sqrt(a.pos_sq / static_cast<double>(a.n));
+    s.ee_orientation_error_max_deg = a.ori_max;
+    s.ee_orientation_error_rms_deg = std::sqrt(a.ori_sq / static_cast<double>(a.n));
+    s.wrench_norm_max = a.wrench_max;
+    s.compliance_switches = a.compliance_switches;
+    s.loop_switches = a.loop_switches;
+    const auto first = micros_.begin() + static_cast<std::ptrdiff_t>(a.first_cycle);
+    const std::vector<double> slice(first, first + static_cast<std::ptrdiff_t>(a.n));
+    s.cycle_median_us = percentile(slice, 0.5);
+    s.cycle_p999_us = percentile(slice, 0.999);
+    return s;
+  }
+
+  RobotInterface& robot_;
+  Controller& cycle_;
+  Fsm& fsm_;
+  Gamepad* gamepad_;
+  Logger* logger_;
+  const RunOptions& options_;
+  std::ostream& out_;
+  const double period_;
+  const std::size_t max_cycles_;
+  std::vector<double> micros_;  // every cycle's compute time, sized before the loop
+  const std::vector<PhaseMark> phases_;
+  std::vector<PhaseAccumulator> acc_;
+  std::size_t phase_ = 0;
+  const bool tty_;
+  RobotCommand command_;
+  LogRow row_;
+  LoopClock clock_;
+  int consecutive_overruns_ = 0;
+  double next_status_ = 0.0;
+  ComplianceMode last_mode_;
+  int last_touches_;
+  int last_loop_switches_;
+  RunSummary summary_;
 };
 
 }  // namespace
 
 RunSummary run_session(RobotInterface& robot, Controller& cycle, Fsm& fsm, Gamepad* gamepad, Logger* logger,
                        const RunOptions& options, std::ostream& out) {
-  RunSummary summary;
-  const double period = robot.period_s();
-  const std::size_t max_cycles = static_cast<std::size_t>(std::ceil(options.duration_s / period));
-  std::vector<double> micros(max_cycles, 0.0);  // before the loop: no allocation inside it
-  std::vector<PhaseMark> phases = options.phases;
-  if (phases.empty()) phases.push_back({0.0, "run"});
-  std::vector<PhaseAccumulator> acc(phases.size());
-  std::size_t phase = 0;
-  const bool tty = options.status_line && isatty(fileno(stdout));
-
-  RobotCommand command(robot.dof());
-  LogRow row;
-  LoopClock clock(period, options.real_time ? LoopClock::Pacing::kRealTime : LoopClock::Pacing::kLockstep);
-  const auto wall_start = std::chrono::steady_clock::now();
-  int consecutive_overruns = 0;
-  double next_status = 0.0;
-  ComplianceMode last_mode = cycle.compliance().mode();
-  int last_touches = cycle.compliance().touch_count();
-  int last_loop_switches = cycle.low_level().switch_count();
-  std::size_t k = 0;
-  for (; k < max_cycles; ++k) {
-    const RobotState& state = robot.read();
-    const double t = state.time_s;
-    while (phase + 1 < phases.size() && t >= phases[phase + 1].start_s) {
-      ++phase;
-      acc[phase].first_cycle = k;
-      if (!tty) out << "[" << t << " s] phase: " << phases[phase].name << "\n";
-    }
-    const auto start = std::chrono::steady_clock::now();
-    if (gamepad) {
-      Event event;
-      while (gamepad->poll(event)) fsm.post(event);
-    }
-    const CycleStatus status = cycle.step(state, fsm.update(t, state, cycle), command);
-    const double us = std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count();
-    micros[k] = us;
-    robot.write(command);
-    if (logger) {
-      fill_log_row(row, state, cycle, fsm);
-      row.cycle_time_s = 1e-6 * us;
-      logger->push(row);
-    }
-
-    // ---- per-phase statistics
-    PhaseAccumulator& a = acc[phase];
-    const Vector6d& error = cycle.qp().end_effector().error();
-    const double pos = 1e3 * error.head<3>().norm(), ori = error.tail<3>().norm() * 180.0 / M_PI;
-    a.pos_max = std::max(a.pos_max, pos);
-    a.pos_sq += pos * pos;
-    a.ori_max = std::max(a.ori_max, ori);
-    a.ori_sq += ori * ori;
-    a.wrench_max = std::max(a.wrench_max, cycle.wrench().norm());
-    ++a.n;
-    if (cycle.compliance().mode() != last_mode || cycle.compliance().touch_count() != last_touches) ++a.compliance_switches;
-    if (cycle.low_level().switch_count() != last_loop_switches) ++a.loop_switches;
-    last_mode = cycle.compliance().mode();
-    last_touches = cycle.compliance().touch_count();
-    last_loop_switches = cycle.low_level().switch_count();
-
-    // ---- safety: stale or invalid data, or two overruns in a row
-    if (!summary.safe_hold && (status == CycleStatus::kStaleState || status == CycleStatus::kInvalidState)) {
-      summary.safe_hold = true;
-      summary.safe_hold_reason = std::string("sensor data ") + std::string(to_string(status)) + " at t = " + std::to_string(t) + " s";
-      fsm.post(Event::kStop);
-      out << "phri: SAFE HOLD: " << summary.safe_hold_reason << "; braking to rest\n";
-    }
-    const double late = clock.wait_next();
-    consecutive_overruns = late > 0.0 ? consecutive_overruns + 1 : 0;
-    if (consecutive_overruns >= 2 && !summary.safe_hold) {
-      summary.safe_hold = true;
-      summary.safe_hold_reason = "two consecutive overruns of the " + std::to_string(1e3 * period) + " ms period at t = " + std::to_string(t) + " s";
-      fsm.post(Event::kStop);
-      out << "phri: SAFE HOLD: " << summary.safe_hold_reason << "; braking to rest\n";
-    }
-
-    // ---- status
-    if (options.status_line && t >= next_status) {
-      next_status = t + (tty ? 0.2 : 5.0);
-      char line[200];  // string_views printed with %.*s: no allocation in the loop
-      const std::string_view mode = to_string(cycle.compliance().mode());
-      const std::string_view loop = to_string(cycle.low_level().loop());
-      std::snprintf(line, sizeof line, "t %6.2f s | %-10.*s | loop %-27.*s | EE error %6.2f mm | wrench %5.1f | cycle %5.1f us",
-                    t, static_cast<int>(mode.size()), mode.data(), static_cast<int>(loop.size()), loop.data(), pos,
-                    cycle.wrench().norm(), us);
-      if (tty) {
-        out << "\r" << line << std::flush;
-      } else {
-        out << line << "\n";
-      }
-    }
-    if (fsm.finished()) {
-      ++k;
-      break;
-    }
-  }
-  if (tty) out << "\n";
-  summary.cycles = k;
-  summary.simulated_s = static_cast<double>(k) * period;
-  summary.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
-  summary.overruns = clock.overruns();
-  summary.held_cycles = cycle.held_cycles();
-  for (std::size_t p = 0; p < phases.size(); ++p) {
-    PhaseSummary s;
-    s.name = phases[p].name;
-    s.start_s = phases[p].start_s;
-    s.end_s = p + 1 < phases.size() ? phases[p + 1].start_s : summary.simulated_s;
-    const PhaseAccumulator& a = acc[p];
-    if (a.n > 0) {
-      s.ee_position_error_max_mm = a.pos_max;
-      s.ee_position_error_rms_mm = std::sqrt(a.pos_sq / static_cast<double>(a.n));
-      s.ee_orientation_error_max_deg = a.ori_max;
-      s.ee_orientation_error_rms_deg = std::sqrt(a.ori_sq / static_cast<double>(a.n));
-      s.wrench_norm_max = a.wrench_max;
-      s.compliance_switches = a.compliance_switches;
-      s.loop_switches = a.loop_switches;
-      std::vector<double> slice(micros.begin() + static_cast<std::ptrdiff_t>(a.first_cycle),
-                                micros.begin() + static_cast<std::ptrdiff_t>(a.first_cycle + static_cast<std::size_t>(a.n)));
-      s.cycle_median_us = percentile(slice, 0.5);
-      s.cycle_p999_us = percentile(slice, 0.999);
-    }
-    summary.phases.push_back(s);
-  }
-  std::vector<double> all(micros.begin(), micros.begin() + static_cast<std::ptrdiff_t>(k));
-  summary.cycle_median_us = percentile(all, 0.5);
-  summary.cycle_p99_us = percentile(all, 0.99);
-  summary.cycle_p999_us = percentile(all, 0.999);
-  summary.cycle_max_us = all.empty() ? 0.0 : *std::max_element(all.begin(), all.end());
-  return summary;
+  return Session(robot, cycle, fsm, gamepad, logger, options, out).run();
 }
 
 void print_run_summary(const RunSummary& s, std::ostream& out) {

@@ -1,14 +1,13 @@
 #include <phri/experiments/experiment_files.hpp>
 
 #include <phri/core/error.hpp>
+#include <phri/core/process.hpp>
 
 #include <algorithm>
-#include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <ostream>
+#include <string_view>
 #include <system_error>
 
 namespace phri {
@@ -18,16 +17,16 @@ void ensure_output_directory(const std::string& dir) {
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
   if (ec || !std::filesystem::is_directory(dir)) {
-    throw ConfigError(dir, "", "cannot create the output directory: " + ec.message());
+    throw IoError(dir, "cannot create the output directory: " + ec.message());
   }
 }
 
 void write_text_file(const std::string& path, const std::string& text) {
   std::ofstream file(path, std::ios::binary | std::ios::trunc);
-  if (!file) throw ConfigError(path, "", "cannot open for writing");
+  if (!file) throw IoError(path, "cannot open for writing");
   file << text;
   file.close();
-  if (!file) throw ConfigError(path, "", "write failed");
+  if (!file) throw IoError(path, "write failed");
 }
 
 std::string output_path(const std::string& dir, const std::string& name) {
@@ -35,28 +34,35 @@ std::string output_path(const std::string& dir, const std::string& name) {
   return (std::filesystem::path(dir) / name).string();
 }
 
-namespace {
-// Single-quoted for /bin/sh: every ' becomes '\''.
-std::string shell_quote(const std::string& s) {
-  std::string q(1, '\'');
-  for (char c : s) {
-    if (c == '\'') {
-      q.append("'\\''");
-    } else {
-      q.push_back(c);
-    }
+std::vector<std::string> write_output_files(const std::string& dir, const std::vector<OutputFile>& files) {
+  std::vector<std::string> paths;
+  if (dir.empty()) return paths;
+  ensure_output_directory(dir);
+  for (const OutputFile& file : files) {
+    paths.push_back(output_path(dir, file.name));
+    write_text_file(paths.back(), file.text);
   }
-  q.push_back('\'');
-  return q;
+  return paths;
+}
+
+namespace {
+// The script's output, each line indented under ours.
+void print_indented(const std::string& text, std::ostream& out) {
+  std::size_t start = 0;
+  while (start < text.size()) {
+    const std::size_t end = std::min(text.find('\n', start), text.size() - 1) + 1;
+    out << "  " << std::string_view(text).substr(start, end - start);
+    start = end;
+  }
 }
 }  // namespace
 
-void report_files_and_figure(const std::vector<std::string>& files, const std::string& output_dir,
-                             const std::string& figure_script, const std::string& figure_name, std::ostream& out) {
-  for (const std::string& f : files) out << "wrote " << f << "\n";
-  if (!output_dir.empty() && !figure_script.empty()) {
-    const std::string png = output_path(output_dir, figure_name);
-    if (run_figure_script(figure_script, {output_dir, png}, out)) out << "wrote " << png << "\n";
+void report_experiment(const ExperimentReport& report, std::ostream& out) {
+  out << "\n" << report.table;
+  for (const std::string& f : report.files) out << "wrote " << f << "\n";
+  if (!report.output_dir.empty() && !report.figure_script.empty()) {
+    const std::string png = output_path(report.output_dir, report.figure_name);
+    if (run_figure_script(report.figure_script, {report.output_dir, png}, out)) out << "wrote " << png << "\n";
   }
   out.flush();
 }
@@ -71,40 +77,22 @@ bool run_figure_script(const std::string& script, const std::vector<std::string>
     out << "figure: skipped (script " << script << " not found)\n";
     return false;
   }
-  std::string command = "MPLBACKEND=Agg ";
-  command.append(kSystemPython).append(" ").append(shell_quote(script));
-  for (const std::string& a : args) command.append(" ").append(shell_quote(a));
-  command.append(" 2>&1");
-  out.flush();
-  std::FILE* pipe = ::popen(command.c_str(), "r");
-  if (pipe == nullptr) {
-    out << "figure: could not start " << kSystemPython << "\n";
+  std::string output;
+  int status = 0;
+  try {
+    std::vector<std::string> argv = {kSystemPython, script};
+    argv.insert(argv.end(), args.begin(), args.end());
+    status = run_process(argv, {{"MPLBACKEND=Agg"}, &output});  // headless
+  } catch (const IoError& e) {
+    out << "figure: could not start " << kSystemPython << " (" << e.what() << ")\n";
     return false;
   }
-  char buffer[512];
-  while (std::fgets(buffer, sizeof(buffer), pipe) != nullptr) out << "  " << buffer;
-  const int status = ::pclose(pipe);
+  print_indented(output, out);
   if (status != 0) {
     out << "figure: " << script << " failed (status " << status << ")\n";
     return false;
   }
   return true;
-}
-
-std::string format_fixed(double value, int digits) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof(buffer), "%.*f", digits, value);
-  return buffer;
-}
-
-
-double percentile(std::vector<double> values, double p) {
-  if (values.empty()) return 0.0;
-  std::sort(values.begin(), values.end());
-  const double rank = std::clamp(p, 0.0, 1.0) * static_cast<double>(values.size() - 1);
-  const std::size_t lo = static_cast<std::size_t>(std::floor(rank));
-  const std::size_t hi = std::min(values.size() - 1, lo + 1);
-  return values[lo] + (rank - static_cast<double>(lo)) * (values[hi] - values[lo]);
 }
 
 }  // namespace phri

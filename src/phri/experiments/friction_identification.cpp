@@ -2,6 +2,7 @@
 
 #include <phri/control/controller_settings.hpp>
 #include <phri/core/error.hpp>
+#include <phri/core/format.hpp>
 #include <phri/experiments/experiment_files.hpp>
 #include <phri/experiments/friction_perturbation.hpp>
 #include <phri/model/algorithms.hpp>
@@ -71,7 +72,7 @@ public:
   /// nominal friction and of the reference's acceleration.
   const RobotState& step(int j, Drive drive, double target, double acceleration = 0.0) {
     const RobotState& s = robot_.read();
-    if (s.fault) throw ConfigError("SimRobot", "friction identification", "the simulated plant faulted");
+    if (s.fault) throw ExperimentError("friction identification", "the simulated plant faulted");
     compute_gravity(model_, data_, s.q_rad);
     const ActuatorTable& nominal = robot_.config().actuators;
     for (int i = 0; i < n_; ++i) {
@@ -108,7 +109,7 @@ public:
     }
     const WriteStatus status = robot_.write(command_);
     if (status != WriteStatus::kOk) {
-      throw ConfigError("SimRobot", "friction identification", "the plant refused a current command");
+      throw ExperimentError("friction identification", "the plant refused a current command");
     }
     return s;
   }
@@ -239,8 +240,8 @@ double find_static(FrictionRig& rig, int j, int direction, const FrictionIdentif
     lo = hi;
     hi *= 1.5;
     if (hi > max_torque) {
-      throw ConfigError("SimRobot", "friction identification",
-                        "joint " + std::to_string(j + 1) + " does not start below half its maximum torque");
+      throw ExperimentError("friction identification",
+                            "joint " + std::to_string(j + 1) + " does not start below half its maximum torque");
     }
   }
   for (int k = 0; k < o.static_bisection_steps; ++k) {
@@ -317,6 +318,149 @@ std::string models_csv(const FrictionIdentificationResult& r) {
   return s.str();
 }
 
+// The plant of the identification: the options' plant file, upright (no gravity torque), seeded,
+// its friction perturbed from actuators.yaml's when asked.
+SimRobotConfig identification_plant(const FrictionIdentificationOptions& o) {
+  SimRobotConfig config = SimRobotConfig::from_yaml_file(o.plant_config_path);
+  const int n = config.dof();
+  for (int j : o.joints) {
+    if (j < 1 || j > n) {
+      throw ConfigError("<friction identification options>", "joints", "joint " + std::to_string(j) + " out of 1.." + std::to_string(n));
+    }
+  }
+  config.initial_q_rad.assign(static_cast<std::size_t>(n), 0.0);  // upright: no gravity torque
+  config.seed = o.seed;
+  if (o.friction_perturbation > 0.0) {
+    config.actuator_overrides = perturbed_friction_overrides(config.actuators, o.friction_perturbation, o.seed);
+  }
+  return config;
+}
+
+// The controller's model (with its default tool payloads), for the gravity compensation.
+Model identification_model(const FrictionIdentificationOptions& o, int plant_dof) {
+  ModelOptions model_options;
+  for (Payload p : ControllerSettings::default_payloads()) {
+    p.frame = "end_effector_link";
+    model_options.payloads.push_back(p);
+  }
+  Model model = Model::from_urdf_file(o.urdf_path, model_options);
+  if (model.nq() != plant_dof) throw ConfigError(o.urdf_path, "joints", "the model and the plant differ in joint count");
+  return model;
+}
+
+// The constant-current levels of joint j, both directions at each speed, appended to `levels`;
+// then the joint stops and comes back to upright (continuous joints: stay where they stopped).
+void run_speed_levels(FrictionRig& rig, int j, const FrictionIdentificationOptions& o, FrictionIdentificationResult& result,
+                      std::ostream* progress) {
+  const ActuatorParameters& nominal = rig.robot().config().actuators[j];
+  const bool limited = rig.limited(j);
+  const double level_s = o.run_up_s + o.settle_s + o.average_s;
+  double max_speed = o.max_speed_fraction * nominal.velocity_limit_rad_s;
+  if (limited) max_speed = std::min(max_speed, 0.9 * 2.0 * o.limited_half_range_rad / level_s);
+  const double min_speed = std::min(o.min_speed_rad_s, 0.5 * max_speed);
+  if (progress) {
+    *progress << "joint " << j + 1 << " (" << nominal.joint_name << (limited ? ", limited" : ", continuous")
+              << "): " << 2 * o.speed_levels << " constant-current levels, " << format_fixed(min_speed, 3) << " to "
+              << format_fixed(max_speed, 3) << " rad/s each way, at t = " << format_fixed(rig.time(), 1) << " s"
+              << std::endl;
+  }
+  for (int k = 0; k < o.speed_levels; ++k) {
+    const double speed = min_speed * std::pow(max_speed / min_speed, static_cast<double>(k) / (o.speed_levels - 1));
+    for (int direction : {+1, -1}) {
+      if (limited) {
+        const double half = std::min(0.5 * speed * level_s, o.limited_half_range_rad);
+        move_to(rig, j, -direction * half, 0.2);
+      }
+      result.levels.push_back(run_level(rig, j, direction, speed, o, result.samples));
+    }
+  }
+  const double stop_at = limited ? 0.0 : rig.state().q_rad[j];
+  for (int k = 0; k < cycles(0.3, rig.robot().period_s()); ++k) rig.step(j, Drive::kHold, rig.state().q_rad[j]);
+  move_to(rig, j, stop_at, 0.3);
+  rig.set_hold(j, stop_at);
+}
+
+// Least squares on the steady levels: e = c0 + tau_c sign(qd) + tau_v qd. Sets the estimate's
+// offset, Coulomb and viscous coefficients, residual and level counts.
+void fit_sliding_friction(const std::vector<FrictionLevel>& levels, JointFrictionEstimate& e) {
+  int used = 0;
+  for (const FrictionLevel& l : levels) used += l.steady ? 1 : 0;
+  e.levels_total = static_cast<int>(levels.size());
+  e.levels_used = used;
+  if (used < 4) {
+    throw ExperimentError("friction identification",
+                          "joint " + std::to_string(e.joint) + ": only " + std::to_string(used) + " steady levels");
+  }
+  Eigen::MatrixXd a(used, 3);
+  Eigen::VectorXd b(used);
+  int row = 0;
+  for (const FrictionLevel& l : levels) {
+    if (!l.steady) continue;
+    a(row, 0) = 1.0;
+    a(row, 1) = sign(l.velocity_rad_s);
+    a(row, 2) = l.velocity_rad_s;
+    b[row] = l.torque_error_Nm;
+    ++row;
+  }
+  const Eigen::Vector3d x = a.colPivHouseholderQr().solve(b);
+  e.offset_Nm = x[0];
+  e.identified.coulomb_Nm = x[1];
+  e.identified.viscous_Nms_per_rad = x[2];
+  e.residual_rms_Nm = std::sqrt((a * x - b).squaredNorm() / used);
+}
+
+// The breakaway level of joint j in each direction, from rest at upright; the joint is held where
+// it ends (limited joints: back at upright).
+void identify_static_friction(FrictionRig& rig, int j, const FrictionIdentificationOptions& o, JointFrictionEstimate& e,
+                              std::vector<StaticFrictionTrial>& trials) {
+  const bool limited = rig.limited(j);
+  if (limited) move_to(rig, j, 0.0, 0.2);
+  release(rig, j, 0.2);
+  e.static_positive_Nm = find_static(rig, j, +1, o, trials);
+  if (limited) move_to(rig, j, 0.0, 0.2);
+  release(rig, j, 0.2);
+  e.static_negative_Nm = find_static(rig, j, -1, o, trials);
+  e.identified.static_Nm = 0.5 * (e.static_positive_Nm + e.static_negative_Nm);
+  rig.set_hold(j, rig.state().q_rad[j]);
+  if (limited) {
+    move_to(rig, j, 0.0, 0.2);
+    rig.set_hold(j, 0.0);
+  }
+  release(rig, -1, 0.2);
+}
+
+// One joint (1-based): sliding levels and their fit, then the static search.
+JointFrictionEstimate identify_joint(FrictionRig& rig, int joint, const FrictionIdentificationOptions& o,
+                                     FrictionIdentificationResult& result, std::ostream* progress) {
+  const int j = joint - 1;
+  const ActuatorParameters& nominal = rig.robot().config().actuators[j];
+  const std::size_t first_level = result.levels.size();
+  run_speed_levels(rig, j, o, result, progress);
+
+  JointFrictionEstimate e;
+  e.joint = joint;
+  e.name = nominal.joint_name;
+  e.nominal = nominal.friction;
+  e.plant = rig.robot().plant_actuators()[j].friction;
+  const std::vector<double>& offsets = rig.robot().config().noise.torque_sensor_offset_Nm;
+  e.plant_sensor_offset_Nm = offsets.empty() ? 0.0 : offsets[static_cast<std::size_t>(j)];
+  e.identified = nominal.friction;
+  fit_sliding_friction({result.levels.begin() + static_cast<std::ptrdiff_t>(first_level), result.levels.end()}, e);
+  if (progress) {
+    *progress << "  fit on " << e.levels_used << "/" << e.levels_total << " steady levels: Coulomb "
+              << format_fixed(e.identified.coulomb_Nm, 4) << " N.m, viscous " << format_fixed(e.identified.viscous_Nms_per_rad, 4)
+              << " N.m.s/rad, offset " << format_fixed(e.offset_Nm, 4) << " N.m; static search..." << std::endl;
+  }
+  identify_static_friction(rig, j, o, e, result.static_trials);
+  if (progress) {
+    *progress << "  static " << format_fixed(e.static_positive_Nm, 4) << " / " << format_fixed(e.static_negative_Nm, 4)
+              << " N.m (+/-); plant: Coulomb " << format_fixed(e.plant.coulomb_Nm, 4) << ", viscous "
+              << format_fixed(e.plant.viscous_Nms_per_rad, 4) << ", static " << format_fixed(e.plant.static_Nm, 4)
+              << std::endl;
+  }
+  return e;
+}
+
 }  // namespace
 
 double FrictionIdentificationResult::worst_relative_error() const {
@@ -330,146 +474,21 @@ double FrictionIdentificationResult::worst_relative_error() const {
 FrictionIdentificationResult identify_friction(const FrictionIdentificationOptions& o, std::ostream* progress) {
   validate(o);
   const auto wall_start = std::chrono::steady_clock::now();
-  SimRobotConfig config = SimRobotConfig::from_yaml_file(o.plant_config_path);
-  const int n = config.dof();
-  for (int j : o.joints) {
-    if (j < 1 || j > n) {
-      throw ConfigError("<friction identification options>", "joints", "joint " + std::to_string(j) + " out of 1.." + std::to_string(n));
-    }
-  }
-  config.initial_q_rad.assign(static_cast<std::size_t>(n), 0.0);  // upright: no gravity torque
-  config.seed = o.seed;
-  if (o.friction_perturbation > 0.0) {
-    config.actuator_overrides = perturbed_friction_overrides(config.actuators, o.friction_perturbation, o.seed);
-  }
-
-  ModelOptions model_options;
-  for (Payload p : ControllerSettings::default_payloads()) {
-    p.frame = "end_effector_link";
-    model_options.payloads.push_back(p);
-  }
-  const Model model = Model::from_urdf_file(o.urdf_path, model_options);
-  if (model.nq() != n) throw ConfigError(o.urdf_path, "joints", "the model and the plant differ in joint count");
-
+  const SimRobotConfig config = identification_plant(o);
+  const Model model = identification_model(o, config.dof());
   FrictionRig rig(config, model);
   FrictionIdentificationResult result;
   result.samples.reserve(40000);
-  const double dt = rig.robot().period_s();
   release(rig, -1, 0.3);  // everything held at upright
-
-  for (int joint : o.joints) {
-    const int j = joint - 1;
-    const ActuatorParameters& nominal = config.actuators[j];
-    const ActuatorParameters& truth = rig.robot().plant_actuators()[j];
-    const bool limited = rig.limited(j);
-    const double level_s = o.run_up_s + o.settle_s + o.average_s;
-    double max_speed = o.max_speed_fraction * nominal.velocity_limit_rad_s;
-    if (limited) max_speed = std::min(max_speed, 0.9 * 2.0 * o.limited_half_range_rad / level_s);
-    const double min_speed = std::min(o.min_speed_rad_s, 0.5 * max_speed);
-    if (progress) {
-      *progress << "joint " << joint << " (" << nominal.joint_name << (limited ? ", limited" : ", continuous")
-                << "): " << 2 * o.speed_levels << " constant-current levels, " << format_fixed(min_speed, 3) << " to "
-                << format_fixed(max_speed, 3) << " rad/s each way, at t = " << format_fixed(rig.time(), 1) << " s"
-                << std::endl;
-    }
-    const std::size_t first_level = result.levels.size();
-    for (int k = 0; k < o.speed_levels; ++k) {
-      const double speed = min_speed * std::pow(max_speed / min_speed, static_cast<double>(k) / (o.speed_levels - 1));
-      for (int direction : {+1, -1}) {
-        if (limited) {
-          const double half = std::min(0.5 * speed * level_s, o.limited_half_range_rad);
-          move_to(rig, j, -direction * half, 0.2);
-        }
-        result.levels.push_back(run_level(rig, j, direction, speed, o, result.samples));
-      }
-    }
-    // Stop and come back to upright (continuous joints: where they are, modulo nothing).
-    const double stop_at = limited ? 0.0 : rig.state().q_rad[j];
-    for (int k = 0; k < cycles(0.3, dt); ++k) rig.step(j, Drive::kHold, rig.state().q_rad[j]);
-    move_to(rig, j, stop_at, 0.3);
-    rig.set_hold(j, stop_at);
-
-    // Least squares on the steady levels: e = c0 + tau_c sign(qd) + tau_v qd.
-    int used = 0;
-    for (std::size_t i = first_level; i < result.levels.size(); ++i) used += result.levels[i].steady ? 1 : 0;
-    JointFrictionEstimate e;
-    e.joint = joint;
-    e.name = nominal.joint_name;
-    e.nominal = nominal.friction;
-    e.plant = truth.friction;
-    e.plant_sensor_offset_Nm = config.noise.torque_sensor_offset_Nm.empty()
-                                   ? 0.0
-                                   : config.noise.torque_sensor_offset_Nm[static_cast<std::size_t>(j)];
-    e.levels_total = static_cast<int>(result.levels.size() - first_level);
-    e.levels_used = used;
-    e.identified = nominal.friction;
-    if (used < 4) {
-      throw ConfigError("SimRobot", "friction identification",
-                        "joint " + std::to_string(joint) + ": only " + std::to_string(used) + " steady levels");
-    }
-    Eigen::MatrixXd a(used, 3);
-    Eigen::VectorXd b(used);
-    int row = 0;
-    for (std::size_t i = first_level; i < result.levels.size(); ++i) {
-      const FrictionLevel& l = result.levels[i];
-      if (!l.steady) continue;
-      a(row, 0) = 1.0;
-      a(row, 1) = sign(l.velocity_rad_s);
-      a(row, 2) = l.velocity_rad_s;
-      b[row] = l.torque_error_Nm;
-      ++row;
-    }
-    const Eigen::Vector3d x = a.colPivHouseholderQr().solve(b);
-    e.offset_Nm = x[0];
-    e.identified.coulomb_Nm = x[1];
-    e.identified.viscous_Nms_per_rad = x[2];
-    e.residual_rms_Nm = std::sqrt((a * x - b).squaredNorm() / used);
-
-    if (progress) {
-      *progress << "  fit on " << used << "/" << e.levels_total << " steady levels: Coulomb "
-                << format_fixed(e.identified.coulomb_Nm, 4) << " N.m, viscous " << format_fixed(e.identified.viscous_Nms_per_rad, 4)
-                << " N.m.s/rad, offset " << format_fixed(e.offset_Nm, 4) << " N.m; static search..." << std::endl;
-    }
-    if (limited) move_to(rig, j, 0.0, 0.2);
-    release(rig, j, 0.2);
-    e.static_positive_Nm = find_static(rig, j, +1, o, result.static_trials);
-    if (limited) move_to(rig, j, 0.0, 0.2);
-    release(rig, j, 0.2);
-    e.static_negative_Nm = find_static(rig, j, -1, o, result.static_trials);
-    e.identified.static_Nm = 0.5 * (e.static_positive_Nm + e.static_negative_Nm);
-    rig.set_hold(j, rig.state().q_rad[j]);
-    if (limited) {
-      move_to(rig, j, 0.0, 0.2);
-      rig.set_hold(j, 0.0);
-    }
-    release(rig, -1, 0.2);
-    if (progress) {
-      *progress << "  static " << format_fixed(e.static_positive_Nm, 4) << " / " << format_fixed(e.static_negative_Nm, 4)
-                << " N.m (+/-); plant: Coulomb " << format_fixed(e.plant.coulomb_Nm, 4) << ", viscous "
-                << format_fixed(e.plant.viscous_Nms_per_rad, 4) << ", static " << format_fixed(e.plant.static_Nm, 4)
-                << std::endl;
-    }
-    result.joints.push_back(e);
-  }
+  for (int joint : o.joints) result.joints.push_back(identify_joint(rig, joint, o, result, progress));
   result.simulated_s = rig.time();
   result.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
-
-  if (!o.output_dir.empty()) {
-    ensure_output_directory(o.output_dir);
-    const std::pair<std::string, std::string> files[] = {
-        {"friction_levels.csv", levels_csv(result)},
-        {"friction_samples.csv", samples_csv(result)},
-        {"friction_static.csv", static_csv(result)},
-        {"friction_models.csv", models_csv(result)},
-        {"friction_identified.yaml", friction_identification_yaml(result, o)},
-        {"friction_identification.md", friction_identification_table(result)},
-    };
-    for (const auto& [name, text] : files) {
-      const std::string path = output_path(o.output_dir, name);
-      write_text_file(path, text);
-      result.files.push_back(path);
-    }
-  }
+  result.files = write_output_files(o.output_dir, {{"friction_levels.csv", levels_csv(result)},
+                                                   {"friction_samples.csv", samples_csv(result)},
+                                                   {"friction_static.csv", static_csv(result)},
+                                                   {"friction_models.csv", models_csv(result)},
+                                                   {"friction_identified.yaml", friction_identification_yaml(result, o)},
+                                                   {"friction_identification.md", friction_identification_table(result)}});
   return result;
 }
 
@@ -521,19 +540,15 @@ std::string friction_identification_yaml(const FrictionIdentificationResult& r, 
 }
 
 int run_friction_identification_command(const FrictionIdentificationOptions& options, std::ostream& out) {
-  try {
-    out << "friction identification: plant " << options.plant_config_path << ", friction perturbation "
-        << options.friction_perturbation << ", seed " << options.seed << ", joints";
-    for (int j : options.joints) out << ' ' << j;
-    out << std::endl;
-    const FrictionIdentificationResult r = identify_friction(options, &out);
-    out << "\n" << friction_identification_table(r);
-    report_files_and_figure(r.files, options.output_dir, options.figure_script, "friction_identification.png", out);
-    return 0;
-  } catch (const ConfigError& e) {
-    out << "error: " << e.what() << std::endl;
-    return 1;
-  }
+  out << "friction identification: plant " << options.plant_config_path << ", friction perturbation "
+      << options.friction_perturbation << ", seed " << options.seed << ", joints";
+  for (int j : options.joints) out << ' ' << j;
+  out << std::endl;
+  const FrictionIdentificationResult r = identify_friction(options, &out);
+  report_experiment({friction_identification_table(r), r.files, options.output_dir, options.figure_script,
+                     "friction_identification.png"},
+                    out);
+  return 0;
 }
 
 }  // namespace phri

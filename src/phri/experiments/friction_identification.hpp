@@ -143,7 +143,9 @@ struct FrictionIdentificationResult {
 /// Runs the identification on the simulated plant; progress lines go to `progress` (may be null).
 /// Writes into options.output_dir (when not empty): friction_levels.csv, friction_samples.csv,
 /// friction_static.csv, friction_identified.yaml (per-joint `friction:` blocks with the keys of
-/// actuators.yaml), friction_identification.md. Throws ConfigError on bad options or files.
+/// actuators.yaml), friction_identification.md. Throws ConfigError on bad options or input files,
+/// IoError when an output cannot be written, ExperimentError when the plant faults or a joint's
+/// friction cannot be identified.
 FrictionIdentificationResult identify_friction(const FrictionIdentificationOptions& options,
                                                std::ostream* progress = nullptr);
 
@@ -155,8 +157,8 @@ std::string friction_identification_yaml(const FrictionIdentificationResult& res
                                          const FrictionIdentificationOptions& options);
 
 /// Everything the CLI's `phri identify-friction` needs: simulate, write the files, run the figure
-/// script (when /usr/bin/python3 and the script exist), print the table on `out`.
-/// Returns 0 on success, 1 on a configuration error (printed on `out`).
+/// script (when /usr/bin/python3 and the script exist), print the table on `out`. Returns 0;
+/// failures throw (phri::Error, as identify_friction).
 int run_friction_identification_command(const FrictionIdentificationOptions& options, std::ostream& out);
 
 }  // namespace phri

@@ -2,17 +2,17 @@
 
 #include <phri/control/controller.hpp>
 #include <phri/core/error.hpp>
+#include <phri/core/format.hpp>
+#include <phri/core/statistics.hpp>
 #include <phri/experiments/experiment_files.hpp>
 #include <phri/experiments/friction_perturbation.hpp>
 #include <phri/model/algorithms.hpp>
 #include <phri/sim/sim_robot.hpp>
 
-#include <yaml-cpp/yaml.h>
-
 #include <algorithm>
 #include <chrono>
-#include <filesystem>
 #include <cmath>
+#include <optional>
 #include <ostream>
 #include <sstream>
 
@@ -74,46 +74,39 @@ struct Trajectory {
   }
 };
 
-// actuators.yaml as the controller reads it: the options' file, or a copy of it with the friction
-// compensation thresholds replaced (written next to the results, so a run documents its controller).
-std::string controller_actuators(const TorqueTrackingOptions& o) {
-  if (!(o.friction_velocity_threshold_rad_s > 0.0) && !(o.friction_acceleration_threshold_rad_s2 > 0.0)) {
-    return o.actuators_path;
-  }
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(o.actuators_path);
-  } catch (const YAML::Exception& e) {
-    throw ConfigError(o.actuators_path, "", e.what());
-  }
-  if (!root["joints"] || !root["joints"].IsSequence()) throw ConfigError(o.actuators_path, "joints", "missing");
-  for (std::size_t i = 0; i < root["joints"].size(); ++i) {
-    YAML::Node friction = root["joints"][i]["friction"];
-    if (o.friction_velocity_threshold_rad_s > 0.0) friction["velocity_threshold_rad_s"] = o.friction_velocity_threshold_rad_s;
-    if (o.friction_acceleration_threshold_rad_s2 > 0.0) {
-      friction["acceleration_threshold_rad_s2"] = o.friction_acceleration_threshold_rad_s2;
-    }
-  }
-  YAML::Emitter out;
-  out << root;
-  const std::string dir = o.output_dir.empty() ? std::filesystem::temp_directory_path().string() : o.output_dir;
-  const std::string path = output_path(dir, o.output_dir.empty() ? "phri_controller_actuators.yaml" : "controller_actuators.yaml");
-  write_text_file(path, std::string("# ") + o.actuators_path +
-                            " with the torque-tracking experiment's friction compensation thresholds\n" + out.c_str() + "\n");
-  return path;
-}
-
-ControllerSettings cycle_settings(const TorqueTrackingOptions& o, TrackingScenario scenario, ComplianceMode mode,
-                                   const std::string& actuators) {
+ControllerSettings cycle_settings(const TorqueTrackingOptions& o, TrackingScenario scenario, ComplianceMode mode) {
   ControllerSettings s;
-  s.urdf_path = o.urdf_path;
-  s.actuators_path = actuators;
-  s.collision_path = o.collision_path;
   s.initial_compliance = mode;
   s.initial_loop = LowLevelMode::kPosition;
   s.custom_torque = o.custom_torque;
   if (scenario == TrackingScenario::kStatic) s.external_torque_source = o.static_external_torque;
   return s;
+}
+
+// What the controller is built from, loaded once: every run's Controller starts from a copy.
+struct ControllerRobot {
+  Model model;
+  ActuatorTable actuators;
+  std::optional<CollisionModel> collision;
+};
+
+// The options' files as the controller uses them, with actuators.yaml's friction compensation
+// thresholds replaced in memory when the options set them.
+ControllerRobot load_controller_robot(const TorqueTrackingOptions& o) {
+  // The model options do not depend on the scenario (frame names, F/T offset and payloads only).
+  const ControllerSettings settings = cycle_settings(o, TrackingScenario::kStatic, o.static_compliance);
+  Model model = Model::from_urdf_file(o.urdf_path, Controller::model_options(settings));
+  ActuatorTable actuators = ActuatorTable::from_yaml_file(o.actuators_path);
+  for (int i = 0; i < actuators.size(); ++i) {
+    FrictionParameters& f = actuators[i].friction;
+    if (o.friction_velocity_threshold_rad_s > 0.0) f.velocity_threshold_rad_s = o.friction_velocity_threshold_rad_s;
+    if (o.friction_acceleration_threshold_rad_s2 > 0.0) {
+      f.acceleration_threshold_rad_s2 = o.friction_acceleration_threshold_rad_s2;
+    }
+  }
+  std::optional<CollisionModel> collision;
+  if (!o.collision_path.empty()) collision = CollisionModel::from_yaml_file(o.collision_path, model);
+  return {std::move(model), std::move(actuators), std::move(collision)};
 }
 
 SimRobotConfig plant_config(const TorqueTrackingOptions& o, TrackingScenario scenario) {
@@ -149,72 +142,95 @@ SimRobotConfig plant_config(const TorqueTrackingOptions& o, TrackingScenario sce
   return c;
 }
 
-double rms(const std::vector<double>& values) {
-  double sum = 0.0;
-  for (double v : values) sum += v * v;
-  return values.empty() ? 0.0 : std::sqrt(sum / static_cast<double>(values.size()));
-}
-
 std::string loop_name(LowLevelMode loop) { return std::string(to_string(loop)); }
 
-TorqueTrackingRun run_one(const TorqueTrackingOptions& o, TrackingScenario scenario, LowLevelMode loop,
-                          const std::string& actuators, std::ostream* progress, double& simulated) {
-  const ComplianceMode mode = scenario == TrackingScenario::kStatic ? o.static_compliance : o.dynamic_compliance;
-  SimRobot robot(plant_config(o, scenario));
-  Controller cycle(cycle_settings(o, scenario, mode, actuators));
+// The cycle counts of one run: position control, then the loop under test, whose first `skip`
+// cycles are left out of the statistics; the dynamic trajectory starts `delay` cycles after the switch.
+struct RunSchedule {
+  int position_cycles = 0, test_cycles = 0, skip = 0, delay = 0;
+};
+
+RunSchedule run_schedule(const TorqueTrackingOptions& o, TrackingScenario scenario, double dt) {
+  const double duration = scenario == TrackingScenario::kStatic ? o.static_duration_s : o.dynamic_duration_s;
+  return {static_cast<int>(std::lround(o.position_phase_s / dt)), static_cast<int>(std::lround(duration / dt)),
+          static_cast<int>(std::lround(o.transient_s / dt)), static_cast<int>(std::lround(o.trajectory_delay_s / dt))};
+}
+
+// The errors of one run after the switch: every sample into the time series (CSV), those past the
+// transient into the statistics.
+class TrackingRecorder {
+public:
+  TrackingRecorder(int dof, int test_cycles, int skip) : error_sum_(Eigen::VectorXd::Zero(dof)), skip_(skip) {
+    csv_ << "t_s,error_norm_Nm,error_norm_true_Nm";
+    for (int i = 0; i < dof; ++i) csv_ << ",error_" << (i + 1) << "_Nm";
+    csv_ << ",ee_error_mm\n";
+    for (std::vector<double>* v : {&norms_, &norms_true_, &ee_errors_}) v->reserve(static_cast<std::size_t>(test_cycles));
+  }
+
+  /// Sample `sample` (0: the first period after the switch) at time sample * dt.
+  void record(int sample, double dt, const Eigen::VectorXd& error, const Eigen::VectorXd& error_true, double ee_error) {
+    csv_ << format_fixed(sample * dt, 3) << ',' << format_fixed(error.norm(), 5) << ',' << format_fixed(error_true.norm(), 5);
+    for (int i = 0; i < error.size(); ++i) csv_ << ',' << format_fixed(error[i], 5);
+    csv_ << ',' << format_fixed(1e3 * ee_error, 4) << '\n';
+    if (sample < skip_) return;
+    norms_.push_back(error.norm());
+    error_sum_ += error;
+    norms_true_.push_back(error_true.norm());
+    ee_errors_.push_back(ee_error);
+  }
+
+  void fill_statistics(TorqueTrackingRun& run) const {
+    run.rms_Nm = rms(norms_);
+    run.p95_Nm = percentile(norms_, 0.95);
+    run.max_Nm = norms_.empty() ? 0.0 : *std::max_element(norms_.begin(), norms_.end());
+    run.bias_Nm = norms_.empty() ? 0.0 : error_sum_.norm() / static_cast<double>(norms_.size());
+    run.rms_true_Nm = rms(norms_true_);
+    run.p95_true_Nm = percentile(norms_true_, 0.95);
+    run.ee_position_rms_mm = 1e3 * rms(ee_errors_);
+    run.ee_position_max_mm = ee_errors_.empty() ? 0.0 : 1e3 * *std::max_element(ee_errors_.begin(), ee_errors_.end());
+    run.samples = static_cast<int>(norms_.size());
+  }
+
+  std::string csv() const { return csv_.str(); }
+
+private:
+  std::ostringstream csv_;
+  std::vector<double> norms_, norms_true_, ee_errors_;
+  Eigen::VectorXd error_sum_;
+  int skip_;
+};
+
+// How far the plant's true end effector (forward kinematics of its true joint angles) is from the
+// end-effector task's target [m].
+double true_ee_error(const Controller& cycle, const SimRobot& robot, Data& truth_data) {
+  forward_kinematics(cycle.model(), truth_data, robot.truth().q_rad);
+  update_frame_placements(cycle.model(), truth_data);
+  const std::size_t ee = static_cast<std::size_t>(cycle.end_effector_frame());
+  return (cycle.qp().end_effector().target_pose().translation() - truth_data.frame_placements[ee].translation()).norm();
+}
+
+// Runs the schedule: position control, the switch to `loop`, the dynamic scenario's trajectory;
+// records the errors. Returns the number of QP fallbacks.
+long drive_run(const TorqueTrackingOptions& o, TrackingScenario scenario, LowLevelMode loop, const RunSchedule& schedule,
+               SimRobot& robot, Controller& cycle, TrackingRecorder& recorder, std::ostream* progress) {
   const int n = robot.dof();
-  RobotCommand command(n);
-  Data truth_data(cycle.model());  // FK of the plant's true joint angles (same kinematics)
-  const int ee = cycle.end_effector_frame();
   const double dt = robot.period_s();
   const Trajectory trajectory{o.sine_amplitude_m, o.sine_omega_rad_s, o.triangle_speed_m_s,
                               o.triangle_min_m,   o.triangle_max_m,   o.fade_in_s};
-
-  const int position_cycles = static_cast<int>(std::lround(o.position_phase_s / dt));
-  const double duration = scenario == TrackingScenario::kStatic ? o.static_duration_s : o.dynamic_duration_s;
-  const int test_cycles = static_cast<int>(std::lround(duration / dt));
-  const int skip = static_cast<int>(std::lround(o.transient_s / dt));
-  const int delay = static_cast<int>(std::lround(o.trajectory_delay_s / dt));
-
-  std::ostringstream csv;
-  csv << "t_s,error_norm_Nm,error_norm_true_Nm";
-  for (int i = 0; i < n; ++i) csv << ",error_" << (i + 1) << "_Nm";
-  csv << ",ee_error_mm\n";
-
-  std::vector<double> norms, norms_true, ee_errors;
-  norms.reserve(static_cast<std::size_t>(test_cycles));
-  norms_true.reserve(static_cast<std::size_t>(test_cycles));
-  ee_errors.reserve(static_cast<std::size_t>(test_cycles));
+  RobotCommand command(n);
+  ControllerTargets targets(n);
+  Data truth_data(cycle.model());  // FK of the plant's true joint angles (same kinematics)
   Eigen::VectorXd tau_desired_prev = Eigen::VectorXd::Zero(n);
-  Eigen::VectorXd error(n), error_true(n);
-  Eigen::VectorXd error_sum = Eigen::VectorXd::Zero(n);
   Eigen::Isometry3d start = Eigen::Isometry3d::Identity();
   long fallbacks = 0;
-
-  ControllerTargets targets(n);
-  for (int k = 0; k < position_cycles + test_cycles + 1; ++k) {
+  for (int k = 0; k < schedule.position_cycles + schedule.test_cycles + 1; ++k) {
     const RobotState& state = robot.read();
     targets.clear();
-    const int after = k - position_cycles;  // cycles since the switch (the switch happens at after == 0)
+    const int after = k - schedule.position_cycles;  // cycles since the switch (the switch happens at after == 0)
     if (after >= 1) {
       // The previous cycle's set-point against what the sensors read at the end of its period.
-      error = tau_desired_prev - state.tau_sensor_Nm;
-      error_true = tau_desired_prev - robot.truth().tau_transmitted_Nm;
-      forward_kinematics(cycle.model(), truth_data, robot.truth().q_rad);
-      update_frame_placements(cycle.model(), truth_data);
-      const double ee_error =
-          (cycle.qp().end_effector().target_pose().translation() -
-           truth_data.frame_placements[static_cast<std::size_t>(ee)].translation()).norm();
-      const double t = (after - 1) * dt;
-      csv << format_fixed(t, 3) << ',' << format_fixed(error.norm(), 5) << ',' << format_fixed(error_true.norm(), 5);
-      for (int i = 0; i < n; ++i) csv << ',' << format_fixed(error[i], 5);
-      csv << ',' << format_fixed(1e3 * ee_error, 4) << '\n';
-      if (after - 1 >= skip) {
-        norms.push_back(error.norm());
-        error_sum += error;
-        norms_true.push_back(error_true.norm());
-        ee_errors.push_back(ee_error);
-      }
+      recorder.record(after - 1, dt, tau_desired_prev - state.tau_sensor_Nm,
+                      tau_desired_prev - robot.truth().tau_transmitted_Nm, true_ee_error(cycle, robot, truth_data));
     }
     if (after == 0) {
       targets.low_level_mode = loop;
@@ -224,9 +240,9 @@ TorqueTrackingRun run_one(const TorqueTrackingOptions& o, TrackingScenario scena
                   << format_fixed(state.time_s, 2) << " s" << std::endl;
       }
     }
-    if (scenario == TrackingScenario::kDynamic && after > delay) {
+    if (scenario == TrackingScenario::kDynamic && after > schedule.delay) {
       Vector6d offset, velocity, acceleration;
-      trajectory.at((after - delay) * dt, offset, velocity, acceleration);
+      trajectory.at((after - schedule.delay) * dt, offset, velocity, acceleration);
       Eigen::Isometry3d target = start;
       target.translation() += offset.head<3>();
       targets.has_pose = true;
@@ -237,24 +253,27 @@ TorqueTrackingRun run_one(const TorqueTrackingOptions& o, TrackingScenario scena
     robot.write(command);
     if (state.fault) throw ExperimentError("torque tracking", "the simulated plant faulted");
   }
-  simulated += robot.state().time_s;
+  return fallbacks;
+}
 
+// One scenario with one loop on a fresh plant and controller; its time series goes to the output folder.
+TorqueTrackingRun run_one(const TorqueTrackingOptions& o, TrackingScenario scenario, LowLevelMode loop,
+                          const ControllerRobot& controller_robot, std::ostream* progress, double& simulated) {
+  const ComplianceMode mode = scenario == TrackingScenario::kStatic ? o.static_compliance : o.dynamic_compliance;
+  SimRobot robot(plant_config(o, scenario));
+  Controller cycle(controller_robot.model, controller_robot.actuators, controller_robot.collision,
+                   cycle_settings(o, scenario, mode));
+  const RunSchedule schedule = run_schedule(o, scenario, robot.period_s());
+  TrackingRecorder recorder(robot.dof(), schedule.test_cycles, schedule.skip);
   TorqueTrackingRun run;
   run.scenario = scenario;
   run.loop = loop;
-  run.rms_Nm = rms(norms);
-  run.p95_Nm = percentile(norms, 0.95);
-  run.max_Nm = norms.empty() ? 0.0 : *std::max_element(norms.begin(), norms.end());
-  run.bias_Nm = norms.empty() ? 0.0 : error_sum.norm() / static_cast<double>(norms.size());
-  run.rms_true_Nm = rms(norms_true);
-  run.p95_true_Nm = percentile(norms_true, 0.95);
-  run.ee_position_rms_mm = 1e3 * rms(ee_errors);
-  run.ee_position_max_mm = ee_errors.empty() ? 0.0 : 1e3 * *std::max_element(ee_errors.begin(), ee_errors.end());
-  run.samples = static_cast<int>(norms.size());
-  run.qp_fallbacks = fallbacks;
+  run.qp_fallbacks = drive_run(o, scenario, loop, schedule, robot, cycle, recorder, progress);
+  simulated += robot.state().time_s;
+  recorder.fill_statistics(run);
   if (!o.output_dir.empty()) {
-    run.csv_path = output_path(o.output_dir, std::string("torque_tracking_") + to_string(scenario) + "_" + loop_name(loop) + ".csv");
-    write_text_file(run.csv_path, csv.str());
+    const std::string name = std::string("torque_tracking_") + to_string(scenario) + "_" + loop_name(loop) + ".csv";
+    run.csv_path = write_output_files(o.output_dir, {{name, recorder.csv()}}).front();
   }
   if (progress) {
     *progress << "  " << to_string(scenario) << " / " << loop_name(loop) << ": ||tau_d - tau_s|| RMS "
@@ -263,6 +282,19 @@ TorqueTrackingRun run_one(const TorqueTrackingOptions& o, TrackingScenario scena
               << " mm" << std::endl;
   }
   return run;
+}
+
+// The statistics of every run, one row each.
+std::string summary_csv(const TorqueTrackingResult& result, const TorqueTrackingOptions& o) {
+  std::ostringstream summary;
+  summary << "scenario,loop,rms_Nm,p95_Nm,max_Nm,bias_Nm,rms_true_Nm,p95_true_Nm,window_start_s,samples\n";
+  for (const TorqueTrackingRun& run : result.runs) {
+    summary << to_string(run.scenario) << ',' << loop_name(run.loop) << ',' << format_fixed(run.rms_Nm, 6) << ','
+            << format_fixed(run.p95_Nm, 6) << ',' << format_fixed(run.max_Nm, 6) << ',' << format_fixed(run.bias_Nm, 6) << ','
+            << format_fixed(run.rms_true_Nm, 6) << ',' << format_fixed(run.p95_true_Nm, 6) << ','
+            << format_fixed(o.transient_s, 3) << ',' << run.samples << '\n';
+  }
+  return summary.str();
 }
 
 void validate(const TorqueTrackingOptions& o) {
@@ -302,8 +334,7 @@ TorqueTrackingResult run_torque_tracking(const TorqueTrackingOptions& o, std::os
   const auto wall_start = std::chrono::steady_clock::now();
   if (!o.output_dir.empty()) ensure_output_directory(o.output_dir);
   TorqueTrackingResult result;
-  const std::string actuators = controller_actuators(o);
-  if (actuators != o.actuators_path && !o.output_dir.empty()) result.files.push_back(actuators);
+  const ControllerRobot controller_robot = load_controller_robot(o);
   for (TrackingScenario scenario : o.scenarios) {
     for (LowLevelMode loop : o.loops) {
       if (progress) {
@@ -312,26 +343,15 @@ TorqueTrackingResult run_torque_tracking(const TorqueTrackingOptions& o, std::os
                    << format_fixed(scenario == TrackingScenario::kStatic ? o.static_duration_s : o.dynamic_duration_s, 1)
                    << " s" << std::endl;
       }
-      result.runs.push_back(run_one(o, scenario, loop, actuators, progress, result.simulated_s));
+      result.runs.push_back(run_one(o, scenario, loop, controller_robot, progress, result.simulated_s));
       if (!result.runs.back().csv_path.empty()) result.files.push_back(result.runs.back().csv_path);
     }
   }
   result.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   if (!o.output_dir.empty()) {
-    std::ostringstream summary;
-    summary << "scenario,loop,rms_Nm,p95_Nm,max_Nm,bias_Nm,rms_true_Nm,p95_true_Nm,window_start_s,samples\n";
-    for (const TorqueTrackingRun& run : result.runs) {
-      summary << to_string(run.scenario) << ',' << loop_name(run.loop) << ',' << format_fixed(run.rms_Nm, 6) << ','
-              << format_fixed(run.p95_Nm, 6) << ',' << format_fixed(run.max_Nm, 6) << ',' << format_fixed(run.bias_Nm, 6) << ','
-              << format_fixed(run.rms_true_Nm, 6)
-              << ',' << format_fixed(run.p95_true_Nm, 6) << ',' << format_fixed(o.transient_s, 3) << ',' << run.samples << '\n';
-    }
-    const std::string csv = output_path(o.output_dir, "torque_tracking_summary.csv");
-    write_text_file(csv, summary.str());
-    result.files.push_back(csv);
-    const std::string md = output_path(o.output_dir, "torque_tracking.md");
-    write_text_file(md, torque_tracking_table(result, o));
-    result.files.push_back(md);
+    const std::vector<std::string> written = write_output_files(
+        o.output_dir, {{"torque_tracking_summary.csv", summary_csv(result, o)}, {"torque_tracking.md", torque_tracking_table(result, o)}});
+    result.files.insert(result.files.end(), written.begin(), written.end());
   }
   return result;
 }
@@ -380,16 +400,12 @@ std::string torque_tracking_table(const TorqueTrackingResult& r, const TorqueTra
 }
 
 int run_torque_tracking_command(const TorqueTrackingOptions& options, std::ostream& out) {
-  try {
-    out << "torque tracking: plant " << options.plant_config_path << ", seed " << options.seed << std::endl;
-    const TorqueTrackingResult r = run_torque_tracking(options, &out);
-    out << "\n" << torque_tracking_table(r, options);
-    report_files_and_figure(r.files, options.output_dir, options.figure_script, "torque_tracking.png", out);
-    return 0;
-  } catch (const ConfigError& e) {
-    out << "error: " << e.what() << std::endl;
-    return 1;
-  }
+  out << "torque tracking: plant " << options.plant_config_path << ", seed " << options.seed << std::endl;
+  const TorqueTrackingResult r = run_torque_tracking(options, &out);
+  report_experiment({torque_tracking_table(r, options), r.files, options.output_dir, options.figure_script,
+                     "torque_tracking.png"},
+                    out);
+  return 0;
 }
 
 }  // namespace phri

@@ -21,7 +21,8 @@
 // "true" uses the plant's noise-free transmitted torque. Statistics (RMS, 95th percentile, max of
 // the norm) are taken from `transient_s` after the switch to the loop under test to the end.
 //
-// Each run builds a fresh plant (same seed: same noise and mismatch) and a fresh Controller.
+// Each run builds a fresh plant (same seed: same noise and mismatch) and a fresh Controller, from
+// the model, actuator table and collision model loaded once from the options' files.
 //
 // What to expect from the static scenario in this framework: the inverse dynamics subtracts the
 // momentum observer's tau_ext, which at rest converges to g - tau_s, so tau_d = M qdd_d + tau_s
@@ -110,9 +111,8 @@ struct TorqueTrackingOptions {
   // ---- the custom loop's gains (lambda, K_I, theta, ...)
   CustomTorqueSettings custom_torque;
   /// The custom loop's friction pre-compensation thresholds, replacing actuators.yaml's on every
-  /// joint when > 0 (the controller then reads a copy of actuators.yaml with these values,
-  /// controller_actuators.yaml in the output directory). 0: actuators.yaml's (0.1 rad/s and
-  /// 1 rad/s^2, the paper demo's runtime values).
+  /// joint of the controller's actuator table when > 0 (torque_tracking.md records them).
+  /// 0: actuators.yaml's (0.1 rad/s and 1 rad/s^2, the paper demo's runtime values).
   double friction_velocity_threshold_rad_s = 0.0;
   double friction_acceleration_threshold_rad_s2 = 0.0;
 
@@ -158,7 +158,8 @@ struct TorqueTrackingResult {
 /// (may be null). Writes into options.output_dir (when not empty) one CSV per run,
 /// torque_tracking_<scenario>_<loop>.csv (t_s, error_norm_Nm, error_norm_true_Nm, per-joint
 /// measured errors, ee_error_mm), torque_tracking_summary.csv (the statistics) and
-/// torque_tracking.md (the table). Throws ConfigError on bad options or files.
+/// torque_tracking.md (the table). Throws ConfigError on bad options or input files, IoError when
+/// an output cannot be written, ExperimentError when the plant faults.
 TorqueTrackingResult run_torque_tracking(const TorqueTrackingOptions& options, std::ostream* progress = nullptr);
 
 /// The markdown table: RMS and p95 per loop and scenario, and the ratios.
@@ -166,7 +167,7 @@ std::string torque_tracking_table(const TorqueTrackingResult& result, const Torq
 
 /// Everything the CLI's `phri experiment torque-tracking` needs: simulate, write the files, run
 /// the figure script (when /usr/bin/python3 and the script exist), print the table on `out`.
-/// Returns 0 on success, 1 on a configuration error (printed on `out`).
+/// Returns 0; failures throw (phri::Error, as run_torque_tracking).
 int run_torque_tracking_command(const TorqueTrackingOptions& options, std::ostream& out);
 
 }  // namespace phri

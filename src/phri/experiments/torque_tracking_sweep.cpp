@@ -1,6 +1,8 @@
 #include <phri/experiments/torque_tracking_sweep.hpp>
 
 #include <phri/core/error.hpp>
+#include <phri/core/format.hpp>
+#include <phri/core/statistics.hpp>
 #include <phri/experiments/experiment_files.hpp>
 
 #include <algorithm>
@@ -9,6 +11,21 @@
 #include <sstream>
 
 namespace phri {
+
+namespace {
+// One row per drive-gain error and mismatch seed.
+std::string sweep_csv(const StaticSweepResult& result) {
+  std::ostringstream csv;
+  csv << "torque_constant_error,mismatch_seed,custom_rms_Nm,high_velocity_rms_Nm,custom_bias_Nm,high_velocity_bias_Nm,"
+         "ratio\n";
+  for (const StaticSweepRow& r : result.rows) {
+    csv << format_fixed(r.torque_constant_error, 4) << ',' << r.mismatch_seed << ',' << format_fixed(r.custom_rms_Nm, 6)
+        << ',' << format_fixed(r.high_velocity_rms_Nm, 6) << ',' << format_fixed(r.custom_bias_Nm, 6) << ','
+        << format_fixed(r.high_velocity_bias_Nm, 6) << ',' << format_fixed(r.ratio, 4) << '\n';
+  }
+  return csv.str();
+}
+}  // namespace
 
 StaticSweepResult run_static_sweep(const StaticSweepOptions& o, std::ostream* progress) {
   const std::string src = "<static sweep options>";
@@ -66,22 +83,7 @@ StaticSweepResult run_static_sweep(const StaticSweepOptions& o, std::ostream* pr
   }
   result.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
 
-  if (!o.output_dir.empty()) {
-    std::ostringstream csv;
-    csv << "torque_constant_error,mismatch_seed,custom_rms_Nm,high_velocity_rms_Nm,custom_bias_Nm,high_velocity_bias_Nm,"
-           "ratio\n";
-    for (const StaticSweepRow& r : result.rows) {
-      csv << format_fixed(r.torque_constant_error, 4) << ',' << r.mismatch_seed << ',' << format_fixed(r.custom_rms_Nm, 6)
-          << ',' << format_fixed(r.high_velocity_rms_Nm, 6) << ',' << format_fixed(r.custom_bias_Nm, 6) << ','
-          << format_fixed(r.high_velocity_bias_Nm, 6) << ',' << format_fixed(r.ratio, 4) << '\n';
-    }
-    const std::string csv_path = output_path(o.output_dir, "static_sweep.csv");
-    write_text_file(csv_path, csv.str());
-    result.files.push_back(csv_path);
-    const std::string md = output_path(o.output_dir, "static_sweep.md");
-    write_text_file(md, static_sweep_table(result, o));
-    result.files.push_back(md);
-  }
+  result.files = write_output_files(o.output_dir, {{"static_sweep.csv", sweep_csv(result)}, {"static_sweep.md", static_sweep_table(result, o)}});
   return result;
 }
 
@@ -107,18 +109,13 @@ std::string static_sweep_table(const StaticSweepResult& r, const StaticSweepOpti
 }
 
 int run_static_sweep_command(const StaticSweepOptions& options, std::ostream& out) {
-  try {
-    out << "static torque tracking vs drive gain error: plant " << options.tracking.plant_config_path << ", "
-        << options.torque_constant_errors.size() << " errors x " << options.mismatch_seeds.size() << " mismatch seeds x 2 loops"
-        << std::endl;
-    const StaticSweepResult r = run_static_sweep(options, &out);
-    out << "\n" << static_sweep_table(r, options);
-    report_files_and_figure(r.files, options.output_dir, options.figure_script, "static_sweep.png", out);
-    return 0;
-  } catch (const ConfigError& e) {
-    out << "error: " << e.what() << std::endl;
-    return 1;
-  }
+  out << "static torque tracking vs drive gain error: plant " << options.tracking.plant_config_path << ", "
+      << options.torque_constant_errors.size() << " errors x " << options.mismatch_seeds.size() << " mismatch seeds x 2 loops"
+      << std::endl;
+  const StaticSweepResult r = run_static_sweep(options, &out);
+  report_experiment({static_sweep_table(r, options), r.files, options.output_dir, options.figure_script, "static_sweep.png"},
+                    out);
+  return 0;
 }
 
 }  // namespace phri

@@ -55,14 +55,14 @@ struct StaticSweepResult {
 
 /// Runs the sweep (progress lines on `progress`, may be null); writes static_sweep.csv (one row per
 /// error x seed) and static_sweep.md (the summary table) into output_dir when it is not empty.
-/// Throws ConfigError on bad options.
+/// Throws ConfigError on bad options, and what run_torque_tracking throws.
 StaticSweepResult run_static_sweep(const StaticSweepOptions& options, std::ostream* progress = nullptr);
 
 /// The summary table (markdown).
 std::string static_sweep_table(const StaticSweepResult& result, const StaticSweepOptions& options);
 
-/// The CLI's `phri experiment torque-tracking --static-sweep`: run, write, draw, print. 0 on
-/// success, 1 on a configuration error (printed on `out`).
+/// The CLI's `phri experiment torque-tracking --static-sweep`: run, write, draw, print. Returns 0;
+/// failures throw (phri::Error, as run_static_sweep).
 int run_static_sweep_command(const StaticSweepOptions& options, std::ostream& out);
 
 }  // namespace phri

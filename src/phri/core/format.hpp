@@ -1,0 +1,14 @@
+#pragma once
+// Numbers as text, one definition for tables, CSV files and messages.
+#include <string>
+
+namespace phri {
+
+/// `value` with `digits` decimals, as printf "%.*f" (format_fixed(x, 6) equals std::to_string(x)).
+std::string format_fixed(double value, int digits);
+
+/// `value` with up to `significant` significant digits, as printf "%.*g" (format_general(x, 6)
+/// equals what `std::ostream << x` writes with the default settings).
+std::string format_general(double value, int significant);
+
+}  // namespace phri
