@@ -1,5 +1,6 @@
-#include <phri/core/number_text.hpp>
 #include <phri/core/yaml_reader.hpp>
+
+#include <phri/core/format.hpp>
 
 #include <cmath>
 #include <filesystem>
@@ -13,7 +14,7 @@ namespace {
 constexpr int kMessageDigits = 10;
 
 std::string range_text(double min, double max) {
-  return "[" + format_number(min, kMessageDigits) + ", " + format_number(max, kMessageDigits) + "]";
+  return "[" + format_general(min, kMessageDigits) + ", " + format_general(max, kMessageDigits) + "]";
 }
 
 }  // namespace
@@ -131,7 +132,7 @@ double YamlReader::as_number(double min, double max) const {
   }
   if (!std::isfinite(value)) throw error("", "must be finite, got '" + node_.Scalar() + "'");
   if (value < min || value > max) {
-    throw error("", "must be in " + range_text(min, max) + ", got " + format_number(value, kMessageDigits));
+    throw error("", "must be in " + range_text(min, max) + ", got " + format_general(value, kMessageDigits));
   }
   return value;
 }

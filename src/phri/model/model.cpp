@@ -2,6 +2,7 @@
 #include <phri/model/model.hpp>
 
 #include <phri/core/error.hpp>
+#include <phri/core/format.hpp>
 
 #include <console_bridge/console.h>
 #include <urdf_parser/urdf_parser.h>
@@ -71,12 +72,6 @@ Eigen::Isometry3d to_isometry(const urdf::Pose& pose) {
 bool pose_is_finite(const urdf::Pose& p) {
   return finite(p.position.x) && finite(p.position.y) && finite(p.position.z) &&
          finite(p.rotation.x) && finite(p.rotation.y) && finite(p.rotation.z) && finite(p.rotation.w);
-}
-
-std::string fmt(double x) {
-  std::ostringstream s;
-  s << x;
-  return s.str();
 }
 
 bool is_movable(const urdf::Joint& joint) { return joint.type != urdf::Joint::FIXED; }
@@ -233,14 +228,14 @@ private:
       for (double v : values) {
         if (!finite(v)) fail(where + " <limit>", "values must be finite");
       }
-      if (limits->velocity < 0.0) fail(where + " <limit>", "velocity must be >= 0 (got " + fmt(limits->velocity) + ")");
-      if (limits->effort < 0.0) fail(where + " <limit>", "effort must be >= 0 (got " + fmt(limits->effort) + ")");
+      if (limits->velocity < 0.0) fail(where + " <limit>", "velocity must be >= 0 (got " + format_general(limits->velocity, 6) + ")");
+      if (limits->effort < 0.0) fail(where + " <limit>", "effort must be >= 0 (got " + format_general(limits->effort, 6) + ")");
       // URDF uses 0 for "not given" in practice; the controller configuration can set limits.
       if (limits->velocity > 0.0) joint.velocity_limit = limits->velocity;
       if (limits->effort > 0.0) joint.effort_limit = limits->effort;
       if (joint.type != JointType::kContinuous) {
         if (limits->lower > limits->upper) {
-          fail(where + " <limit>", "lower " + fmt(limits->lower) + " > upper " + fmt(limits->upper));
+          fail(where + " <limit>", "lower " + format_general(limits->lower, 6) + " > upper " + format_general(limits->upper, 6));
         }
         if (limits->lower < limits->upper) {
           joint.lower = limits->lower;
@@ -265,7 +260,7 @@ private:
     Eigen::Matrix3d tensor;
     tensor << in.ixx, in.ixy, in.ixz, in.ixy, in.iyy, in.iyz, in.ixz, in.iyz, in.izz;
     if (in.mass < 0.0 || (in.mass == 0.0 && !tensor.isZero(0.0))) {
-      fail(where, "mass must be positive (got " + fmt(in.mass) + ")");
+      fail(where, "mass must be positive (got " + format_general(in.mass, 6) + ")");
     }
     if (in.mass == 0.0) {
       if (body >= 0 && on_path_.count(link.name) && link.parent_joint && moves(*link.parent_joint)) {
@@ -289,13 +284,13 @@ private:
     const Eigen::Vector3d ev = eig.eigenvalues();  // ascending
     const double scale = std::max(ev.cwiseAbs().maxCoeff(), 1e-300);
     if (ev[0] <= 1e-12 * scale) {
-      fail(where, "inertia tensor is not positive definite (principal moments " + fmt(ev[0]) + ", " +
-                      fmt(ev[1]) + ", " + fmt(ev[2]) + ")");
+      fail(where, "inertia tensor is not positive definite (principal moments " + format_general(ev[0], 6) + ", " +
+                      format_general(ev[1], 6) + ", " + format_general(ev[2], 6) + ")");
     }
     // A physical body also satisfies the triangle inequality I1 + I2 >= I3.
     if (ev[0] + ev[1] < ev[2] * (1.0 - 1e-6)) {
-      fail(where, "inertia tensor violates the triangle inequality (principal moments " + fmt(ev[0]) +
-                      " + " + fmt(ev[1]) + " < " + fmt(ev[2]) + ")");
+      fail(where, "inertia tensor violates the triangle inequality (principal moments " + format_general(ev[0], 6) +
+                      " + " + format_general(ev[1], 6) + " < " + format_general(ev[2], 6) + ")");
     }
   }
 

@@ -1,5 +1,5 @@
 #include <phri/core/error.hpp>
-#include <phri/core/number_text.hpp>
+#include <phri/core/format.hpp>
 #include <phri/sim/mujoco_handles.hpp>
 #include <phri/sim/sim_scene.hpp>
 
@@ -13,7 +13,7 @@ namespace phri {
 namespace {
 
 // Digits that write a double back exactly.
-std::string num(double v) { return format_number(v, 17); }
+std::string num(double v) { return format_general(v, 17); }
 
 std::string vec(const Eigen::Vector3d& v) { return num(v.x()) + " " + num(v.y()) + " " + num(v.z()); }
 
