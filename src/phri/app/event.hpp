@@ -57,10 +57,7 @@ inline constexpr std::array<std::string_view, kEventCount> kEventNames = {
 
 constexpr int code(Event e) { return static_cast<int>(e); }
 
-constexpr std::string_view to_string(Event e) {
-  const int i = code(e);
-  return i >= 0 && i < kEventCount ? kEventNames[static_cast<std::size_t>(i)] : std::string_view("unknown");
-}
+constexpr std::string_view to_string(Event e) { return enum_name(e, kEventNames); }
 
 constexpr std::optional<Event> event_from_string(std::string_view name) { return enum_from_string<Event, kEventCount>(name); }
 

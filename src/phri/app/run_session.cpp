@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <numbers>
 #include <cstdio>
 #include <ostream>
 #include <string>
@@ -117,7 +118,7 @@ private:
   double accumulate_phase() {
     PhaseAccumulator& a = acc_[phase_];
     const Vector6d& error = cycle_.qp().end_effector().error();
-    const double pos = 1e3 * error.head<3>().norm(), ori = error.tail<3>().norm() * 180.0 / M_PI;
+    const double pos = 1e3 * error.head<3>().norm(), ori = error.tail<3>().norm() * 180.0 / std::numbers::pi;
     a.add(pos, ori, cycle_.wrench().norm());
     const ComplianceController& compliance = cycle_.compliance();
     if (compliance.mode() != last_mode_ || compliance.touch_count() != last_touches_) ++a.compliance_switches;

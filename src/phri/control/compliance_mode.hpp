@@ -16,15 +16,9 @@ enum class ComplianceMode {
 };
 inline constexpr int kComplianceModeCount = 4;
 
-constexpr std::string_view to_string(ComplianceMode mode) {
-  switch (mode) {
-    case ComplianceMode::kStiff: return "stiff";
-    case ComplianceMode::kNullSpace: return "null_space";
-    case ComplianceMode::kFullBody: return "full_body";
-    case ComplianceMode::kDual: return "dual";
-  }
-  return "unknown";
-}
+inline constexpr std::array<std::string_view, kComplianceModeCount> kComplianceModeNames = {"stiff", "null_space",
+                                                                                          "full_body", "dual"};
+constexpr std::string_view to_string(ComplianceMode mode) { return enum_name(mode, kComplianceModeNames); }
 
 constexpr std::optional<ComplianceMode> compliance_mode_from_string(std::string_view name) {
   return enum_from_string<ComplianceMode, kComplianceModeCount>(name);

@@ -50,13 +50,7 @@ WriteStatus FakeRobot::write(const RobotCommand& command) {
     ++refused_;
     state_.rejected_writes = refused_;
   } else {
-    command_.mode = command.mode;
-    switch (command.mode) {
-      case LowLevelMode::kPosition: command_.q_rad = command.q_rad; break;
-      case LowLevelMode::kKinovaTorque:
-      case LowLevelMode::kKinovaTorqueHighVelocity: command_.tau_Nm = command.tau_Nm; break;
-      case LowLevelMode::kCurrent: command_.current_A = command.current_A; break;
-    }
+    command_.copy_setpoint(command);
   }
   if (observer_) observer_(command, status);
   return status;

@@ -21,15 +21,9 @@ inline constexpr int kLowLevelModeCount = 4;
 
 constexpr bool is_valid(LowLevelMode mode) { return static_cast<int>(mode) < kLowLevelModeCount; }
 
-constexpr std::string_view to_string(LowLevelMode mode) {
-  switch (mode) {
-    case LowLevelMode::kPosition: return "position";
-    case LowLevelMode::kKinovaTorque: return "kinova_torque";
-    case LowLevelMode::kKinovaTorqueHighVelocity: return "kinova_torque_high_velocity";
-    case LowLevelMode::kCurrent: return "current";
-  }
-  return "invalid";
-}
+inline constexpr std::array<std::string_view, kLowLevelModeCount> kLowLevelModeNames = {
+    "position", "kinova_torque", "kinova_torque_high_velocity", "current"};
+constexpr std::string_view to_string(LowLevelMode mode) { return enum_name(mode, kLowLevelModeNames, "invalid"); }
 
 /// Parses the names of to_string. "custom" (the paper's custom torque loop, which drives the motor
 /// current) is accepted for kCurrent.

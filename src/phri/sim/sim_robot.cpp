@@ -82,17 +82,6 @@ RandomPushGenerator::LinkSurface capsule_surface(const mjModel* m, int body, int
   return s;
 }
 
-// The mode and the set-point that mode uses; the other set-points keep their values.
-void copy_setpoint(const RobotCommand& from, RobotCommand& to) {
-  to.mode = from.mode;
-  switch (from.mode) {
-    case LowLevelMode::kPosition: to.q_rad = from.q_rad; break;
-    case LowLevelMode::kKinovaTorque:
-    case LowLevelMode::kKinovaTorqueHighVelocity: to.tau_Nm = from.tau_Nm; break;
-    case LowLevelMode::kCurrent: to.current_A = from.current_A; break;
-  }
-}
-
 }  // namespace
 
 SimRobot::SimRobot(const SimRobotConfig& config)
@@ -411,7 +400,7 @@ WriteStatus SimRobot::write(const RobotCommand& command) {
     ++state_.rejected_writes;
     return status;
   }
-  copy_setpoint(command, pending_);
+  pending_.copy_setpoint(command);
   has_pending_ = true;
   return WriteStatus::kOk;
 }
@@ -423,7 +412,7 @@ const RobotState& SimRobot::read() {
   }
   const bool fresh = has_pending_;
   if (fresh) {
-    copy_setpoint(pending_, command_);
+    command_.copy_setpoint(pending_);
     has_pending_ = false;
   }
   drive_.begin_cycle(command_, fresh, q_meas_, vendor_torque());
