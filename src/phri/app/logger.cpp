@@ -90,7 +90,7 @@ std::string Logger::legend_yaml() {
     out += "  " + std::to_string(i) + ": " + std::string(kEventNames[static_cast<std::size_t>(i)]) + "\n";
   }
   legend_entry(out, "cycle_status", {CycleStatus::kOk, CycleStatus::kQpFallback, CycleStatus::kInvalidState,
-                                     CycleStatus::kStaleState});
+                                     CycleStatus::kStaleState, CycleStatus::kTargetsRejected});
   legend_entry(out, "controller_status", {WholeBodyQpStatus::kOk, WholeBodyQpStatus::kQpInfeasible,
                                           WholeBodyQpStatus::kQpIterationLimit, WholeBodyQpStatus::kQpFailed,
                                           WholeBodyQpStatus::kInvalidInput});

@@ -110,12 +110,39 @@ Controller::Controller(LoadedRobot robot, const ControllerSettings& settings)
       ft_fusion_(model_.nv(), settings.observer_gain, settings.period_s),
       no_targets_(model_.nv()) {}
 
-void Controller::apply(const ControllerTargets& targets) {
-  if (targets.stiffness_scale) compliance_.set_stiffness_scale(*targets.stiffness_scale, qp_);
-  if (targets.has_posture) qp_.posture().set_target(targets.posture.q, targets.posture.qd, targets.posture.qdd);
-  if (targets.has_pose) qp_.end_effector().set_target(targets.pose.pose, targets.pose.velocity, targets.pose.acceleration);
-  if (targets.compliance_mode) pending_mode_ = targets.compliance_mode;
-  if (targets.low_level_mode) low_level_.request(*targets.low_level_mode);
+namespace {
+bool usable(const PostureReference& r, int nv) {
+  return r.q.size() == nv && r.qd.size() == nv && r.qdd.size() == nv && r.q.allFinite() && r.qd.allFinite() &&
+         r.qdd.allFinite();
+}
+bool usable(const PoseReference& r) {
+  return r.pose.matrix().allFinite() && r.velocity.allFinite() && r.acceleration.allFinite();
+}
+}  // namespace
+
+// Each target is checked where it enters; a bad one is ignored (the previous one stays) and
+// counted, never passed on to the QP. Returns false when one was ignored.
+bool Controller::apply(const ControllerTargets& targets) {
+  const long rejected_before = rejected_targets_;
+  auto accept = [&](bool ok) {
+    if (!ok) ++rejected_targets_;
+    return ok;
+  };
+  if (targets.stiffness_scale && accept(*targets.stiffness_scale > 0.0 && std::isfinite(*targets.stiffness_scale))) {
+    compliance_.set_stiffness_scale(*targets.stiffness_scale, qp_);
+  }
+  if (targets.has_posture && accept(usable(targets.posture, model_.nv()))) {
+    qp_.posture().set_target(targets.posture.q, targets.posture.qd, targets.posture.qdd);
+  }
+  if (targets.has_pose && accept(usable(targets.pose))) {
+    qp_.end_effector().set_target(targets.pose.pose, targets.pose.velocity, targets.pose.acceleration);
+  }
+  if (targets.compliance_mode && accept(static_cast<int>(*targets.compliance_mode) >= 0 &&
+                                        static_cast<int>(*targets.compliance_mode) < kComplianceModeCount)) {
+    pending_mode_ = targets.compliance_mode;
+  }
+  if (targets.low_level_mode && accept(is_valid(*targets.low_level_mode))) low_level_.request(*targets.low_level_mode);
+  return rejected_targets_ == rejected_before;
 }
 
 bool Controller::state_usable(const RobotState& state) {
@@ -164,7 +191,7 @@ void Controller::select_external_torque() {
 }
 
 CycleStatus Controller::step(const RobotState& state, const ControllerTargets& targets, RobotCommand& command) {
-  apply(targets);
+  const bool targets_accepted = apply(targets);
   if (!state_usable(state)) {
     ++held_cycles_;
     // The previous command stays in `command`; before any, hold the measured pose if possible.
@@ -203,7 +230,9 @@ CycleStatus Controller::step(const RobotState& state, const ControllerTargets& t
   // ---- low level
   low_level_.update(state, qp_.desired_torque(), qp_.desired_acceleration(), command);
   have_command_ = true;
-  status_ = qp_status == WholeBodyQpStatus::kOk ? CycleStatus::kOk : CycleStatus::kQpFallback;
+  status_ = qp_status != WholeBodyQpStatus::kOk ? CycleStatus::kQpFallback
+            : targets_accepted                 ? CycleStatus::kOk
+                                               : CycleStatus::kTargetsRejected;
   return status_;
 }
 

@@ -35,6 +35,8 @@ enum class CycleStatus {
   kQpFallback,     ///< the QP failed; the brake of WholeBodyQp::fallback ran
   kInvalidState,   ///< non-finite or invalid joint/torque data: previous command held
   kStaleState,     ///< the joint data did not advance since the last cycle: previous command held
+  kTargetsRejected,  ///< the cycle ran, but a target was of the wrong size, non-finite or out of
+                     ///< range: that one was ignored, the previous one kept (rejected_targets())
 };
 constexpr std::string_view to_string(CycleStatus s) {
   switch (s) {
@@ -42,6 +44,7 @@ constexpr std::string_view to_string(CycleStatus s) {
     case CycleStatus::kQpFallback: return "qp_fallback";
     case CycleStatus::kInvalidState: return "invalid_state";
     case CycleStatus::kStaleState: return "stale_state";
+    case CycleStatus::kTargetsRejected: return "targets_rejected";
   }
   return "unknown";
 }
@@ -79,6 +82,8 @@ public:
   int sensor_frame() const { return sensor_frame_; }
   CycleStatus status() const { return status_; }
   long held_cycles() const { return held_cycles_; }
+  /// Targets ignored so far (wrong size, non-finite, stiffness scale not > 0).
+  long rejected_targets() const { return rejected_targets_; }
   const ControllerSettings& settings() const { return settings_; }
   bool started() const { return started_; }
   /// The wrench norm the dual-compliance trigger sees (low-passed).
@@ -94,7 +99,7 @@ private:
   static LoadedRobot load(const ControllerSettings& settings);
   Controller(LoadedRobot robot, const ControllerSettings& settings);
   static WholeBodyQpSettings qp_settings(const ControllerSettings& settings, const ActuatorTable& actuators);
-  void apply(const ControllerTargets& targets);
+  bool apply(const ControllerTargets& targets);
   bool state_usable(const RobotState& state);
   void estimate(const RobotState& state);
   void select_external_torque();
@@ -119,6 +124,7 @@ private:
   std::optional<ComplianceMode> pending_mode_;
   CycleStatus status_ = CycleStatus::kOk;
   long held_cycles_ = 0;
+  long rejected_targets_ = 0;
   Eigen::MatrixXd ee_jacobian_;              // 6 x nv, for J^T F
   Eigen::VectorXd ft_torque_, tau_ext_;
   LowPassFilter trigger_filter_;       // the wrench norm the dual-compliance trigger sees
