@@ -133,7 +133,7 @@ TEST(Logger, HeaderNamesEveryColumnOnce) {
 
 TEST(Logger, LegendNamesTheCodes) {
   const std::string legend = phri::Logger::legend_yaml();
-  for (const char* expected : {"compliance_mode:", "1: null_space", "low_level_loop:", "3: current", "event:",
+  for (const char* expected : {"compliance_mode:", "1: null_space", "low_level_loop:", "3: custom", "event:",
                                "-1: none", "3: dual_compliance", "cycle_status:", "qp_status:"}) {
     EXPECT_NE(legend.find(expected), std::string::npos) << expected;
   }

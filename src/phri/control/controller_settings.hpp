@@ -9,6 +9,7 @@
 #include <phri/lowlevel/low_level_controller.hpp>
 
 #include <phri/model/model.hpp>
+#include <phri/robot/paper_end_of_arm.hpp>
 
 #include <string>
 #include <vector>
@@ -28,22 +29,23 @@ struct ControllerSettings {
   std::string actuators_path;  ///< actuators.yaml: limits, rotor inertia, friction model
   std::string collision_path;  ///< collision.yaml; empty: no self-collision constraint
   std::string end_effector_frame = "end_effector_link";
-  /// F/T sensor measuring frame on the end-effector frame: offset along its z axis (paper setup:
-  /// adapter 0.03 m + Bota mounting-to-wrench 0.035 m).
-  double ft_sensor_offset_m = 0.065;
+  /// F/T sensor measuring frame on the end-effector frame: offset along its z axis (paper setup,
+  /// robot/paper_end_of_arm.hpp).
+  double ft_sensor_offset_m = PaperEndOfArm::kSensorOffset_m;
   /// What the arm carries beyond its URDF, in the end-effector frame (the paper's setup, as the
-  /// plant models it: configs/plant_gen3.yaml): F/T adapter + sensor 0.269 kg, tool 0.3 kg.
+  /// plant models it, robot/paper_end_of_arm.hpp): F/T adapter + sensor 0.269 kg, tool 0.3 kg.
   std::vector<Payload> payloads = default_payloads();
   static std::vector<Payload> default_payloads() {
-    Payload sensor{"ft_adapter_and_sensor", "", {}};
-    sensor.inertia.mass = 0.26931;
-    sensor.inertia.com = Eigen::Vector3d(0.0, 0.0, 0.03);
-    sensor.inertia.inertia_com = Eigen::Vector3d(2.0e-4, 2.0e-4, 2.2e-4).asDiagonal();
-    Payload tool{"tool", "", {}};
-    tool.inertia.mass = 0.3;
-    tool.inertia.com = Eigen::Vector3d(0.0, 0.0, 0.065 + 0.05);
-    tool.inertia.inertia_com = Eigen::Vector3d(3.4e-4, 7.3e-4, 8.9e-4).asDiagonal();
-    return {sensor, tool};
+    auto payload = [](const char* name, const RigidBodyData& body, double offset_z_m) {
+      Payload p{name, "", {}};
+      p.inertia.mass = body.mass_kg;
+      p.inertia.com = body.com_m + Eigen::Vector3d(0.0, 0.0, offset_z_m);
+      p.inertia.inertia_com = body.principal_inertia_kgm2.asDiagonal();
+      return p;
+    };
+    // The tool's COM is given below the sensor: shift it by the sensor's offset.
+    return {payload("ft_adapter_and_sensor", PaperEndOfArm::ft_adapter_and_sensor(), 0.0),
+            payload("tool", PaperEndOfArm::tool(), PaperEndOfArm::kSensorOffset_m)};
   }
   double period_s = 1e-3;
   /// Momentum observer bandwidth K_O [rad/s]. The paper's code uses 10; 50 follows a push 5x

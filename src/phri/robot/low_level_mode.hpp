@@ -14,21 +14,23 @@ enum class LowLevelMode : std::uint8_t {
   kPosition = 0,                  ///< joint position servo on q_des (the vendor's stiff position loop)
   kKinovaTorque = 1,              ///< vendor torque loop with velocity negative feedback on tau_des
   kKinovaTorqueHighVelocity = 2,  ///< vendor torque loop: tau_des + H(z)(tau_des - tau_sensor)
-  kCurrent = 3,                   ///< raw motor current i_des (what a custom torque controller drives)
+  kCurrent = 3,                   ///< raw motor current i_des: the drives in current mode, driven by
+                                  ///< the paper's custom torque loop (named "custom")
 };
 
 inline constexpr int kLowLevelModeCount = 4;
 
 constexpr bool is_valid(LowLevelMode mode) { return static_cast<int>(mode) < kLowLevelModeCount; }
 
+/// The names users see (configurations, events, logs, experiment files): kCurrent is the paper's
+/// "custom" torque loop.
 inline constexpr std::array<std::string_view, kLowLevelModeCount> kLowLevelModeNames = {
-    "position", "kinova_torque", "kinova_torque_high_velocity", "current"};
+    "position", "kinova_torque", "kinova_torque_high_velocity", "custom"};
 constexpr std::string_view to_string(LowLevelMode mode) { return enum_name(mode, kLowLevelModeNames, "invalid"); }
 
-/// Parses the names of to_string. "custom" (the paper's custom torque loop, which drives the motor
-/// current) is accepted for kCurrent.
+/// Parses the names of to_string; "current" (Kortex's name of the drive mode) is accepted for kCurrent.
 constexpr std::optional<LowLevelMode> low_level_mode_from_string(std::string_view name) {
-  if (name == "custom") return LowLevelMode::kCurrent;
+  if (name == "current") return LowLevelMode::kCurrent;
   return enum_from_string<LowLevelMode, kLowLevelModeCount>(name);
 }
 

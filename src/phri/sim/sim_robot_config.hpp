@@ -15,6 +15,7 @@
 // perturbs the plant's link inertials relative to the URDF (model mismatch).
 #include <phri/core/error.hpp>
 #include <phri/robot/actuator_table.hpp>
+#include <phri/robot/paper_end_of_arm.hpp>
 #include <phri/sim/external_force.hpp>
 #include <phri/sim/random_push_settings.hpp>
 
@@ -93,10 +94,10 @@ struct SimRobotConfig {
   // ---- F/T sensor between the flange and the tool
   struct FtSensor {
     std::string flange_site = "end_effector";  ///< MJCF site of the tool flange (z out of the flange)
-    double sensor_offset_m = 0.065;            ///< flange -> sensor measuring frame, along flange z
-    double flange_side_mass_kg = 0.26931;      ///< adapter + sensor body, not measured by the sensor
-    Eigen::Vector3d flange_side_com_m = Eigen::Vector3d(0.0, 0.0, 0.03);       ///< flange frame
-    Eigen::Vector3d flange_side_inertia_kgm2 = Eigen::Vector3d(2.0e-4, 2.0e-4, 2.2e-4);
+    double sensor_offset_m = PaperEndOfArm::kSensorOffset_m;  ///< flange -> sensor measuring frame, along flange z
+    double flange_side_mass_kg = PaperEndOfArm::ft_adapter_and_sensor().mass_kg;  ///< not measured by the sensor
+    Eigen::Vector3d flange_side_com_m = PaperEndOfArm::ft_adapter_and_sensor().com_m;  ///< flange frame
+    Eigen::Vector3d flange_side_inertia_kgm2 = PaperEndOfArm::ft_adapter_and_sensor().principal_inertia_kgm2;
     double rate_Hz = 1000.0;
     double force_std_N = 0.05;
     double torque_std_Nm = 0.002;
@@ -106,9 +107,9 @@ struct SimRobotConfig {
 
   // ---- the tool below the F/T sensor (DS4 gamepad and its mount by default)
   struct Tool {
-    double mass_kg = 0.3;
-    Eigen::Vector3d com_m = Eigen::Vector3d(0.0, 0.0, 0.05);  ///< sensor frame
-    Eigen::Vector3d inertia_kgm2 = Eigen::Vector3d(3.4e-4, 7.3e-4, 8.9e-4);  ///< principal, sensor axes
+    double mass_kg = PaperEndOfArm::tool().mass_kg;
+    Eigen::Vector3d com_m = PaperEndOfArm::tool().com_m;  ///< sensor frame
+    Eigen::Vector3d inertia_kgm2 = PaperEndOfArm::tool().principal_inertia_kgm2;  ///< principal, sensor axes
   } tool;
 
   // ---- link inertial and drive-gain mismatch relative to the URDF and actuators.yaml
