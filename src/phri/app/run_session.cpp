@@ -7,8 +7,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <numbers>
 #include <cstdio>
+#include <numbers>
 #include <ostream>
 #include <string>
 #include <string_view>
