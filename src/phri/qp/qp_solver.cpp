@@ -78,7 +78,7 @@ void columns_axpy(const double* m, Index ld, Index rows, Index cols, const doubl
 
 // x * 0 is 0 for finite x and NaN otherwise, and a sum of zeros and NaNs is NaN in any order:
 // four partial sums let the compiler vectorise the check.
-[[gnu::always_inline]] inline bool all_finite(const double* p, Index n) {
+[[gnu::always_inline]] inline bool all_finite(const double* __restrict p, Index n) {
   return sum4(n, [p](Index i) { return p[i] * 0.0; }) == 0.0;
 }
 
