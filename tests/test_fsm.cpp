@@ -20,6 +20,8 @@
 #include "hand_push.hpp"
 #include "temp_dir.hpp"
 
+#include "gen3_settings.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -41,16 +43,6 @@ const std::string kRoot = PHRI_SOURCE_DIR;
 // 1 at 1 ms): samples are taken by cycle index, exactly once, not by comparing floating-point times.
 constexpr std::uint64_t cycle_at(double t) { return static_cast<std::uint64_t>(t * 1000.0 + 0.5); }
 
-phri::ControllerSettings cycle_settings() {
-  phri::ControllerSettings s;
-  s.urdf_path = kRoot + "/robots/kinova_gen3/gen3.urdf";
-  s.actuators_path = kRoot + "/robots/kinova_gen3/actuators.yaml";
-  s.collision_path = kRoot + "/robots/kinova_gen3/collision.yaml";
-  s.initial_compliance = phri::ComplianceMode::kNullSpace;
-  s.initial_loop = phri::LowLevelMode::kPosition;
-  return s;
-}
-
 phri::SimRobotConfig plant(std::vector<phri::ExternalForce> pushes = {}) {
   phri::SimRobotConfig c = phri::SimRobotConfig::from_yaml_file(kRoot + "/configs/plant_gen3.yaml");
   c.mismatch.enabled = true;
@@ -66,7 +58,7 @@ struct Transition {
 class Rig {
 public:
   explicit Rig(phri::FsmSettings settings, std::vector<phri::ExternalForce> pushes = {})
-      : robot_(plant(std::move(pushes))), cycle_(cycle_settings()), fsm_(settings, cycle_), command_(7) {}
+      : robot_(plant(std::move(pushes))), cycle_(phri::test::gen3_controller_settings()), fsm_(settings, cycle_), command_(7) {}
 
   // Runs `seconds`; `each` after every cycle.
   void run(double seconds, const std::function<void()>& each = {}) {
@@ -373,7 +365,7 @@ TEST(Fsm, StartupTimesOutAndStillHandsOver) {
 }
 
 TEST(Fsm, BadSettingsAreConfigErrorsNamingTheKey) {
-  phri::Controller cycle(cycle_settings());
+  phri::Controller cycle(phri::test::gen3_controller_settings());
   // Building an Fsm from the default settings changed by `edit`, as a callable for expect_config_error.
   const auto building = [&](const std::function<void(phri::FsmSettings&)>& edit) {
     return [&cycle, edit] {

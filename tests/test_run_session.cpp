@@ -20,6 +20,8 @@
 
 #include "temp_dir.hpp"
 
+#include "gen3_settings.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -33,16 +35,6 @@ namespace {
 
 const std::string kRoot = PHRI_SOURCE_DIR;
 const std::string kGen3 = kRoot + "/robots/kinova_gen3/";
-
-phri::ControllerSettings gen3_settings() {
-  phri::ControllerSettings s;
-  s.urdf_path = kGen3 + "gen3.urdf";
-  s.actuators_path = kGen3 + "actuators.yaml";
-  s.collision_path = kGen3 + "collision.yaml";
-  s.initial_compliance = phri::ComplianceMode::kNullSpace;
-  s.initial_loop = phri::LowLevelMode::kPosition;
-  return s;
-}
 
 // The plant's home posture (configs/plant_gen3.yaml, initial.q_rad), the start-up's starting point.
 Eigen::VectorXd plant_home() {
@@ -75,7 +67,7 @@ int count(const std::string& text, const std::string& needle) {
 class Session {
  public:
   explicit Session(phri::FsmSettings fsm_settings = {})
-      : controller_(gen3_settings()), fsm_(fsm_settings, controller_) {
+      : controller_(phri::test::gen3_controller_settings()), fsm_(fsm_settings, controller_) {
     robot_.set_write_observer([this](const phri::RobotCommand& command, phri::WriteStatus status) {
       statuses_.push_back(status);
       positions_.push_back(command.q_rad);

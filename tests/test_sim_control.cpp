@@ -11,6 +11,8 @@
 #include "allocation_counter.hpp"
 #include "hand_push.hpp"
 
+#include "gen3_settings.hpp"
+
 #include <gtest/gtest.h>
 
 #include <functional>
@@ -37,13 +39,7 @@ public:
     return c;
   }
   static phri::ControllerSettings make_settings(phri::ComplianceMode mode, phri::LowLevelMode loop) {
-    phri::ControllerSettings s;
-    s.urdf_path = kRoot + "/robots/kinova_gen3/gen3.urdf";
-    s.actuators_path = kRoot + "/robots/kinova_gen3/actuators.yaml";
-    s.collision_path = kRoot + "/robots/kinova_gen3/collision.yaml";
-    s.initial_compliance = mode;
-    s.initial_loop = loop;
-    return s;
+    return phri::test::gen3_controller_settings(mode, loop);
   }
 
   void run(double seconds, const std::function<void()>& each = {}) {
