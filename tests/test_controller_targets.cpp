@@ -3,10 +3,13 @@
 // in the cycle it is given; a target of the wrong size, non-finite or out of range is ignored
 // (the previous one kept), counted and reported in the cycle's status, and never reaches the QP.
 // Driven on FakeRobot (position servo, no MuJoCo).
+#include <phri/app/fsm.hpp>
 #include <phri/control/controller.hpp>
 #include <phri/robot/fake_robot.hpp>
 
 #include "allocation_counter.hpp"
+
+#include "gen3_settings.hpp"
 
 #include <gtest/gtest.h>
 
@@ -15,25 +18,15 @@
 
 namespace {
 
-const std::string kGen3 = std::string(PHRI_SOURCE_DIR) + "/robots/kinova_gen3/";
-
 class ControllerTargetsTest : public ::testing::Test {
 protected:
-  ControllerTargetsTest() : controller_(settings()), targets_(7), command_(7) {
+  ControllerTargetsTest() : controller_(phri::test::gen3_controller_settings()), targets_(7), command_(7) {
     Eigen::VectorXd q(7);
     q << 0.0, 0.58, 3.14, -1.84, 0.0, 0.85, 1.57;
     phri::FakeRobotSettings s;
     s.initial_q_rad = q;
     robot_.emplace(s);
     step();  // the first cycle takes the arm's pose as the targets
-  }
-  static phri::ControllerSettings settings() {
-    phri::ControllerSettings s;
-    s.urdf_path = kGen3 + "gen3.urdf";
-    s.actuators_path = kGen3 + "actuators.yaml";
-    s.collision_path = kGen3 + "collision.yaml";
-    s.initial_loop = phri::LowLevelMode::kPosition;
-    return s;
   }
   phri::CycleStatus step() {
     const phri::CycleStatus status = controller_.step(robot_->read(), targets_, command_);
@@ -108,6 +101,20 @@ TEST_F(ControllerTargetsTest, BadTargetsAreIgnoredCountedAndReportedWithoutAlloc
   EXPECT_EQ(controller_.low_level().loop(), phri::LowLevelMode::kPosition);
   EXPECT_TRUE(command_.q_rad.allFinite());
   EXPECT_EQ(step(), phri::CycleStatus::kOk);  // and the next good cycle is ok again
+}
+
+TEST_F(ControllerTargetsTest, StiffnessEventsInOneCycleActAsIfHandledOneByOne) {
+  // Seven presses up saturate the scale at 4 (1.25^7 = 4.77); one press down then gives 4 / 1.25,
+  // as it would over eight cycles, though all reach the FSM in the same period (unclamped, the
+  // presses would give 1.25^6 = 3.81).
+  phri::FsmSettings settings;
+  settings.startup.enabled = false;
+  phri::Fsm fsm(settings, controller_);
+  for (int k = 0; k < 7; ++k) fsm.post(phri::Event::kStiffnessUp);
+  fsm.post(phri::Event::kStiffnessDown);
+  const phri::RobotState& state = robot_->read();
+  controller_.step(state, fsm.update(state.time_s, state, controller_), command_);
+  EXPECT_DOUBLE_EQ(controller_.compliance().stiffness_scale(), 4.0 / 1.25);
 }
 
 }  // namespace

@@ -194,10 +194,12 @@ void Fsm::handle(Event event, double t, const RobotState& /*state*/, const Contr
       stop_requested_ = true;
       return;
     case Event::kStiffnessUp:
-      targets_.stiffness_scale = stiffness_scale(cycle) * settings_.stiffness_step;
+      targets_.stiffness_scale =
+          ComplianceController::clamped_stiffness_scale(stiffness_scale(cycle) * settings_.stiffness_step);
       return;
     case Event::kStiffnessDown:
-      targets_.stiffness_scale = stiffness_scale(cycle) / settings_.stiffness_step;
+      targets_.stiffness_scale =
+          ComplianceController::clamped_stiffness_scale(stiffness_scale(cycle) / settings_.stiffness_step);
       return;
     default: return;
   }

@@ -71,7 +71,7 @@ void ComplianceController::set_mode(ComplianceMode mode, WholeBodyQp& qp, const 
 }
 
 void ComplianceController::set_stiffness_scale(double scale, WholeBodyQp& qp) {
-  stiffness_scale_ = std::clamp(scale, 0.1, 4.0);
+  stiffness_scale_ = clamped_stiffness_scale(scale);
   apply(qp);
 }
 

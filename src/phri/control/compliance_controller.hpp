@@ -10,6 +10,8 @@
 #include <phri/control/compliance_mode.hpp>
 #include <phri/control/whole_body_qp.hpp>
 
+#include <algorithm>
+
 namespace phri {
 
 struct ComplianceSettings {
@@ -49,6 +51,8 @@ public:
   int touch_count() const { return touch_count_; }
   const ComplianceSettings& settings() const { return settings_; }
   void set_stiffness_scale(double scale, WholeBodyQp& qp);  ///< live stiffness up/down (gamepad)
+  /// The scale set_stiffness_scale keeps: clamped to [0.1, 4].
+  static double clamped_stiffness_scale(double scale) { return std::clamp(scale, 0.1, 4.0); }
   double stiffness_scale() const { return stiffness_scale_; }
 
 private:
