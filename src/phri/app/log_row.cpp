@@ -48,6 +48,8 @@ void fill_log_row(LogRow& row, const RobotState& state, const Controller& cycle)
   row.touched = cycle.compliance().touched() ? 1 : 0;
   row.low_level_loop = static_cast<std::int32_t>(cycle.low_level().loop());
   row.cycle_status = static_cast<std::int32_t>(cycle.status());
+  row.safety_state = static_cast<std::int32_t>(cycle.supervisor().state());
+  row.safety_fault = static_cast<std::int32_t>(cycle.supervisor().sample_fault());
   row.controller_status = static_cast<std::int32_t>(qp.status());
   row.qp_status = static_cast<std::int32_t>(qp.qp_status());
   row.qp_iterations = qp.qp_iterations();

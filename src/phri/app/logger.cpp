@@ -90,7 +90,12 @@ std::string Logger::legend_yaml() {
     out += "  " + std::to_string(i) + ": " + std::string(kEventNames[static_cast<std::size_t>(i)]) + "\n";
   }
   legend_entry(out, "cycle_status", {CycleStatus::kOk, CycleStatus::kQpFallback, CycleStatus::kInvalidState,
-                                     CycleStatus::kStaleState, CycleStatus::kTargetsRejected});
+                                     CycleStatus::kStaleState, CycleStatus::kTargetsRejected, CycleStatus::kSafeStop});
+  legend_entry(out, "safety_state", {SupervisorState::kNormal, SupervisorState::kDegraded, SupervisorState::kSafeStop});
+  out += "safety_fault:\n";
+  for (int f = 0; f <= static_cast<int>(SafetyFault::kFollowingError); ++f) {
+    out += "  " + std::to_string(f) + ": " + std::string(to_string(static_cast<SafetyFault>(f))) + "\n";
+  }
   legend_entry(out, "controller_status", {WholeBodyQpStatus::kOk, WholeBodyQpStatus::kQpInfeasible,
                                           WholeBodyQpStatus::kQpIterationLimit, WholeBodyQpStatus::kQpFailed,
                                           WholeBodyQpStatus::kInvalidInput});

@@ -20,6 +20,8 @@
 namespace phri {
 namespace {
 
+constexpr std::uint64_t kMaxPrintedTransitions = 20;
+
 // The sums of one phase, for its row of the summary table.
 struct PhaseAccumulator {
   double pos_max = 0, pos_sq = 0, ori_max = 0, ori_sq = 0, wrench_max = 0;
@@ -71,7 +73,7 @@ public:
       enter_phases(t, k);
       const CycleStatus status = control_cycle(state, k);
       const double pos = accumulate_phase();
-      check_sensor_data(status, t);
+      check_safety(status);
       check_overruns(clock_.wait_next(), t);
       print_status(t, pos, micros_[k]);
       if (fsm_.finished()) {
@@ -105,7 +107,13 @@ private:
     const CycleStatus status = cycle_.step(state, fsm_.update(state.time_s, state, cycle_), command_);
     const double us = std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count();
     micros_[k] = us;
-    robot_.write(command_);
+    // A refused command leaves the robot on its previous one (a stale torque, a set-point it may
+    // not reach): a fault the controller acts on, a safe stop from the next cycle.
+    const WriteStatus written = robot_.write(command_);
+    if (written != WriteStatus::kOk) {
+      ++summary_.refused_writes;
+      cycle_.report_fault(SafetyFault::kWriteRefused, state.time_s);
+    }
     if (logger_) {
       fill_log_row(row_, state, cycle_, fsm_);
       row_.cycle_time_s = 1e-6 * us;
@@ -129,10 +137,32 @@ private:
     return pos;
   }
 
-  // Stale or invalid sensor data: brake to rest and hold.
-  void check_sensor_data(CycleStatus status, double t) {
-    if (summary_.safe_hold || (status != CycleStatus::kStaleState && status != CycleStatus::kInvalidState)) return;
-    safe_hold(std::string("sensor data ") + std::string(to_string(status)) + " at t = " + std::to_string(t) + " s");
+  // Every supervisor transition is shown (the first kMaxPrintedTransitions; all are counted and
+  // logged); a safe stop also stops the FSM (its references brake to rest) and ends the run.
+  void check_safety(CycleStatus status) {
+    const StateSupervisor& supervisor = cycle_.supervisor();
+    if (supervisor.transition_count() != summary_.safety_transitions) {
+      summary_.safety_transitions = supervisor.transition_count();
+      if (supervisor.state() == SupervisorState::kDegraded) ++summary_.degraded_spells;
+      if (summary_.safety_transitions <= kMaxPrintedTransitions) {
+        out_ << "phri: safety: " << describe(supervisor.last_transition()) << "\n";
+        if (summary_.safety_transitions == kMaxPrintedTransitions) out_ << "phri: safety: further transitions are only logged\n";
+      }
+    }
+    if (summary_.safe_hold || status != CycleStatus::kSafeStop) return;
+    safe_hold("safety: " + describe(supervisor.safe_stop_transition()));
+  }
+
+  static std::string describe(const SafetyTransition& tr) {
+    std::string text = std::string(to_string(tr.from)) + " -> " + std::string(to_string(tr.to));
+    if (tr.reason != SafetyFault::kNone) {
+      text += " (" + std::string(to_string(tr.reason));
+      if (tr.joint >= 0) text += ", joint " + std::to_string(tr.joint + 1);
+      text += ")";
+    }
+    char at[48];
+    std::snprintf(at, sizeof at, " at t = %.3f s", tr.time_s);
+    return text + at;
   }
 
   // Two overruns of the period in a row (`late` > 0: this cycle overran): brake to rest and hold.
@@ -147,7 +177,7 @@ private:
     summary_.safe_hold = true;
     summary_.safe_hold_reason = std::move(reason);
     fsm_.post(Event::kStop);
-    out_ << "phri: SAFE HOLD: " << summary_.safe_hold_reason << "; braking to rest\n";
+    out_ << "phri: SAFE HOLD: " << summary_.safe_hold_reason << "; braking to rest, then the robot's position hold\n";
   }
 
   // ~5 Hz on a terminal (one refreshed line), every 5 s otherwise.
@@ -173,7 +203,8 @@ private:
     summary_.simulated_s = static_cast<double>(cycles) * period_;
     summary_.overruns = clock_.overruns();
     summary_.held_cycles = cycle_.held_cycles();
-    for (std::size_t p = 0; p < phases_.size(); ++p) summary_.phases.push_back(phase_summary(p));
+    // Phases the run never reached (it ended or stopped first) are left out of the table.
+    for (std::size_t p = 0; p <= phase_; ++p) summary_.phases.push_back(phase_summary(p));
     const std::vector<double> all(micros_.begin(), micros_.begin() + static_cast<std::ptrdiff_t>(cycles));
     summary_.cycle_median_us = percentile(all, 0.5);
     summary_.cycle_p99_us = percentile(all, 0.99);
@@ -185,7 +216,7 @@ private:
     PhaseSummary s;
     s.name = phases_[p].name;
     s.start_s = phases_[p].start_s;
-    s.end_s = p + 1 < phases_.size() ? phases_[p + 1].start_s : summary_.simulated_s;
+    s.end_s = p + 1 < phases_.size() ? std::min(phases_[p + 1].start_s, summary_.simulated_s) : summary_.simulated_s;
     const PhaseAccumulator& a = acc_[p];
     if (a.n == 0) return s;
     s.ee_position_error_max_mm = a.pos_max;
@@ -235,12 +266,13 @@ RunSummary run_session(RobotInterface& robot, Controller& cycle, Fsm& fsm, Gamep
 }
 
 void print_run_summary(const RunSummary& s, std::ostream& out) {
-  char line[400];
+  char line[700];
   std::snprintf(line, sizeof line,
                 "%llu cycles, %.1f s simulated in %.1f s of wall time; controller cycle: median %.1f us, p99 %.1f us, "
-                "p99.9 %.1f us, max %.1f us; %llu overruns; %ld held cycles%s\n\n",
+                "p99.9 %.1f us, max %.1f us; %llu overruns; %ld held cycles; %llu degraded spells; %llu refused writes%s\n\n",
                 static_cast<unsigned long long>(s.cycles), s.simulated_s, s.wall_s, s.cycle_median_us, s.cycle_p99_us,
-                s.cycle_p999_us, s.cycle_max_us, static_cast<unsigned long long>(s.overruns), s.held_cycles,
+                s.cycle_p999_us, s.cycle_max_us, static_cast<unsigned long long>(s.overruns), s.held_cycles, static_cast<unsigned long long>(s.degraded_spells),
+                static_cast<unsigned long long>(s.refused_writes),
                 s.safe_hold ? (" ; SAFE HOLD: " + s.safe_hold_reason).c_str() : "");
   out << line;
   out << "| phase | from s | to s | EE pos max mm | EE pos RMS mm | EE ori max deg | EE ori RMS deg | wrench max | mode switches | loop switches | cycle median us | cycle p99.9 us |\n";

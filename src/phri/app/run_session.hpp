@@ -5,9 +5,11 @@
 // terminal, plain progress lines otherwise) and, at the end, cycle-time statistics and a table per
 // phase (phases are named spans of the run, e.g. the scripted demo's steps).
 //
-// Safety: two consecutive overruns of the real-time period, or stale/invalid sensor data (the
-// Controller holds the previous command then), post a stop to the FSM (brake to rest, hold) and
-// are reported once, clearly.
+// Safety: every transition of the controller's StateSupervisor is printed with its reason; a
+// refused write() is reported to the controller as a fault (safe stop). A safe stop, or two
+// consecutive overruns of the real-time period, post a stop to the FSM (brake to rest, hold) and
+// are reported once, clearly. Short sensor faults (a spike, a few missing frames) only degrade:
+// the controller holds the last good state, then resumes.
 #include <phri/control/controller.hpp>
 #include <phri/app/fsm.hpp>
 #include <phri/app/gamepad.hpp>
@@ -49,6 +51,9 @@ struct RunSummary {
   double cycle_median_us = 0.0, cycle_p99_us = 0.0, cycle_p999_us = 0.0, cycle_max_us = 0.0;
   std::uint64_t overruns = 0;
   long held_cycles = 0;
+  std::uint64_t refused_writes = 0;
+  std::uint64_t safety_transitions = 0;  ///< supervisor state changes
+  std::uint64_t degraded_spells = 0;     ///< entries into the degraded state
   bool safe_hold = false;
   std::string safe_hold_reason;
   std::vector<PhaseSummary> phases;

@@ -3,7 +3,9 @@
 #include <phri/core/error.hpp>
 #include <phri/model/algorithms.hpp>
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace phri {
 
@@ -61,9 +63,44 @@ const ActuatorTable& checked(const ActuatorTable& table, const Model& model, con
 
 const ControllerSettings& checked(const ControllerSettings& settings) {
   if (!(settings.period_s > 0)) throw ConfigError("ControllerSettings", "period_s", "must be > 0");
-  if (!(settings.observer_gain > 0)) throw ConfigError("ControllerSettings", "observer_gain", "must be > 0");
+  // The discrete observer r_k = K_O (p_k - p_0 - sum T (... + r_{k-1})) has the pole 1 - K_O T:
+  // unstable for K_O T >= 2, ringing above 1.
+  if (!(settings.observer_gain > 0 && settings.observer_gain * settings.period_s < 1.0)) {
+    throw ConfigError("ControllerSettings", "observer_gain",
+                      "must be > 0 and < 1 / period_s (" + std::to_string(1.0 / settings.period_s) +
+                          "): the discrete observer's pole 1 - K_O T must stay in (0, 1)");
+  }
+  const SafetySettings& safety = settings.safety;
+  if (!(safety.max_qp_fallback_s >= 0 && safety.brake_rate > 0 && safety.handover_speed_rad_s > 0 &&
+        safety.max_brake_s > 0 && safety.velocity_guard_fraction > 0 && safety.velocity_guard_fraction <= 1.5 &&
+        safety.velocity_guard_rate >= 0 && safety.limit_guard_stiffness_Nm_per_rad >= 0 &&
+        safety.external_torque_bound_factor > 0)) {
+    throw ConfigError("ControllerSettings", "safety", "rates, speeds and times must be > 0 (guard fraction <= 1.5)");
+  }
   if (!(settings.wrench_trigger_filter_s >= 0)) throw ConfigError("ControllerSettings", "wrench_trigger_filter_s", "must be >= 0");
   return settings;
+}
+
+// What the drives and sensors can report: the URDF range, the drives' limits.
+SensorRanges sensor_ranges(const Model& model, const ActuatorTable& actuators) {
+  const int n = model.nv();
+  SensorRanges r{model.lower_limits(), model.upper_limits(), Eigen::VectorXd(n), Eigen::VectorXd(n), Eigen::VectorXd(n)};
+  for (int i = 0; i < n; ++i) {
+    if (!model.joint(i).has_position_limits()) {
+      r.q_lower[i] = -std::numeric_limits<double>::infinity();
+      r.q_upper[i] = std::numeric_limits<double>::infinity();
+    }
+    r.velocity_limit[i] = actuators[i].velocity_limit_rad_s;
+    r.torque_range[i] = std::max(actuators[i].max_motor_torque_Nm(), actuators[i].torque_limit_Nm);
+    r.current_range[i] = actuators[i].current_limit_A;
+  }
+  return r;
+}
+
+SupervisorSettings supervisor_settings(const ControllerSettings& settings) {
+  SupervisorSettings s = settings.safety.supervisor;
+  s.period_s = settings.period_s;
+  return s;
 }
 
 CustomTorqueSettings custom_torque_settings(const ControllerSettings& settings) {
@@ -99,6 +136,7 @@ Controller::Controller(LoadedRobot robot, const ControllerSettings& settings)
       observer_(model_, settings.observer_gain),
       wrench_(settings.wrench),
       low_level_(actuators_, custom_torque_settings(settings), settings.initial_loop),
+      supervisor_(sensor_ranges(model_, actuators_), supervisor_settings(settings)),
       end_effector_frame_(model_.frame_id(settings.end_effector_frame)),
       sensor_frame_(model_.frame_id("ft_sensor")),
       q_(Eigen::VectorXd::Zero(model_.nq())),
@@ -108,7 +146,23 @@ Controller::Controller(LoadedRobot robot, const ControllerSettings& settings)
       tau_ext_(Eigen::VectorXd::Zero(model_.nv())),
       trigger_filter_(settings.wrench_trigger_filter_s, settings.period_s),
       ft_fusion_(model_.nv(), settings.observer_gain, settings.period_s),
-      no_targets_(model_.nv()) {}
+      no_targets_(model_.nv()),
+      hold_q_(Eigen::VectorXd::Zero(model_.nv())),
+      brake_q_(Eigen::VectorXd::Zero(model_.nv())),
+      brake_qd_(Eigen::VectorXd::Zero(model_.nv())),
+      brake_tau_(Eigen::VectorXd::Zero(model_.nv())),
+      guarded_tau_(Eigen::VectorXd::Zero(model_.nv())),
+      limit_lower_(supervisor_.ranges().q_lower),
+      limit_upper_(supervisor_.ranges().q_upper),
+      torque_limit_(qp_.torque_limit()),
+      drive_velocity_limit_(supervisor_.ranges().velocity_limit),
+      reflected_inertia_(Eigen::VectorXd::Zero(model_.nv())),
+      static_friction_(Eigen::VectorXd::Zero(model_.nv())) {
+  for (int i = 0; i < model_.nv(); ++i) {
+    reflected_inertia_[i] = actuators_[i].reflected_inertia_kgm2;
+    static_friction_[i] = std::max(actuators_[i].friction.static_Nm, actuators_[i].friction.coulomb_Nm);
+  }
+}
 
 namespace {
 bool usable(const PostureReference& r, int nv) {
@@ -145,27 +199,12 @@ bool Controller::apply(const ControllerTargets& targets) {
   return rejected_targets_ == rejected_before;
 }
 
-bool Controller::state_usable(const RobotState& state) {
-  if (state.q_rad.size() != model_.nq() || state.qd_rad_s.size() != model_.nv() ||
-      state.tau_sensor_Nm.size() != model_.nv() || !state.joints.valid || !state.torque.valid ||
-      !state.q_rad.allFinite() || !state.qd_rad_s.allFinite() || !state.tau_sensor_Nm.allFinite() ||
-      !state.current_A.allFinite()) {
-    status_ = CycleStatus::kInvalidState;
-    return false;
-  }
-  if (started_ && state.joints.sequence == last_joint_sequence_) {
-    status_ = CycleStatus::kStaleState;
-    return false;
-  }
-  return true;
-}
-
 // Model terms, momentum observer, F/T wrench at the end effector.
-void Controller::estimate(const RobotState& state) {
+void Controller::estimate(const RobotState& state, double dt) {
   compute_all_terms(model_, data_, q_, qd_);
   coriolis_transpose_times_velocity(model_, data_);
-  observer_.update(data_, qd_, state.tau_sensor_Nm, settings_.period_s);
-  if (state.wrench.valid && state.wrench.sequence != last_wrench_sequence_) {
+  observer_.update(data_, qd_, state.tau_sensor_Nm, dt);
+  if (state.wrench.valid && state.wrench.sequence != last_wrench_sequence_ && state.wrench_sensor.allFinite()) {
     last_wrench_sequence_ = state.wrench.sequence;
     const Eigen::Isometry3d& sensor = data_.frame_placements[static_cast<std::size_t>(sensor_frame_)];
     const Eigen::Isometry3d& ee = data_.frame_placements[static_cast<std::size_t>(end_effector_frame_)];
@@ -190,21 +229,128 @@ void Controller::select_external_torque() {
   }
 }
 
+// Keeps the previous command while the supervisor holds the last good state (bounded: it turns
+// into a safe stop after max_degraded_s). Before any command: the robot's hold at the measured pose.
+void Controller::hold_previous(const RobotState& state, RobotCommand& command) {
+  ++held_cycles_;
+  const SafetyFault fault = supervisor_.sample_fault();
+  status_ = fault == SafetyFault::kStale || fault == SafetyFault::kStampFrozen || fault == SafetyFault::kFrozenValues
+                ? CycleStatus::kStaleState
+                : CycleStatus::kInvalidState;
+  if (!have_command_ && state.q_rad.size() == model_.nq() && state.q_rad.allFinite() &&
+      command.q_rad.size() == model_.nq()) {
+    command.mode = LowLevelMode::kPosition;
+    command.q_rad = state.q_rad;
+  }
+}
+
+// The latched safe stop. Position loop (or no command yet): the robot's position hold at once.
+// Torque and current loops: gravity compensation with joint damping on the last good velocity
+// (decaying at brake_rate while no good sample comes: a stale velocity is not repeated for ever),
+// then, at rest or after max_brake_s, the hand-over to the position hold at the measured pose.
+void Controller::safe_stop(bool sample_good, RobotCommand& command) {
+  status_ = CycleStatus::kSafeStop;
+  const SafetySettings& s = settings_.safety;
+  const RobotState& good = supervisor_.last_good();
+  cycles_since_good_ = sample_good ? 0 : cycles_since_good_ + 1;
+  if (safe_stop_cycles_++ == 0) {
+    holding_ = !have_command_ || low_level_.loop() == LowLevelMode::kPosition || !supervisor_.has_good();
+    hold_q_ = supervisor_.has_good() ? good.q_rad : q_;
+  }
+  if (holding_) {
+    low_level_.hold(hold_q_, command);
+    return;
+  }
+  const double age_s = static_cast<double>(cycles_since_good_) * settings_.period_s;
+  brake_q_ = good.q_rad;
+  brake_qd_ = std::exp(-s.brake_rate * age_s) * good.qd_rad_s;
+  const bool at_rest = brake_qd_.cwiseAbs().maxCoeff() < s.handover_speed_rad_s;
+  if (at_rest || static_cast<double>(safe_stop_cycles_) * settings_.period_s > s.max_brake_s) {
+    holding_ = true;
+    hold_q_ = brake_q_;
+    low_level_.hold(hold_q_, command);
+    return;
+  }
+  brake_tau_.setZero();  // zero velocity: data_.nonlinear_effects = g(q)
+  compute_all_terms(model_, data_, brake_q_, brake_tau_);
+  for (int i = 0; i < model_.nv(); ++i) {
+    const double inertia = data_.mass_matrix(i, i) + reflected_inertia_[i];
+    brake_tau_[i] = std::clamp(data_.nonlinear_effects[i] - s.brake_rate * inertia * brake_qd_[i], -torque_limit_[i],
+                               torque_limit_[i]);
+  }
+  low_level_.command_torque(brake_tau_, command);
+}
+
+// More than the joint's torque limit (times a factor) is not a push the controller can act on;
+// and within a joint's limit band, the component of tau_ext pointing away from the limit may be
+// the hard stop's reaction, not a hand: fed back, it would make tau_d press into the stop (the
+// observer then reads the stop's answer as a push, and so on). It is dropped there.
+void Controller::bound_external_torque() {
+  const WholeBodyQpSettings& qp = qp_.settings();
+  for (int i = 0; i < model_.nv(); ++i) {
+    const double bound = settings_.safety.external_torque_bound_factor * torque_limit_[i];
+    double t = std::clamp(tau_ext_[i], -bound, bound);
+    if (std::isfinite(limit_upper_[i])) {
+      const double band = qp.joint_influence_fraction * (limit_upper_[i] - limit_lower_[i]);
+      if (q_[i] > limit_upper_[i] - band) t = std::max(t, 0.0);
+      if (q_[i] < limit_lower_[i] + band) t = std::min(t, 0.0);
+    }
+    tau_ext_[i] = std::isfinite(t) ? t : 0.0;
+  }
+}
+
+// The last line behind the QP, on the torque: damping on the excess speed above
+// velocity_guard_fraction of the drive's limit, and beyond a limit's safety distance d_s an
+// outward torque of the joint's static friction plus a spring on the depth (the damper's
+// acceleration alone is below stiction, so a joint could rest there).
+void Controller::guard_torque(Eigen::VectorXd& tau) const {
+  const SafetySettings& s = settings_.safety;
+  for (int i = 0; i < model_.nv(); ++i) {
+    const double inertia = data_.mass_matrix(i, i) + reflected_inertia_[i];
+    const double guard_speed = s.velocity_guard_fraction * drive_velocity_limit_[i];
+    const double excess = std::abs(qd_[i]) - guard_speed;
+    if (excess > 0.0) tau[i] -= std::copysign(s.velocity_guard_rate * inertia * excess, qd_[i]);
+    const double above = q_[i] - qp_.safe_upper()[i], below = qp_.safe_lower()[i] - q_[i];
+    if (above > 0.0) tau[i] -= static_friction_[i] + s.limit_guard_stiffness_Nm_per_rad * above;
+    if (below > 0.0) tau[i] += static_friction_[i] + s.limit_guard_stiffness_Nm_per_rad * below;
+    tau[i] = std::clamp(tau[i], -torque_limit_[i], torque_limit_[i]);
+  }
+}
+
+// A QP that keeps failing leaves the arm on the fallback brake: after max_qp_fallback_s, a safe
+// stop. So does an invalid input (non-finite estimate), at once.
+void Controller::check_qp(WholeBodyQpStatus qp_status, double t) {
+  if (qp_status == WholeBodyQpStatus::kInvalidInput) {
+    supervisor_.report(SafetyFault::kQpFailure, t);
+    return;
+  }
+  qp_fallbacks_in_row_ = qp_status == WholeBodyQpStatus::kOk ? 0 : qp_fallbacks_in_row_ + 1;
+  if (static_cast<double>(qp_fallbacks_in_row_) * settings_.period_s > settings_.safety.max_qp_fallback_s) {
+    supervisor_.report(SafetyFault::kQpFailure, t);
+  }
+}
+
 CycleStatus Controller::step(const RobotState& state, const ControllerTargets& targets, RobotCommand& command) {
   const bool targets_accepted = apply(targets);
-  if (!state_usable(state)) {
-    ++held_cycles_;
-    // The previous command stays in `command`; before any, hold the measured pose if possible.
-    if (!have_command_ && state.q_rad.size() == model_.nq() && state.q_rad.allFinite()) {
-      command.mode = LowLevelMode::kPosition;
-      command.q_rad = state.q_rad;
-    }
+  const bool had_good = supervisor_.has_good();
+  const double previous_good_stamp = supervisor_.last_good_time();
+  const bool good = supervisor_.check(state);
+  if (supervisor_.safe_stop()) {
+    safe_stop(good, command);
     return status_;
   }
-  last_joint_sequence_ = state.joints.sequence;
+  if (!good) {
+    hold_previous(state, command);
+    return status_;
+  }
+  cycles_since_good_ = 0;
   q_ = state.q_rad;
   qd_ = state.qd_rad_s;
-  estimate(state);
+  // The observer integrates over the time since the last sample it saw (missed ones included).
+  const double dt = had_good ? std::clamp(state.joints.stamp_s - previous_good_stamp, settings_.period_s,
+                                          settings_.period_s + supervisor_.settings().max_degraded_s)
+                             : settings_.period_s;
+  estimate(state, dt);
 
   // ---- modes and targets
   if (!started_) {
@@ -219,16 +365,30 @@ CycleStatus Controller::step(const RobotState& state, const ControllerTargets& t
   // The trigger sees the wrench norm through a short low-pass (settings.wrench_trigger_filter_s):
   // single-sample spikes of the F/T signal (tool inertia during stick-slip jolts, noise) must not
   // free the end effector for a few milliseconds.
-  compliance_.update(trigger_filter_.update(wrench_.calibrated() ? wrench_.norm() : 0.0), qp_, data_);
+  // A median of the last three samples first: a single-sample spike of any size never passes.
+  const double norm = wrench_.calibrated() ? wrench_.norm() : 0.0;
+  const double a = trigger_history_[0], b = trigger_history_[1];
+  trigger_history_[0] = b;
+  trigger_history_[1] = norm;
+  const double median = std::max(std::min(a, b), std::min(std::max(a, b), norm));
+  compliance_.update(trigger_filter_.update(median), qp_, data_);
 
   // ---- QP and inverse dynamics. Under the robot's position loop the external torque is not fed
   // back: the stiff servo rejects it and the observer would only see servo effort.
   select_external_torque();
+  bound_external_torque();
   if (low_level_.requested() == LowLevelMode::kPosition) tau_ext_.setZero();
   const WholeBodyQpStatus qp_status = qp_.update(model_, data_, q_, qd_, tau_ext_, settings_.period_s);
+  check_qp(qp_status, state.time_s);
+  if (supervisor_.safe_stop()) {
+    safe_stop(true, command);
+    return status_;
+  }
 
-  // ---- low level
-  low_level_.update(state, qp_.desired_torque(), qp_.desired_acceleration(), command);
+  // ---- guards, low level
+  guarded_tau_ = qp_.desired_torque();
+  guard_torque(guarded_tau_);
+  low_level_.update(state, guarded_tau_, qp_.desired_acceleration(), command);
   have_command_ = true;
   status_ = qp_status != WholeBodyQpStatus::kOk ? CycleStatus::kQpFallback
             : targets_accepted                 ? CycleStatus::kOk

@@ -7,8 +7,17 @@
 //              -> LowLevelController -> RobotCommand
 //
 // Built from loaded objects (Model, ActuatorTable, CollisionModel) or from the files named in
-// ControllerSettings (ConfigError on bad input). step() allocates nothing and never throws. Invalid
-// or stale sensor data: the cycle holds (the previous command is kept) and says so in status().
+// ControllerSettings (ConfigError on bad input). step() allocates nothing and never throws.
+//
+// Safety (DESIGN.md: safe behaviour instead of a crash). Every sample passes the StateSupervisor
+// (safety/) first. An implausible or missing sample is never estimated from: the previous command
+// is kept for at most SupervisorSettings::max_degraded_s (status kInvalidState / kStaleState).
+// Beyond that, or on a fault found elsewhere (the QP failing for max_qp_fallback_s, a refused
+// write reported by the loop through report_fault(), a robot fault), a latched safe stop: in the
+// torque and current loops a joint-damping brake on gravity compensation from the last good
+// state, then the robot's position hold at the measured pose; in the position loop, the hold at
+// once. Behind the QP: tau_ext bounded (and a hard stop's reaction never read as a push), a
+// velocity guard and a limit guard on the torque.
 // Everything that changes the controller at run time arrives in ControllerTargets: the FSM, the
 // gamepad, a dashboard or a script never reach into its stages.
 #include <phri/control/controller_settings.hpp>
@@ -37,6 +46,7 @@ enum class CycleStatus {
   kStaleState,     ///< the joint data did not advance since the last cycle: previous command held
   kTargetsRejected,  ///< the cycle ran, but a target was of the wrong size, non-finite or out of
                      ///< range: that one was ignored, the previous one kept (rejected_targets())
+  kSafeStop,       ///< latched safe stop: braking, then holding (supervisor().safe_stop_transition())
 };
 constexpr std::string_view to_string(CycleStatus s) {
   switch (s) {
@@ -45,6 +55,7 @@ constexpr std::string_view to_string(CycleStatus s) {
     case CycleStatus::kInvalidState: return "invalid_state";
     case CycleStatus::kStaleState: return "stale_state";
     case CycleStatus::kTargetsRejected: return "targets_rejected";
+    case CycleStatus::kSafeStop: return "safe_stop";
   }
   return "unknown";
 }
@@ -64,6 +75,8 @@ public:
   /// One cycle: apply the targets, then estimate, QP, inverse dynamics, low level. The first
   /// usable state becomes the targets (hold where the arm is) before the given ones apply.
   CycleStatus step(const RobotState& state, const ControllerTargets& targets, RobotCommand& command);
+  /// A fault the caller found (e.g. WriteStatus != kOk from the robot): safe stop from the next step.
+  void report_fault(SafetyFault fault, double time_s) { supervisor_.report(fault, time_s); }
   /// One cycle with no new targets.
   CycleStatus step(const RobotState& state, RobotCommand& command) { return step(state, no_targets_, command); }
 
@@ -78,6 +91,9 @@ public:
   const WrenchEstimator& wrench() const { return wrench_; }
   const LowLevelController& low_level() const { return low_level_; }
   const ActuatorTable& actuators() const { return actuators_; }
+  const StateSupervisor& supervisor() const { return supervisor_; }
+  /// Whether the safe stop has handed over to the position hold (false: braking, or no safe stop).
+  bool holding() const { return holding_; }
   int end_effector_frame() const { return end_effector_frame_; }
   int sensor_frame() const { return sensor_frame_; }
   CycleStatus status() const { return status_; }
@@ -100,9 +116,13 @@ private:
   Controller(LoadedRobot robot, const ControllerSettings& settings);
   static WholeBodyQpSettings qp_settings(const ControllerSettings& settings, const ActuatorTable& actuators);
   bool apply(const ControllerTargets& targets);
-  bool state_usable(const RobotState& state);
-  void estimate(const RobotState& state);
+  void hold_previous(const RobotState& state, RobotCommand& command);
+  void safe_stop(bool sample_good, RobotCommand& command);
+  void estimate(const RobotState& state, double dt);
   void select_external_torque();
+  void bound_external_torque();
+  void guard_torque(Eigen::VectorXd& tau) const;
+  void check_qp(WholeBodyQpStatus qp_status, double t);
 
   ControllerSettings settings_;
   Model model_;
@@ -114,6 +134,7 @@ private:
   MomentumObserver observer_;
   WrenchEstimator wrench_;
   LowLevelController low_level_;
+  StateSupervisor supervisor_;
   int end_effector_frame_ = 0;
   int sensor_frame_ = 0;
   Eigen::VectorXd q_, qd_;
@@ -127,9 +148,17 @@ private:
   long rejected_targets_ = 0;
   Eigen::MatrixXd ee_jacobian_;              // 6 x nv, for J^T F
   Eigen::VectorXd ft_torque_, tau_ext_;
+  double trigger_history_[2] = {0.0, 0.0};  // the two previous wrench norms (median of three)
   LowPassFilter trigger_filter_;       // the wrench norm the dual-compliance trigger sees
   ComplementaryFilter ft_fusion_;      // observer (low) + J^T F/T (high), ExternalTorqueSource::kFused
   ControllerTargets no_targets_;
+  long qp_fallbacks_in_row_ = 0;
+  long cycles_since_good_ = 0;
+  long safe_stop_cycles_ = 0;
+  bool holding_ = false;
+  Eigen::VectorXd hold_q_, brake_q_, brake_qd_, brake_tau_, guarded_tau_;
+  Eigen::VectorXd limit_lower_, limit_upper_;       // URDF limits (±inf: continuous)
+  Eigen::VectorXd torque_limit_, drive_velocity_limit_, reflected_inertia_, static_friction_;
 };
 
 }  // namespace phri

@@ -10,6 +10,7 @@
 
 #include <phri/model/model.hpp>
 #include <phri/robot/paper_end_of_arm.hpp>
+#include <phri/safety/state_supervisor.hpp>
 
 #include <string>
 #include <vector>
@@ -22,6 +23,32 @@ enum class ExternalTorqueSource {
   kForceTorqueSensor, ///< J_ee^T of the F/T sensor's operator wrench only (the paper's static
                       ///< torque-tracking experiment: "the weight measured by the F/T sensor is compensated")
   kFused,             ///< the paper's code: observer + high-pass of J^T F/T (complementary filter, pole K_O)
+};
+
+/// What the controller does after the supervisor's plausibility checks: the guards behind the QP
+/// and the safe stop (Controller::step).
+struct SafetySettings {
+  SupervisorSettings supervisor;  ///< plausibility of every sample (period_s: the controller's)
+  /// [s] the QP may fall back to its brake this long in a row before a safe stop (a QP that stays
+  /// infeasible, e.g. a posture in collision, must not leave the arm on a fallback for ever).
+  double max_qp_fallback_s = 0.05;
+  /// [1/s] safe-stop brake: tau = g(q) - rate (M_ii + I_r) qd per joint, from the last good
+  /// velocity (decaying at this rate while no good sample comes).
+  double brake_rate = 20.0;
+  /// [rad/s] every joint slower than this: the brake hands over to the robot's position hold.
+  double handover_speed_rad_s = 0.02;
+  /// [s] longest brake before the hand-over, whatever the speed.
+  double max_brake_s = 1.0;
+  /// Velocity guard of the torque loops, the last line behind the QP's velocity constraint: above
+  /// guard_fraction x the drive's velocity limit, damping rate x (M_ii + I_r) x the excess.
+  double velocity_guard_fraction = 0.95;
+  double velocity_guard_rate = 200.0;  ///< [1/s]
+  /// Limit guard: beyond the damper's safety distance d_s, an outward torque of the joint's static
+  /// friction plus stiffness x the depth, so that a joint leaves the band against its stiction.
+  double limit_guard_stiffness_Nm_per_rad = 200.0;
+  /// |tau_ext| used by the QP is bounded by this factor x the joint's torque limit: more than the
+  /// arm can resist is not a push the controller can act on (a spike, a stop).
+  double external_torque_bound_factor = 1.5;
 };
 
 struct ControllerSettings {
@@ -64,6 +91,7 @@ struct ControllerSettings {
   double wrench_trigger_filter_s = 0.01;
   WrenchEstimatorSettings wrench;
   CustomTorqueSettings custom_torque;
+  SafetySettings safety;
   ComplianceMode initial_compliance = ComplianceMode::kNullSpace;
   LowLevelMode initial_loop = LowLevelMode::kCurrent;
 };

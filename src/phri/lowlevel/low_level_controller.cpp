@@ -8,17 +8,48 @@ constexpr double kTorqueBlendTime = 0.05;  // s
 }
 
 LowLevelController::LowLevelController(const ActuatorTable& actuators, const CustomTorqueSettings& custom,
-                                       LowLevelMode initial)
+                                       LowLevelMode initial, double following_error_rad)
     : custom_(actuators, custom),
       period_s_(custom.period_s),
       loop_(initial),
       requested_(initial),
+      following_error_rad_(following_error_rad),
       q_ref_(Eigen::VectorXd::Zero(actuators.size())),
       qd_ref_(Eigen::VectorXd::Zero(actuators.size())),
       torque_offset_(Eigen::VectorXd::Zero(actuators.size())),
       torque_per_amp_(Eigen::VectorXd::Zero(actuators.size())),
+      current_limit_(Eigen::VectorXd::Zero(actuators.size())),
+      entry_current_(Eigen::VectorXd::Zero(actuators.size())),
       offset_decay_(std::exp(-custom.period_s / kTorqueBlendTime)) {
-  for (int i = 0; i < actuators.size(); ++i) torque_per_amp_[i] = actuators[i].torque_per_amp();
+  for (int i = 0; i < actuators.size(); ++i) {
+    torque_per_amp_[i] = actuators[i].torque_per_amp();
+    current_limit_[i] = actuators[i].current_limit_A;
+  }
+}
+
+void LowLevelController::command_torque(const Eigen::VectorXd& tau, RobotCommand& command) {
+  switch (loop_) {
+    case LowLevelMode::kPosition: return;
+    case LowLevelMode::kKinovaTorque:
+    case LowLevelMode::kKinovaTorqueHighVelocity:
+      command.mode = loop_;
+      command.tau_Nm = tau;
+      return;
+    case LowLevelMode::kCurrent:
+      command.mode = loop_;
+      command.current_A = tau.cwiseQuotient(torque_per_amp_).cwiseMax(-current_limit_).cwiseMin(current_limit_);
+      return;
+  }
+}
+
+void LowLevelController::hold(const Eigen::VectorXd& q, RobotCommand& command) {
+  if (loop_ != LowLevelMode::kPosition) ++switches_;
+  loop_ = requested_ = LowLevelMode::kPosition;
+  started_ = true;
+  q_ref_ = q;
+  qd_ref_.setZero();
+  command.mode = LowLevelMode::kPosition;
+  command.q_rad = q_ref_;
 }
 
 void LowLevelController::update(const RobotState& state, const Eigen::VectorXd& tau_desired,
@@ -37,6 +68,13 @@ void LowLevelController::update(const RobotState& state, const Eigen::VectorXd& 
       // Semi-implicit Euler integration of the desired acceleration.
       qd_ref_ += period_s_ * qdd_desired;
       q_ref_ += period_s_ * qd_ref_;
+      // The integration is open loop: when the servo cannot follow (a push it cannot resist), the
+      // reference would run away. Re-sync to the arm before the robot's following-error fault.
+      if ((q_ref_ - state.q_rad).cwiseAbs().maxCoeff() > following_error_rad_) {
+        q_ref_ = state.q_rad;
+        qd_ref_ = state.qd_rad_s;
+        ++resyncs_;
+      }
       command.mode = LowLevelMode::kPosition;
       command.q_rad = q_ref_;
       break;
@@ -50,7 +88,7 @@ void LowLevelController::update(const RobotState& state, const Eigen::VectorXd& 
       // true constant differs; without a current reading, the joint torque sensors (which miss
       // the friction and rotor torque between motor and sensor).
       if (entering) {
-        if (state.current.valid) {
+        if (state.current.valid && state.current_A.size() == torque_per_amp_.size()) {
           torque_offset_ = torque_per_amp_.cwiseProduct(state.current_A) - tau_desired;
         } else {
           torque_offset_ = state.tau_sensor_Nm - tau_desired;
@@ -61,7 +99,14 @@ void LowLevelController::update(const RobotState& state, const Eigen::VectorXd& 
       break;
     case LowLevelMode::kCurrent:
       if (entering) {
-        custom_.reset(state.current_A, tau_desired, qdd_desired, state.tau_sensor_Nm, state.qd_rad_s);
+        // Start from the current the drives carry; a robot without current readings (or with a
+        // short vector): from the desired torque's nominal current.
+        if (state.current.valid && state.current_A.size() == entry_current_.size()) {
+          entry_current_ = state.current_A;
+        } else {
+          entry_current_ = tau_desired.cwiseQuotient(torque_per_amp_);
+        }
+        custom_.reset(entry_current_, tau_desired, qdd_desired, state.tau_sensor_Nm, state.qd_rad_s);
       } else {
         custom_.update(tau_desired, qdd_desired, state.tau_sensor_Nm, state.qd_rad_s);
       }

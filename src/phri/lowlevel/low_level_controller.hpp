@@ -5,7 +5,9 @@
 // the custom torque loop, switched live from the gamepad):
 //
 //   kPosition                 q_ref += T qd_ref, qd_ref += T qdd_d (the robot's position servo
-//                             tracks q_ref); entered at the measured q, qd
+//                             tracks q_ref); entered at the measured q, qd; re-synced to them
+//                             when the servo cannot follow (|q_ref - q| > following_error_rad:
+//                             a push it cannot resist), so q_ref never runs away
 //   kKinovaTorque             tau_d to the vendor's torque loop
 //   kKinovaTorqueHighVelocity tau_d to the vendor's high-velocity torque loop
 //                             (both entered at the torque the motors produce: the set-point
@@ -26,7 +28,10 @@ namespace phri {
 
 class LowLevelController {
 public:
-  LowLevelController(const ActuatorTable& actuators, const CustomTorqueSettings& custom, LowLevelMode initial);
+  /// following_error_rad: the position loop's re-sync bound, below Kinova's own following-error
+  /// fault (5 degrees, kortex_lowlevel.md) so that the robot never faults on our reference.
+  LowLevelController(const ActuatorTable& actuators, const CustomTorqueSettings& custom, LowLevelMode initial,
+                     double following_error_rad = 0.05);
 
   /// Switch to `loop` at the next update (no effect if it is already running).
   void request(LowLevelMode loop) { requested_ = loop; }
@@ -38,6 +43,15 @@ public:
   void update(const RobotState& state, const Eigen::VectorXd& tau_desired, const Eigen::VectorXd& qdd_desired,
               RobotCommand& command);
 
+  /// Safe stop, torque side: `tau` [N.m] in the running torque or current loop's units (current:
+  /// tau / K_T G_r, clipped to the current limit). In the position loop: nothing (use hold()).
+  void command_torque(const Eigen::VectorXd& tau, RobotCommand& command);
+  /// Safe stop, position side: the robot's position servo holds q from now on (the loop becomes
+  /// kPosition; a later request() takes effect at the next update()).
+  void hold(const Eigen::VectorXd& q, RobotCommand& command);
+
+  /// Position-loop re-syncs so far (each one: the servo could not follow for a moment).
+  long resync_count() const { return resyncs_; }
   const CustomTorqueController& custom() const { return custom_; }
   const Eigen::VectorXd& position_reference() const { return q_ref_; }
 
@@ -48,9 +62,13 @@ private:
   LowLevelMode requested_;
   bool started_ = false;
   int switches_ = 0;
+  long resyncs_ = 0;
+  double following_error_rad_;
   Eigen::VectorXd q_ref_, qd_ref_;
   Eigen::VectorXd torque_offset_;  // motor minus desired torque at a torque-loop entry, fading
   Eigen::VectorXd torque_per_amp_; // nominal K_T G_r per joint
+  Eigen::VectorXd current_limit_;  // A
+  Eigen::VectorXd entry_current_;  // the current the custom loop starts from
   double offset_decay_ = 0.0;
 };
 

@@ -1,0 +1,227 @@
+#include <phri/safety/state_supervisor.hpp>
+
+#include <phri/core/error.hpp>
+
+#include <algorithm>
+#include <cmath>
+
+namespace phri {
+namespace {
+constexpr const char* kWhere = "SupervisorSettings";
+
+int first_not_finite(const Eigen::VectorXd& v) {
+  for (int i = 0; i < v.size(); ++i) {
+    if (!std::isfinite(v[i])) return i;
+  }
+  return -1;
+}
+
+// First joint whose |value| exceeds factor * range (-1: none).
+int first_beyond(const Eigen::VectorXd& v, const Eigen::VectorXd& range, double factor) {
+  for (int i = 0; i < v.size(); ++i) {
+    if (std::abs(v[i]) > factor * range[i]) return i;
+  }
+  return -1;
+}
+
+bool identical(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
+  return a.size() == b.size() && (a.array() == b.array()).all();
+}
+
+void check_settings(const SensorRanges& r, const SupervisorSettings& s) {
+  const long n = r.velocity_limit.size();
+  if (n == 0) throw ConfigError(kWhere, "velocity_limit", "no joints");
+  for (const Eigen::VectorXd* v : {&r.q_lower, &r.q_upper, &r.torque_range, &r.current_range}) {
+    if (v->size() != n) throw ConfigError(kWhere, "ranges", "one entry per joint needed in every range");
+  }
+  if (!((r.velocity_limit.array() > 0).all() && (r.torque_range.array() > 0).all() &&
+        (r.current_range.array() > 0).all() && (r.q_lower.array() < r.q_upper.array()).all())) {
+    throw ConfigError(kWhere, "ranges", "limits must be > 0 and lower < upper");
+  }
+  if (!(s.period_s > 0) || !(s.position_margin_rad >= 0) || !(s.velocity_bound_factor >= 1) ||
+      !(s.position_step_factor >= 1) || !(s.position_step_slack_rad >= 0) || !(s.torque_range_factor >= 1) ||
+      !(s.current_range_factor >= 1) || !(s.max_degraded_s >= s.period_s) || !(s.recovery_samples >= 1) ||
+      !(s.max_fault_budget >= 1) || !(s.fault_budget_decay_per_good >= 0) || !(s.frozen_s >= 0)) {
+    throw ConfigError(kWhere, "settings", "a bound is out of range (factors >= 1, times >= the period)");
+  }
+}
+}  // namespace
+
+StateSupervisor::StateSupervisor(const SensorRanges& ranges, const SupervisorSettings& settings)
+    : ranges_(ranges), settings_(settings), n_(static_cast<int>(ranges.velocity_limit.size())) {
+  check_settings(ranges_, settings_);
+  last_good_ = RobotState(n_);
+  previous_ = RobotState(n_);
+}
+
+void StateSupervisor::reset() {
+  state_ = SupervisorState::kNormal;
+  has_good_ = has_previous_ = has_sequence_ = false;
+  frozen_since_s_ = -1.0;
+  good_in_row_ = bad_in_row_ = 0;
+  fault_budget_ = 0.0;
+  sample_fault_ = SafetyFault::kNone;
+  sample_fault_joint_ = -1;
+}
+
+// The sample's sequence and stamp against the last ones seen (kNone: fresh).
+SafetyFault StateSupervisor::check_freshness(const RobotState& s) const {
+  if (!has_sequence_) return SafetyFault::kNone;
+  const auto advance = static_cast<std::int32_t>(s.joints.sequence - last_sequence_);
+  if (advance <= 0) return SafetyFault::kStale;
+  const long max_advance = static_cast<long>(std::ceil(settings_.max_degraded_s / settings_.period_s)) + 1;
+  if (advance > max_advance) return SafetyFault::kStampJump;  // a jumping sequence: frames lost or garbage
+  if (!has_good_) return SafetyFault::kNone;
+  const double dt = s.joints.stamp_s - last_stamp_;
+  if (!(dt > 0.0)) return dt == 0.0 ? SafetyFault::kStampFrozen : SafetyFault::kStampJump;
+  if (dt > settings_.max_degraded_s + static_cast<double>(advance) * settings_.period_s) return SafetyFault::kStampJump;
+  return SafetyFault::kNone;
+}
+
+// Ranges of every value and the step since the last good sample; `joint` names the first culprit.
+SafetyFault StateSupervisor::check_ranges(const RobotState& s, int& joint) const {
+  const SupervisorSettings& c = settings_;
+  for (int i = 0; i < n_; ++i) {
+    joint = i;
+    const double q = s.q_rad[i];
+    if (q < ranges_.q_lower[i] - c.position_margin_rad || q > ranges_.q_upper[i] + c.position_margin_rad) {
+      return SafetyFault::kPositionRange;
+    }
+    const double v_limit = ranges_.velocity_limit[i];
+    if (std::abs(s.qd_rad_s[i]) > c.velocity_bound_factor * v_limit) return SafetyFault::kVelocityRange;
+    if (has_good_) {
+      const double dt = std::max(s.joints.stamp_s - last_good_.joints.stamp_s, c.period_s);
+      const double step = std::abs(q - last_good_.q_rad[i]);
+      if (step > c.position_step_factor * v_limit * dt + c.position_step_slack_rad) return SafetyFault::kPositionJump;
+    }
+  }
+  if ((joint = first_beyond(s.tau_sensor_Nm, ranges_.torque_range, c.torque_range_factor)) >= 0) {
+    return SafetyFault::kTorqueRange;
+  }
+  if (s.current.valid && (joint = first_beyond(s.current_A, ranges_.current_range, c.current_range_factor)) >= 0) {
+    return SafetyFault::kCurrentRange;
+  }
+  joint = -1;
+  return SafetyFault::kNone;
+}
+
+SafetyFault StateSupervisor::classify(const RobotState& s, int& joint) const {
+  joint = -1;
+  if (s.q_rad.size() != n_ || s.qd_rad_s.size() != n_ || s.tau_sensor_Nm.size() != n_ ||
+      (s.current.valid && s.current_A.size() != n_)) {
+    return SafetyFault::kSize;
+  }
+  if (s.fault) return SafetyFault::kRobotFault;
+  if (!s.joints.valid || !s.torque.valid) return SafetyFault::kInvalid;
+  for (const Eigen::VectorXd* v : {&s.q_rad, &s.qd_rad_s, &s.tau_sensor_Nm}) {
+    if ((joint = first_not_finite(*v)) >= 0) return SafetyFault::kNotFinite;
+  }
+  if (s.current.valid && (joint = first_not_finite(s.current_A)) >= 0) return SafetyFault::kNotFinite;
+  if (!std::isfinite(s.joints.stamp_s)) return SafetyFault::kStampJump;
+  const SafetyFault fresh = check_freshness(s);
+  if (fresh != SafetyFault::kNone) return fresh;
+  return check_ranges(s, joint);
+}
+
+// Real sensors carry noise: q̇, τ_s and the current bit-identical for frozen_s while the sequence
+// advances means the values are not being updated.
+bool StateSupervisor::frozen(const RobotState& s) {
+  if (settings_.frozen_s <= 0.0) return false;
+  const bool same = has_previous_ && identical(s.qd_rad_s, previous_.qd_rad_s) &&
+                    identical(s.tau_sensor_Nm, previous_.tau_sensor_Nm) &&
+                    (!s.current.valid || identical(s.current_A, previous_.current_A));
+  if (!same) {
+    frozen_since_s_ = -1.0;
+    return false;
+  }
+  if (frozen_since_s_ < 0.0) frozen_since_s_ = s.joints.stamp_s;
+  return s.joints.stamp_s - frozen_since_s_ >= settings_.frozen_s;
+}
+
+bool StateSupervisor::check(const RobotState& s) {
+  int joint = -1;
+  SafetyFault fault = classify(s, joint);
+  if (s.q_rad.size() == n_ && s.qd_rad_s.size() == n_ && s.tau_sensor_Nm.size() == n_) {
+    if (fault == SafetyFault::kNone && frozen(s)) fault = SafetyFault::kFrozenValues;
+    if (fault != SafetyFault::kStale) {
+      // Sizes equal: these copies allocate nothing (the current only when it has the right size).
+      previous_.qd_rad_s = s.qd_rad_s;
+      previous_.tau_sensor_Nm = s.tau_sensor_Nm;
+      if (s.current_A.size() == n_) previous_.current_A = s.current_A;
+      has_previous_ = true;
+    }
+  }
+  if (fault != SafetyFault::kStale && fault != SafetyFault::kSize) {
+    last_sequence_ = s.joints.sequence;
+    if (fault == SafetyFault::kNone) last_stamp_ = s.joints.stamp_s;
+    has_sequence_ = true;
+  }
+  if (fault == SafetyFault::kNone) {
+    accept(s);
+    return true;
+  }
+  reject(s, fault, joint);
+  return false;
+}
+
+void StateSupervisor::accept(const RobotState& s) {
+  last_good_.time_s = s.time_s;
+  last_good_.cycle = s.cycle;
+  last_good_.mode = s.mode;
+  last_good_.q_rad = s.q_rad;
+  last_good_.qd_rad_s = s.qd_rad_s;
+  last_good_.tau_sensor_Nm = s.tau_sensor_Nm;
+  if (s.current.valid) last_good_.current_A = s.current_A;
+  last_good_.wrench_sensor = s.wrench_sensor;
+  last_good_.joints = s.joints;
+  last_good_.torque = s.torque;
+  last_good_.current = s.current;
+  last_good_.wrench = s.wrench;
+  has_good_ = true;
+  sample_fault_ = SafetyFault::kNone;
+  sample_fault_joint_ = -1;
+  bad_in_row_ = 0;
+  fault_budget_ = std::max(0.0, fault_budget_ - settings_.fault_budget_decay_per_good);
+  if (state_ == SupervisorState::kDegraded && ++good_in_row_ >= settings_.recovery_samples) {
+    transition(SupervisorState::kNormal, SafetyFault::kNone, -1, s.time_s);
+  }
+}
+
+void StateSupervisor::reject(const RobotState& s, SafetyFault fault, int joint) {
+  ++implausible_;
+  sample_fault_ = fault;
+  sample_fault_joint_ = joint;
+  good_in_row_ = 0;
+  fault_budget_ += 1.0;
+  // Robot time of this cycle: the sample's if it is believable, else the last good one's.
+  const double t = std::isfinite(s.time_s) && s.time_s >= last_good_.time_s ? s.time_s : last_good_.time_s;
+  if (state_ == SupervisorState::kSafeStop) return;
+  if (fault == SafetyFault::kRobotFault) {
+    transition(SupervisorState::kSafeStop, fault, joint, t);  // the robot itself stopped obeying
+    return;
+  }
+  if (state_ == SupervisorState::kNormal) transition(SupervisorState::kDegraded, fault, joint, t);
+  // Cycles in a row without a usable sample (the stamps may be the fault, so cycles, not time).
+  ++bad_in_row_;
+  if (static_cast<double>(bad_in_row_) * settings_.period_s > settings_.max_degraded_s) {
+    transition(SupervisorState::kSafeStop, fault, joint, t);
+  } else if (fault_budget_ > settings_.max_fault_budget) {
+    transition(SupervisorState::kSafeStop, SafetyFault::kTooManyFaults, joint, t);
+  }
+}
+
+void StateSupervisor::report(SafetyFault fault, double t, int joint) {
+  if (state_ == SupervisorState::kSafeStop) return;
+  transition(SupervisorState::kSafeStop, fault, joint, t);
+}
+
+void StateSupervisor::transition(SupervisorState to, SafetyFault reason, int joint, double t) {
+  if (to == state_) return;
+  last_transition_ = SafetyTransition{t, state_, to, reason, joint};
+  if (to == SupervisorState::kSafeStop) safe_stop_transition_ = last_transition_;
+  state_ = to;
+  good_in_row_ = 0;
+  ++transitions_;
+}
+
+}  // namespace phri

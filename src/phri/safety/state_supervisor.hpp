@@ -1,0 +1,198 @@
+#pragma once
+// phri::StateSupervisor: the safety stage between the robot and the controller. Every sample the
+// robot reports is checked for plausibility before anything estimates from it:
+//
+//   sizes; finite; valid flags; fresh (the sequence advanced, the stamp advanced and did not jump);
+//   q within the sensor's range (the URDF limits plus a margin: the hard stops are not further);
+//   |Δq| since the last good sample consistent with the velocity limit; |q̇| within a physical
+//   bound; τ_s and the current within what the drives can produce; values not frozen while the
+//   sequence advances (real sensors always carry noise).
+//
+// An implausible sample is treated as a missing one: the controller keeps the last good state and
+// does not feed its estimators (a single spike must never read as a push). States:
+//
+//   kNormal   --implausible or missing sample-->  kDegraded (last good state held)
+//   kDegraded --`recovery_samples` good samples in a row--> kNormal
+//   kDegraded --longer than max_degraded_s, or too many bad samples lately--> kSafeStop
+//   any       --report(fault): a fault found elsewhere (refused write, QP failing, robot fault)--> kSafeStop
+//
+// kSafeStop latches until reset(): the controller brakes and hands over to the robot's position
+// hold (Controller::step). Every transition is counted and the latest kept with its reason, its
+// joint and its time, for the log and `phri run`. check() allocates nothing and never throws.
+#include <phri/robot/robot_state.hpp>
+
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <string_view>
+
+namespace phri {
+
+enum class SupervisorState : std::uint8_t { kNormal = 0, kDegraded, kSafeStop };
+
+enum class SafetyFault : std::uint8_t {
+  kNone = 0,
+  kSize,            ///< a vector with the wrong number of joints
+  kNotFinite,       ///< NaN or infinite value
+  kInvalid,         ///< the robot marked the joint or torque signal invalid
+  kStale,           ///< the joint sequence did not advance (or went back)
+  kStampFrozen,     ///< the sequence advanced but the stamp did not
+  kStampJump,       ///< the stamp went back or jumped further than the degraded budget
+  kPositionRange,   ///< q beyond the joint's range by more than the sensor margin
+  kPositionJump,    ///< |Δq| faster than the velocity bound allows since the last good sample
+  kVelocityRange,   ///< |q̇| beyond the physical bound
+  kTorqueRange,     ///< |τ_s| beyond what the drive can carry
+  kCurrentRange,    ///< |i| beyond the drive's current range
+  kFrozenValues,    ///< q̇, τ_s and current bit-identical for frozen_s while the sequence advances
+  kDegradedTooLong, ///< no good sample for max_degraded_s
+  kTooManyFaults,   ///< implausible samples keep coming (the debounce budget ran out)
+  kRobotFault,      ///< the robot reports a fault
+  kWriteRefused,    ///< the robot refused a command
+  kQpFailure,       ///< the QP kept failing (brake fallback for longer than allowed)
+  kFollowingError,  ///< the position loop could not follow its reference (re-synced too often)
+};
+
+constexpr std::string_view to_string(SupervisorState s) {
+  switch (s) {
+    case SupervisorState::kNormal: return "normal";
+    case SupervisorState::kDegraded: return "degraded";
+    case SupervisorState::kSafeStop: return "safe_stop";
+  }
+  return "unknown";
+}
+
+constexpr std::string_view to_string(SafetyFault f) {
+  switch (f) {
+    case SafetyFault::kNone: return "none";
+    case SafetyFault::kSize: return "wrong_size";
+    case SafetyFault::kNotFinite: return "not_finite";
+    case SafetyFault::kInvalid: return "invalid_signal";
+    case SafetyFault::kStale: return "stale_sequence";
+    case SafetyFault::kStampFrozen: return "frozen_stamp";
+    case SafetyFault::kStampJump: return "stamp_jump";
+    case SafetyFault::kPositionRange: return "position_out_of_range";
+    case SafetyFault::kPositionJump: return "position_jump";
+    case SafetyFault::kVelocityRange: return "velocity_out_of_range";
+    case SafetyFault::kTorqueRange: return "torque_out_of_range";
+    case SafetyFault::kCurrentRange: return "current_out_of_range";
+    case SafetyFault::kFrozenValues: return "frozen_values";
+    case SafetyFault::kDegradedTooLong: return "degraded_too_long";
+    case SafetyFault::kTooManyFaults: return "too_many_faults";
+    case SafetyFault::kRobotFault: return "robot_fault";
+    case SafetyFault::kWriteRefused: return "write_refused";
+    case SafetyFault::kQpFailure: return "qp_failure";
+    case SafetyFault::kFollowingError: return "following_error";
+  }
+  return "unknown";
+}
+
+/// What the drives and sensors can physically report, per joint.
+struct SensorRanges {
+  Eigen::VectorXd q_lower, q_upper;  ///< joint range [rad] (±inf: continuous joint)
+  Eigen::VectorXd velocity_limit;    ///< the drive's velocity limit [rad/s]
+  Eigen::VectorXd torque_range;      ///< |τ_s| the drive can carry [N.m] (its peak motor torque)
+  Eigen::VectorXd current_range;     ///< |i| the drive can carry [A]
+};
+
+struct SupervisorSettings {
+  double period_s = 1e-3;
+  /// [rad] a reading beyond the joint range by more is not a reading: the Gen3's hard stops sit
+  /// within a few degrees of its software limits (kinova_gen3.md), so 0.2 rad is generous.
+  double position_margin_rad = 0.2;
+  /// |q̇| above factor x the velocity limit is not physical: the drives' own guard stops the arm
+  /// near 1x; a hard push can overshoot, but never by 2.5x.
+  double velocity_bound_factor = 2.5;
+  /// |Δq| over the time since the last good sample above factor x the velocity limit (plus
+  /// position_step_slack_rad for encoder quanta and jitter) is a jump, not a motion.
+  double position_step_factor = 3.0;
+  double position_step_slack_rad = 1e-3;
+  /// |τ_s| above factor x the drive's peak motor torque (and |i| above factor x its current
+  /// limit) is not a reading: the link side can briefly see more than the motor gives (a hard
+  /// stop, an impact), but not several times more.
+  double torque_range_factor = 2.0;
+  double current_range_factor = 1.5;
+  /// [s] how long the last good state may stand in for missing ones before a safe stop. Kortex's
+  /// low-level servoing faults after a few missed 1 kHz frames; 20 ms is the same order.
+  double max_degraded_s = 0.02;
+  /// good samples in a row that end a degraded spell (debounce)
+  int recovery_samples = 3;
+  /// Debounce budget: each implausible sample adds 1, each good one removes decay_per_good;
+  /// above max_fault_budget (intermittent faults, e.g. one spike in every few samples) -> safe stop.
+  double max_fault_budget = 20.0;
+  double fault_budget_decay_per_good = 0.05;
+  /// [s] q̇, τ_s and current bit-identical for this long while the sequence advances: frozen
+  /// values (0: not checked, for noise-free fakes).
+  double frozen_s = 0.05;
+};
+
+struct SafetyTransition {
+  double time_s = 0.0;
+  SupervisorState from = SupervisorState::kNormal, to = SupervisorState::kNormal;
+  SafetyFault reason = SafetyFault::kNone;
+  int joint = -1;  ///< joint the fault was seen on (-1: not a joint's)
+};
+
+class StateSupervisor {
+public:
+  /// Sizes everything for ranges.velocity_limit.size() joints; ConfigError on inconsistent input.
+  StateSupervisor(const SensorRanges& ranges, const SupervisorSettings& settings);
+
+  /// Checks one sample; true: it is plausible and fresh (last_good() is now this sample). In
+  /// kSafeStop the check still runs (the brake uses plausible measurements) but the state stays.
+  bool check(const RobotState& state);
+  /// A fault found outside the state: safe stop, latched, at robot time t.
+  void report(SafetyFault fault, double t, int joint = -1);
+  /// Back to kNormal with no good sample yet (after the operator cleared the cause).
+  void reset();
+
+  SupervisorState state() const { return state_; }
+  bool safe_stop() const { return state_ == SupervisorState::kSafeStop; }
+  /// Whether a good sample has been seen (last_good() is meaningful).
+  bool has_good() const { return has_good_; }
+  const RobotState& last_good() const { return last_good_; }
+  /// Robot time of the last good sample (its stamp) [s].
+  double last_good_time() const { return last_good_.joints.stamp_s; }
+  /// The fault of the last implausible sample (kNone if the last one was good), its joint.
+  SafetyFault sample_fault() const { return sample_fault_; }
+  int sample_fault_joint() const { return sample_fault_joint_; }
+  long implausible_samples() const { return implausible_; }
+  std::uint64_t transition_count() const { return transitions_; }
+  const SafetyTransition& last_transition() const { return last_transition_; }
+  /// The transition into kSafeStop (reason kNone before any).
+  const SafetyTransition& safe_stop_transition() const { return safe_stop_transition_; }
+  const SupervisorSettings& settings() const { return settings_; }
+  const SensorRanges& ranges() const { return ranges_; }
+
+private:
+  SafetyFault classify(const RobotState& s, int& joint) const;
+  SafetyFault check_freshness(const RobotState& s) const;
+  SafetyFault check_ranges(const RobotState& s, int& joint) const;
+  bool frozen(const RobotState& s);
+  void accept(const RobotState& s);
+  void reject(const RobotState& s, SafetyFault fault, int joint);
+  void transition(SupervisorState to, SafetyFault reason, int joint, double t);
+
+  SensorRanges ranges_;
+  SupervisorSettings settings_;
+  int n_ = 0;
+  SupervisorState state_ = SupervisorState::kNormal;
+  RobotState last_good_;
+  RobotState previous_;  // the latest sample with the right sizes, good or not (frozen values)
+  bool has_good_ = false;
+  bool has_previous_ = false;
+  std::uint32_t last_sequence_ = 0;  // of the latest sample seen, good or not
+  double last_stamp_ = 0.0;
+  bool has_sequence_ = false;
+  double frozen_since_s_ = -1.0;     // stamp at which the values stopped changing (-1: changing)
+  int good_in_row_ = 0;
+  long bad_in_row_ = 0;
+  double fault_budget_ = 0.0;
+  SafetyFault sample_fault_ = SafetyFault::kNone;
+  int sample_fault_joint_ = -1;
+  long implausible_ = 0;
+  std::uint64_t transitions_ = 0;
+  SafetyTransition last_transition_;
+  SafetyTransition safe_stop_transition_;
+};
+
+}  // namespace phri
