@@ -157,7 +157,8 @@ Controller::Controller(LoadedRobot robot, const ControllerSettings& settings)
       torque_limit_(qp_.torque_limit()),
       drive_velocity_limit_(supervisor_.ranges().velocity_limit),
       reflected_inertia_(Eigen::VectorXd::Zero(model_.nv())),
-      static_friction_(Eigen::VectorXd::Zero(model_.nv())) {
+      static_friction_(Eigen::VectorXd::Zero(model_.nv())),
+      drive_torque_(supervisor_.ranges().torque_range) {
   for (int i = 0; i < model_.nv(); ++i) {
     reflected_inertia_[i] = actuators_[i].reflected_inertia_kgm2;
     static_friction_[i] = std::max(actuators_[i].friction.static_Nm, actuators_[i].friction.coulomb_Nm);
@@ -208,7 +209,17 @@ void Controller::estimate(const RobotState& state, double dt) {
     last_wrench_sequence_ = state.wrench.sequence;
     const Eigen::Isometry3d& sensor = data_.frame_placements[static_cast<std::size_t>(sensor_frame_)];
     const Eigen::Isometry3d& ee = data_.frame_placements[static_cast<std::size_t>(end_effector_frame_)];
-    wrench_.update(state.wrench_sensor, sensor, ee.translation());
+    // Each axis through a median of its last three samples: a single-sample spike of any size
+    // (a corrupted frame, a jolt of the tool) never reaches the estimate or the touch trigger.
+    for (int i = 0; i < 6; ++i) {
+      const double x = state.wrench_sensor[i], p = wrench_history_(i, 0), pp = wrench_history_(i, 1);
+      wrench_median_[i] = std::max(std::min(p, pp), std::min(std::max(p, pp), x));
+      wrench_history_(i, 1) = p;
+      wrench_history_(i, 0) = x;
+    }
+    if (wrench_samples_ < 2) wrench_median_ = state.wrench_sensor;  // not three samples yet
+    ++wrench_samples_;
+    wrench_.update(wrench_median_, sensor, ee.translation());
   }
 }
 
@@ -275,8 +286,10 @@ void Controller::safe_stop(bool sample_good, RobotCommand& command) {
   compute_all_terms(model_, data_, brake_q_, brake_tau_);
   for (int i = 0; i < model_.nv(); ++i) {
     const double inertia = data_.mass_matrix(i, i) + reflected_inertia_[i];
-    brake_tau_[i] = std::clamp(data_.nonlinear_effects[i] - s.brake_rate * inertia * brake_qd_[i], -torque_limit_[i],
-                               torque_limit_[i]);
+    // Gravity up to what the drive gives (the arm must not fall, whatever the QP's limit), the
+    // damping within the QP's torque limit.
+    const double damping = std::clamp(-s.brake_rate * inertia * brake_qd_[i], -torque_limit_[i], torque_limit_[i]);
+    brake_tau_[i] = std::clamp(data_.nonlinear_effects[i] + damping, -drive_torque_[i], drive_torque_[i]);
   }
   low_level_.command_torque(brake_tau_, command);
 }
@@ -365,13 +378,7 @@ CycleStatus Controller::step(const RobotState& state, const ControllerTargets& t
   // The trigger sees the wrench norm through a short low-pass (settings.wrench_trigger_filter_s):
   // single-sample spikes of the F/T signal (tool inertia during stick-slip jolts, noise) must not
   // free the end effector for a few milliseconds.
-  // A median of the last three samples first: a single-sample spike of any size never passes.
-  const double norm = wrench_.calibrated() ? wrench_.norm() : 0.0;
-  const double a = trigger_history_[0], b = trigger_history_[1];
-  trigger_history_[0] = b;
-  trigger_history_[1] = norm;
-  const double median = std::max(std::min(a, b), std::min(std::max(a, b), norm));
-  compliance_.update(trigger_filter_.update(median), qp_, data_);
+  compliance_.update(trigger_filter_.update(wrench_.calibrated() ? wrench_.norm() : 0.0), qp_, data_);
 
   // ---- QP and inverse dynamics. Under the robot's position loop the external torque is not fed
   // back: the stiff servo rejects it and the observer would only see servo effort.

@@ -148,7 +148,9 @@ private:
   long rejected_targets_ = 0;
   Eigen::MatrixXd ee_jacobian_;              // 6 x nv, for J^T F
   Eigen::VectorXd ft_torque_, tau_ext_;
-  double trigger_history_[2] = {0.0, 0.0};  // the two previous wrench norms (median of three)
+  Eigen::Matrix<double, 6, 2> wrench_history_ = Eigen::Matrix<double, 6, 2>::Zero();  // the two previous samples
+  Vector6d wrench_median_ = Vector6d::Zero();
+  long wrench_samples_ = 0;
   LowPassFilter trigger_filter_;       // the wrench norm the dual-compliance trigger sees
   ComplementaryFilter ft_fusion_;      // observer (low) + J^T F/T (high), ExternalTorqueSource::kFused
   ControllerTargets no_targets_;
@@ -159,6 +161,7 @@ private:
   Eigen::VectorXd hold_q_, brake_q_, brake_qd_, brake_tau_, guarded_tau_;
   Eigen::VectorXd limit_lower_, limit_upper_;       // URDF limits (±inf: continuous)
   Eigen::VectorXd torque_limit_, drive_velocity_limit_, reflected_inertia_, static_friction_;
+  Eigen::VectorXd drive_torque_;  // the drives' peak motor torque
 };
 
 }  // namespace phri

@@ -69,10 +69,14 @@ void LowLevelController::update(const RobotState& state, const Eigen::VectorXd& 
       qd_ref_ += period_s_ * qdd_desired;
       q_ref_ += period_s_ * qd_ref_;
       // The integration is open loop: when the servo cannot follow (a push it cannot resist), the
-      // reference would run away. Re-sync to the arm before the robot's following-error fault.
-      if ((q_ref_ - state.q_rad).cwiseAbs().maxCoeff() > following_error_rad_) {
-        q_ref_ = state.q_rad;
-        qd_ref_ = state.qd_rad_s;
+      // reference would run away. It is kept within following_error_rad of the arm, below the
+      // robot's following-error fault, and stops moving: the servo keeps resisting the push with
+      // the largest error allowed, and the arm returns once the push ends.
+      for (int i = 0; i < q_ref_.size(); ++i) {
+        const double error = q_ref_[i] - state.q_rad[i];
+        if (std::abs(error) <= following_error_rad_) continue;
+        q_ref_[i] = state.q_rad[i] + std::copysign(following_error_rad_, error);
+        qd_ref_[i] = 0.0;
         ++resyncs_;
       }
       command.mode = LowLevelMode::kPosition;

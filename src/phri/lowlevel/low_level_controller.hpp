@@ -5,9 +5,9 @@
 // the custom torque loop, switched live from the gamepad):
 //
 //   kPosition                 q_ref += T qd_ref, qd_ref += T qdd_d (the robot's position servo
-//                             tracks q_ref); entered at the measured q, qd; re-synced to them
-//                             when the servo cannot follow (|q_ref - q| > following_error_rad:
-//                             a push it cannot resist), so q_ref never runs away
+//                             tracks q_ref); entered at the measured q, qd; kept within
+//                             following_error_rad of the measured q when the servo cannot
+//                             follow (a push it cannot resist), so q_ref never runs away
 //   kKinovaTorque             tau_d to the vendor's torque loop
 //   kKinovaTorqueHighVelocity tau_d to the vendor's high-velocity torque loop
 //                             (both entered at the torque the motors produce: the set-point
@@ -50,7 +50,7 @@ public:
   /// kPosition; a later request() takes effect at the next update()).
   void hold(const Eigen::VectorXd& q, RobotCommand& command);
 
-  /// Position-loop re-syncs so far (each one: the servo could not follow for a moment).
+  /// Position-loop reference clamps so far (joint-cycles where the servo could not follow).
   long resync_count() const { return resyncs_; }
   const CustomTorqueController& custom() const { return custom_; }
   const Eigen::VectorXd& position_reference() const { return q_ref_; }
