@@ -3,7 +3,9 @@
 // timed cycle by cycle over 100,000 cycles of a closed-loop run on the simulated Gen3 (SimRobot
 // with its noise, friction and 5 % mismatch; pushes on the elbow and on the tool every few
 // seconds, dual compliance on so the trigger fires, self-collision rows in). The plant's own time
-// is not counted. Reports median, p99, p99.9 and max in microseconds:
+// is not counted. Reports median, p99, p99.9 and max in microseconds; and, timed the same way on
+// the same states in the same run, the safety supervisor's plausibility check alone (a second
+// StateSupervisor built like the controller's: supervisor_median_us, the part of the cycle it adds):
 //   build/release/bench/phri_bench --benchmark_filter=ControllerCycle
 #include <phri/control/controller.hpp>
 #include <phri/core/statistics.hpp>
@@ -46,10 +48,15 @@ void ControllerCycle(benchmark::State& state) {
   phri::Controller cycle(settings);
   phri::RobotCommand command(robot.dof());
 
-  std::vector<double> micros(kCycles);
+  phri::StateSupervisor supervisor(cycle.supervisor().ranges(), cycle.supervisor().settings());
+  std::vector<double> micros(kCycles), supervisor_micros(kCycles);
   for (auto _ : state) {
     for (int k = 0; k < kCycles; ++k) {
       const phri::RobotState& s = robot.read();
+      const auto check_start = std::chrono::steady_clock::now();
+      benchmark::DoNotOptimize(supervisor.check(s));
+      supervisor_micros[static_cast<std::size_t>(k)] =
+          std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - check_start).count();
       const auto start = std::chrono::steady_clock::now();
       cycle.step(s, command);
       micros[static_cast<std::size_t>(k)] =
@@ -62,6 +69,9 @@ void ControllerCycle(benchmark::State& state) {
   state.counters["p99.9_us"] = phri::percentile(micros, 0.999);
   state.counters["max_us"] = phri::percentile(micros, 1.0);
   state.counters["touches"] = cycle.compliance().touch_count();
+  state.counters["supervisor_median_us"] = phri::percentile(supervisor_micros, 0.5);
+  state.counters["supervisor_p99_us"] = phri::percentile(supervisor_micros, 0.99);
+  state.counters["implausible"] = static_cast<double>(cycle.supervisor().implausible_samples());
 }
 BENCHMARK(ControllerCycle)->Iterations(1)->Unit(benchmark::kMillisecond);
 

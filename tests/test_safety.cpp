@@ -9,6 +9,7 @@
 #include <phri/model/algorithms.hpp>
 #include <phri/sim/sim_robot.hpp>
 
+#include "allocation_counter.hpp"
 #include "hand_push.hpp"
 
 #include "gen3_settings.hpp"
@@ -261,12 +262,16 @@ TEST(Safety, AnUnstableObserverGainIsRefusedAndAQpThatKeepsFailingStopsSafely) {
 }
 
 // Defect 6: with NaN on q2 for 2.5 s, the torque loops repeated the last torque or current command
-// for the whole time and the arm moved 5-6 rad. Now: a brake, then the robot's position hold.
+// for the whole time and the arm moved 5-6 rad. Now: a brake, then the robot's position hold,
+// which also resists a push meanwhile.
 TEST(Safety, InvalidDataForSecondsBrakeAndHoldInEveryTorqueLoop) {
   for (const phri::LowLevelMode loop : {phri::LowLevelMode::kCurrent, phri::LowLevelMode::kKinovaTorque,
                                         phri::LowLevelMode::kKinovaTorqueHighVelocity, phri::LowLevelMode::kPosition}) {
     SCOPED_TRACE(std::string(phri::to_string(loop)));
-    Rig rig(phri::ComplianceMode::kNullSpace, loop);
+    // A 40 N push on the wrist while the data are invalid: nothing but the robot's own hold
+    // resists it (a repeated torque command would not).
+    const Eigen::Vector3d force = 40.0 * joint_direction("spherical_wrist_1_link", 0);
+    Rig rig(phri::ComplianceMode::kNullSpace, loop, {hand_push("spherical_wrist_1_link", Eigen::Vector3d::Zero(), force, 1.0, 1.0)});
     rig.run(0.5);
     const Eigen::VectorXd start = rig.q();
     rig.run(3.0, [](long k, phri::RobotState& s) {
@@ -347,6 +352,33 @@ TEST(Safety, ASingleSampleForceSpikeIsNotATouch) {
     }
   });
   EXPECT_EQ(rig.cycle_.compliance().touch_count(), touches);
+}
+
+// The supervisor and the safe stop allocate nothing: the controller's steps through spikes, a
+// degraded spell, the brake and the hand-over to the hold, counted (the corrupted copy of the
+// state is made before the count, outside the controller).
+TEST(Safety, SupervisorDegradedSpellsAndTheSafeStopAllocateNothing) {
+  for (const phri::LowLevelMode loop : {phri::LowLevelMode::kCurrent, phri::LowLevelMode::kKinovaTorque}) {
+    Rig rig(phri::ComplianceMode::kNullSpace, loop);
+    rig.run(0.3);
+    phri::RobotState corrupted(7);
+    std::size_t allocations = 0;
+    for (int k = 0; k < 1500; ++k) {
+      const phri::RobotState& state = rig.robot_.read();
+      corrupted = state;
+      if (k == 100) corrupted.tau_sensor_Nm[2] += 1e6;                                  // one spike
+      if (k >= 200 && k < 210) corrupted.qd_rad_s[1] = std::numeric_limits<double>::quiet_NaN();  // degraded
+      if (k >= 400) corrupted.q_rad[3] = std::numeric_limits<double>::infinity();        // -> safe stop
+      phri::test::AllocationCounter count;
+      rig.cycle_.step(corrupted, rig.command_);
+      allocations += count.allocations();
+      rig.robot_.write(rig.command_);
+    }
+    EXPECT_EQ(allocations, 0u);
+    EXPECT_EQ(rig.cycle_.status(), phri::CycleStatus::kSafeStop);
+    EXPECT_TRUE(rig.cycle_.holding());
+    EXPECT_EQ(rig.cycle_.supervisor().transition_count(), 6u);  // (degraded, normal) x 2, degraded, safe stop
+  }
 }
 
 }  // namespace
