@@ -381,4 +381,18 @@ TEST(Safety, SupervisorDegradedSpellsAndTheSafeStopAllocateNothing) {
   }
 }
 
+// The plant refuses a position set-point further from the joint than Kinova's following-error
+// fault (5 degrees), as the robot would fault on it; one within it is accepted.
+TEST(Safety, ThePlantRefusesAPositionStepBeyondTheFollowingErrorBound) {
+  Rig rig(phri::ComplianceMode::kNullSpace, phri::LowLevelMode::kPosition);
+  rig.run(0.1);
+  phri::RobotCommand command(7);
+  command.mode = phri::LowLevelMode::kPosition;
+  command.q_rad = rig.q();
+  command.q_rad[1] += 0.2;
+  EXPECT_EQ(rig.robot_.write(command), phri::WriteStatus::kOutOfRange);
+  command.q_rad[1] = rig.q()[1] + 0.05;
+  EXPECT_EQ(rig.robot_.write(command), phri::WriteStatus::kOk);
+}
+
 }  // namespace

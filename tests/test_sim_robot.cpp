@@ -261,10 +261,10 @@ TEST(SimRobotSensors, TorqueSensorIsTheTransmittedTorque) {
   RobotCommand cmd(7);
   cmd.mode = LowLevelMode::kPosition;
   cmd.q_rad = to_vector(kTarget);
-  cmd.q_rad[0] += 0.3;
-  cmd.q_rad[3] -= 0.2;
-  cmd.q_rad[6] += 0.5;
-  robot.write(cmd);
+  cmd.q_rad[0] += 0.08;  // steps within the 5 degree following-error bound the robot accepts
+  cmd.q_rad[3] -= 0.08;
+  cmd.q_rad[6] += 0.08;
+  ASSERT_EQ(robot.write(cmd), WriteStatus::kOk);
   std::vector<double> M(static_cast<std::size_t>(m->nv * m->nv));
   double worst = 0.0, largest = 0.0;
   for (int k = 0; k < 600; ++k) {

@@ -363,6 +363,10 @@ void SimRobot::sample_ft_sensor() {
 
 double SimRobot::quantize(double q) const { return quantum_ > 0.0 ? quantum_ * std::round(q / quantum_) : q; }
 
+namespace {
+constexpr double kMaxFollowingError_rad = 5.0 * 3.14159265358979323846 / 180.0;
+}  // namespace
+
 WriteStatus SimRobot::validate(const RobotCommand& c) const {
   if (fault_) return WriteStatus::kFault;
   if (!is_valid(c.mode)) return WriteStatus::kInvalidMode;
@@ -380,6 +384,12 @@ WriteStatus SimRobot::validate(const RobotCommand& c) const {
     switch (c.mode) {
       case LowLevelMode::kPosition:
         if (x < lower_[i] || x > upper_[i]) return WriteStatus::kOutOfRange;
+        // A set-point further from the joint than Kinova's following-error fault (5 degrees,
+        // Kortex low-level servoing) is refused, as the robot would fault on it: no step of any
+        // size reaches the servo.
+        if (std::abs(x - d_->qpos[qadr_[static_cast<std::size_t>(i)]]) > kMaxFollowingError_rad) {
+          return WriteStatus::kOutOfRange;
+        }
         break;
       case LowLevelMode::kKinovaTorque:
       case LowLevelMode::kKinovaTorqueHighVelocity:
