@@ -244,6 +244,36 @@ TEST(Config, InconsistentPairsNameTheKeyThatMustChange) {
                       {.element = "controller.period_s", .mentions = {"plant"}, .file = "test.yaml"});
 }
 
+// yaml-cpp keeps the first of two equal keys silently, and the loaders took `key:` (null) as
+// absent, i.e. the default: both are refused at load, naming the key path.
+TEST(Config, DuplicateKeysAndExplicitNullsAreRefused) {
+  expect_config_error(loading_demo_with("observer_gain: 50.0", "observer_gain: 50.0\n  observer_gain: 5000.0"),
+                      {.element = "controller.observer_gain", .mentions = {"duplicate key"}, .file = "test.yaml"});
+  expect_config_error(loading_demo_with("run:                                     # the run itself",
+                                        "run:\n  pacing: lockstep\nrun:"),
+                      {.element = "run", .mentions = {"duplicate key"}, .file = "test.yaml"});
+  expect_config_error(loading_demo_with("  - {at: 8.0, event: full_body_compliance}",
+                                        "  - {at: 8.0, at: 9.0, event: full_body_compliance}"),
+                      {.element = "events[0].at", .mentions = {"duplicate key"}, .file = "test.yaml"});
+  expect_config_error(loading_demo_with("observer_gain: 50.0", "observer_gain:"),
+                      {.element = "controller.observer_gain", .mentions = {"null"}, .file = "test.yaml"});
+  expect_config_error(loading_demo_with("observer_gain: 50.0", "observer_gain: ~"),
+                      {.element = "controller.observer_gain", .mentions = {"null"}, .file = "test.yaml"});
+  expect_config_error(loading_demo_with("ramp_s: 2.0", "ramp_s: null"),
+                      {.element = "fsm.dynamic.ramp_s", .mentions = {"null"}, .file = "test.yaml"});
+  // ... and in the plant file named by `plant.file` (a copy of plant_gen3.yaml with a duplicate).
+  const std::string plant = read_file(kRoot + "/configs/plant_gen3.yaml");
+  const std::string copy = (std::filesystem::temp_directory_path() / "phri_test_config_plant_dup.yaml").string();
+  {
+    std::string edited = plant;
+    edited.replace(edited.find("  seed: 1 "), 10, "  seed: 2\n  seed: 1 ");
+    std::ofstream(copy) << edited;
+  }
+  expect_config_error(loading_demo_with("file: plant_gen3.yaml", "file: " + copy),
+                      {.element = "plant.seed", .mentions = {"duplicate key"}, .file = copy});
+  std::filesystem::remove(copy);
+}
+
 TEST(Config, FilesAndSyntax) {
   expect_config_error(
       loading_demo_with("urdf: ../robots/kinova_gen3/gen3.urdf", "urdf: ../robots/kinova_gen3/nothing.urdf"),

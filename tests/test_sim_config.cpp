@@ -103,6 +103,20 @@ TEST(ActuatorTable, ValidationNamesTheKey) {
                       {.element = "joints[0].gear_ratios", .file = "act.yaml"});
 }
 
+TEST(ActuatorTable, DuplicateKeysAndNullsAreRefused) {
+  expect_config_error(loading_actuators_with("    gear_ratio: 100 ", "    gear_ratio: 10\n    gear_ratio: 100 "),
+                      {.element = "joints[0].gear_ratio", .mentions = {"duplicate key"}, .file = "act.yaml"});
+  expect_config_error(loading_actuators_with("coulomb_Nm: 2.15", "coulomb_Nm:"),
+                      {.element = "joints[0].friction.coulomb_Nm", .mentions = {"null"}, .file = "act.yaml"});
+}
+
+TEST(SimRobotConfig, DuplicateKeysAndNullsAreRefused) {
+  expect_config_error(loading_plant_with("  seed: 1 ", "  seed: 2\n  seed: 1 "),
+                      {.element = "plant.seed", .mentions = {"duplicate key"}, .file = "test.yaml"});
+  expect_config_error(loading_plant_with("torque_sensor_std_Nm: 0.05", "torque_sensor_std_Nm: ~"),
+                      {.element = "plant.noise.torque_sensor_std_Nm", .mentions = {"null"}, .file = "test.yaml"});
+}
+
 TEST(SimRobotConfig, LoadsTheShippedPlant) {
   const auto c = phri::SimRobotConfig::from_yaml_file(kPlantYaml);
   EXPECT_EQ(c.dof(), 7);

@@ -109,12 +109,8 @@ SimRobotConfig parse_plant(const YamlReader& r, const std::string& base_dir) {
   YAML::Node plant;
   if (r.has("file")) {
     const std::string file = input_file(r, "file", base_dir, false);
-    YAML::Node loaded;
-    try {
-      loaded = YAML::LoadFile(file);
-    } catch (const YAML::Exception& e) {
-      throw ConfigError(file, "", std::string("invalid YAML: ") + e.what());
-    }
+    // Through YamlReader: the same syntax checks (duplicate keys, explicit nulls) as every file.
+    const YAML::Node loaded = YamlReader::load_file(file).node();
     if (!loaded.IsMap() || !loaded["plant"] || !loaded["plant"].IsMap()) {
       throw ConfigError(file, "plant", "expected a map under the key 'plant'");
     }
