@@ -222,6 +222,24 @@ TEST(Config, OutOfRangeValuesNameTheirPath) {
                       {.element = "plant.noise.torque_sensor_std_Nm", .file = "test.yaml"});
 }
 
+// Sizes that would exhaust memory before the run starts: run.duration_s (one cycle time per period
+// is kept) and logging.buffer_rows (the log ring, ~700 B a row).
+TEST(Config, RunLengthAndLogRingAreCapped) {
+  expect_config_error(loading_demo_with("duration_s: 33.5", "duration_s: 1e9"),
+                      {.element = "run.duration_s", .mentions = {"at most 3600 s"}, .file = "test.yaml"});
+  expect_config_error(loading_demo_with("duration_s: 33.5", "duration_s: 3600.5"),
+                      {.element = "run.duration_s", .mentions = {"at most 3600 s"}, .file = "test.yaml"});
+  EXPECT_DOUBLE_EQ(load_edited("duration_s: 33.5", "duration_s: 3600").run.duration_s, 3600.0);
+  expect_config_error(loading_demo_with("buffer_rows: 16384", "buffer_rows: 4194304"),
+                      {.element = "logging.buffer_rows", .mentions = {"100 MiB"}, .file = "test.yaml"});
+  const std::size_t max_rows = phri::log_ring_max_rows();
+  EXPECT_LE(max_rows * sizeof(phri::LogRow), phri::kLogRingMaxBytes);
+  EXPECT_GT(2 * max_rows * sizeof(phri::LogRow), phri::kLogRingMaxBytes);
+  EXPECT_EQ(load_edited("buffer_rows: 16384", "buffer_rows: " + std::to_string(max_rows)).logging.capacity_rows, max_rows);
+  expect_config_error(loading_demo_with("buffer_rows: 16384", "buffer_rows: " + std::to_string(max_rows + 1)),
+                      {.element = "logging.buffer_rows", .file = "test.yaml"});
+}
+
 TEST(Config, InconsistentPairsNameTheKeyThatMustChange) {
   expect_config_error(
       loading_demo_with("safety_distance_m: 0.015", "safety_distance_m: 0.03"),

@@ -1,5 +1,6 @@
 #include <phri/app/config.hpp>
 
+#include <phri/core/format.hpp>
 #include <phri/core/yaml_reader.hpp>
 #include <phri/robot/actuator_table.hpp>
 
@@ -342,6 +343,45 @@ std::vector<TimedEvent> parse_events(const YamlReader& list, double duration_s) 
   return out;
 }
 
+// ------------------------------------------------------------------------------------ logging, gamepad, run
+void parse_logging(const YamlReader& l, Config& c) {
+  l.allow_keys({"enabled", "path", "buffer_rows", "legend"});
+  c.logging_enabled = l.boolean_or("enabled", c.logging_enabled);
+  c.logging.path = l.text_or("path", c.logging.path);
+  if (c.logging.path.empty()) throw l.error("path", "empty file name");
+  const long long rows = l.integer_or("buffer_rows", static_cast<long long>(c.logging.capacity_rows), 16, 1LL << 40);
+  if (rows > static_cast<long long>(log_ring_max_rows())) {
+    throw l.error("buffer_rows", "at most " + std::to_string(log_ring_max_rows()) + " rows of " +
+                                     std::to_string(sizeof(LogRow)) + " bytes (the log ring stays under 100 MiB), got " +
+                                     std::to_string(rows));
+  }
+  c.logging.capacity_rows = static_cast<std::size_t>(rows);
+  c.logging.write_legend = l.boolean_or("legend", c.logging.write_legend);
+}
+
+void parse_gamepad(const YamlReader& g, GamepadSettings& s) {
+  g.allow_keys({"enabled", "poll_interval_ms", "trigger_press", "trigger_release"});
+  s.enabled = g.boolean_or("enabled", s.enabled);
+  s.poll_interval_ms = static_cast<int>(g.integer_or("poll_interval_ms", s.poll_interval_ms, 1, 1000));
+  GamepadMapping& m = s.mapping;
+  m.trigger_press = positive_or(g, "trigger_press", m.trigger_press, 1.0);
+  m.trigger_release = non_negative_or(g, "trigger_release", m.trigger_release, 1.0);
+  require_below(g, "trigger_release", m.trigger_release, m.trigger_press, "must be below trigger_press");
+}
+
+void parse_run(const YamlReader& r, RunSettings& s) {
+  r.allow_keys({"duration_s", "pacing"});
+  s.duration_s = positive_or(r, "duration_s", s.duration_s, kHuge);
+  if (s.duration_s > RunSettings::kMaxDuration_s) {
+    throw r.error("duration_s", "at most 3600 s (the run keeps one cycle time per period), got " +
+                                    format_general(s.duration_s, 10));
+  }
+  if (r.has("pacing")) {
+    s.pacing = r.choice("pacing", {"real_time", "lockstep"}) == "real_time" ? LoopClock::Pacing::kRealTime
+                                                                          : LoopClock::Pacing::kLockstep;
+  }
+}
+
 Config parse(const YamlReader& root, const std::string& base_dir) {
   const std::string& source = root.file();
   root.allow_keys({"robot", "plant", "controller", "low_level", "fsm", "events", "logging", "gamepad", "run"});
@@ -369,38 +409,10 @@ Config parse(const YamlReader& root, const std::string& base_dir) {
   // The FSM's start-up runs in Position; without it the run starts in the torque loop.
   c.controller.initial_loop = c.fsm.startup.enabled ? LowLevelMode::kPosition : c.fsm.torque_loop;
 
-  if (root.has("logging")) {
-    const YamlReader l = root.at("logging");
-    l.allow_keys({"enabled", "path", "buffer_rows", "legend"});
-    c.logging_enabled = l.boolean_or("enabled", c.logging_enabled);
-    c.logging.path = l.text_or("path", c.logging.path);
-    if (c.logging.path.empty()) throw l.error("path", "empty file name");
-    c.logging.capacity_rows = static_cast<std::size_t>(
-        l.integer_or("buffer_rows", static_cast<long long>(c.logging.capacity_rows), 16, 1 << 22));
-    c.logging.write_legend = l.boolean_or("legend", c.logging.write_legend);
-  }
+  if (root.has("logging")) parse_logging(root.at("logging"), c);
   c.logging.dof = std::min(dof, kLogMaxJoints);
-
-  if (root.has("gamepad")) {
-    const YamlReader g = root.at("gamepad");
-    g.allow_keys({"enabled", "poll_interval_ms", "trigger_press", "trigger_release"});
-    c.gamepad.enabled = g.boolean_or("enabled", c.gamepad.enabled);
-    c.gamepad.poll_interval_ms = static_cast<int>(g.integer_or("poll_interval_ms", c.gamepad.poll_interval_ms, 1, 1000));
-    GamepadMapping& m = c.gamepad.mapping;
-    m.trigger_press = positive_or(g, "trigger_press", m.trigger_press, 1.0);
-    m.trigger_release = non_negative_or(g, "trigger_release", m.trigger_release, 1.0);
-    require_below(g, "trigger_release", m.trigger_release, m.trigger_press, "must be below trigger_press");
-  }
-
-  if (root.has("run")) {
-    const YamlReader r = root.at("run");
-    r.allow_keys({"duration_s", "pacing"});
-    c.run.duration_s = positive_or(r, "duration_s", c.run.duration_s, kHuge);
-    if (r.has("pacing")) {
-      c.run.pacing = r.choice("pacing", {"real_time", "lockstep"}) == "real_time" ? LoopClock::Pacing::kRealTime
-                                                                                  : LoopClock::Pacing::kLockstep;
-    }
-  }
+  if (root.has("gamepad")) parse_gamepad(root.at("gamepad"), c.gamepad);
+  if (root.has("run")) parse_run(root.at("run"), c.run);
   if (root.has("events")) c.fsm.timeline = parse_events(root.at("events"), c.run.duration_s);
   return c;
 }
