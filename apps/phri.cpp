@@ -251,6 +251,7 @@ CLI::App* add_torque_tracking_command(CLI::App& experiment, TrackingArguments& a
 // `phri identify-friction`: the experiment with its files found (see locate).
 int friction_identification_command(phri::FrictionIdentificationOptions friction) {
   for (std::string* path : {&friction.plant_config_path, &friction.urdf_path, &friction.figure_script}) *path = locate(*path);
+  phri::ensure_output_directory(friction.output_dir);  // before the work: an unwritable folder fails now
   return phri::run_friction_identification_command(friction, std::cout);
 }
 
@@ -267,9 +268,13 @@ int torque_tracking_command(TrackingArguments& args) {
                             &torque.figure_script, &args.sweep.figure_script}) {
     *path = locate(*path);
   }
-  if (!args.static_sweep) return phri::run_torque_tracking_command(torque, std::cout);
+  if (!args.static_sweep) {
+    phri::ensure_output_directory(torque.output_dir);  // before the work: an unwritable folder fails now
+    return phri::run_torque_tracking_command(torque, std::cout);
+  }
   args.sweep.tracking = torque;
   if (args.out_option->count() > 0) args.sweep.output_dir = torque.output_dir;
+  phri::ensure_output_directory(args.sweep.output_dir);
   return phri::run_static_sweep_command(args.sweep, std::cout);
 }
 
