@@ -111,11 +111,12 @@ int run_command(const RunArguments& args) {
   const std::filesystem::path out(args.out_dir);
   config.logging.path = (out / std::filesystem::path(config.logging.path).filename()).string();
 
-  std::printf("phri run: %s, %.1f s, %s\n", args.config_path.c_str(), config.run.duration_s,
-              config.run.pacing == phri::LoopClock::Pacing::kLockstep ? "lockstep" : "real time");
+  // Everything that can refuse the configuration is built before the first line of output.
   phri::SimRobot robot(config.plant);
   phri::Controller cycle(config.controller);
   phri::Fsm fsm(config.fsm, cycle);
+  std::printf("phri run: %s, %.1f s, %s\n", args.config_path.c_str(), config.run.duration_s,
+              config.run.pacing == phri::LoopClock::Pacing::kLockstep ? "lockstep" : "real time");
   std::unique_ptr<phri::Gamepad> gamepad;
   if (config.gamepad.enabled) {
     gamepad = std::make_unique<phri::Gamepad>(config.gamepad);
@@ -308,8 +309,18 @@ std::string command_word_error(CLI::App& app, int argc, char** argv) {
   }
 }
 
+// One line whatever the message: a library's multi-line text (every phri error is one line
+// already) is joined with "; ".
 int print_error(const char* what) {
-  std::fprintf(stderr, "phri: error: %s\n", what);
+  std::string line;
+  for (const char* c = what; *c != '\0'; ++c) {
+    if (*c != '\n' && *c != '\r') {
+      line += *c;
+    } else if (!line.empty() && c[1] != '\0' && c[1] != '\n' && line.back() != ' ') {
+      line += "; ";
+    }
+  }
+  std::fprintf(stderr, "phri: error: %s\n", line.c_str());
   return 2;
 }
 

@@ -11,7 +11,9 @@
 #include <phri/robot/actuator_table.hpp>
 #include <phri/sim/external_force.hpp>
 #include <phri/sim/link_inertial.hpp>
+#include <phri/sim/mujoco_handles.hpp>
 #include <phri/sim/random_push_generator.hpp>
+#include <phri/sim/sim_scene.hpp>
 #include <phri/sim/sim_robot_config.hpp>
 #include <phri/sim/stick_slip_friction.hpp>
 
@@ -20,6 +22,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <functional>
 #include <numbers>
@@ -192,6 +195,26 @@ TEST(SimRobotConfig, CodeBuiltConfigGetsDefaults) {
   const auto shipped = phri::SimRobotConfig::from_yaml_file(kPlantYaml);
   EXPECT_EQ(c.vendor.position_kd_Nms_per_rad, shipped.vendor.position_kd_Nms_per_rad);
   EXPECT_EQ(c.vendor.torque_velocity_damping_Nms_per_rad, shipped.vendor.torque_velocity_damping_Nms_per_rad);
+}
+
+// MuJoCo's XML errors come on several lines ("XML Error: ...\nElement 'joint', line 55\n"): the
+// ConfigError carries them as one.
+TEST(SimRobotConfig, MujocoErrorsAreOneLine) {
+  EXPECT_EQ(phri::mujoco_error_line("XML Error: bad\n\n  Element 'joint', line 55  \n"),
+            "XML Error: bad; Element 'joint', line 55");
+  EXPECT_EQ(phri::mujoco_error_line(""), "unknown error");
+  std::string mjcf = read_file(kRoot + "/robots/kinova_gen3/gen3_plant.xml");
+  mjcf = edited(mjcf, "<joint name=\"joint_2\" range=\"-2.24 2.24\"/>", "<joint name=\"joint_2\" bogus=\"1\"/>");
+  const std::string path = (std::filesystem::temp_directory_path() / "phri_test_sim_config_broken.xml").string();
+  std::ofstream(path) << mjcf;
+  auto c = phri::SimRobotConfig::from_yaml_file(kPlantYaml);
+  c.mjcf_path = path;
+  const auto error = expect_config_error([&] { (void)phri::SimScene::build_mjcf(c); },
+                                         {.mentions = {"bogus", "line 55"}, .file = path});
+  if (error) {
+    EXPECT_EQ(std::string(error->what()).find('\n'), std::string::npos) << error->what();
+  }
+  std::filesystem::remove(path);
 }
 
 TEST(SimRobotConfig, ReadsOptionalSections) {

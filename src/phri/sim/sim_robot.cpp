@@ -1,6 +1,7 @@
 #include <phri/core/error.hpp>
 #include <phri/sim/sim_robot.hpp>
 #include <phri/sim/link_inertial.hpp>
+#include <phri/sim/mujoco_handles.hpp>
 #include <phri/sim/sim_scene.hpp>
 
 #include <Eigen/Geometry>
@@ -45,7 +46,7 @@ MjModelPtr load_scene(const std::string& xml, const std::string& source) {
   char error[1024] = "";
   MjModelPtr m(mj_loadXML(name, &vfs, error, sizeof(error)));
   mj_deleteVFS(&vfs);
-  if (!m) throw ConfigError(source, "scene", std::string("MuJoCo cannot load the composed scene: ") + error);
+  if (!m) throw ConfigError(source, "scene", "MuJoCo cannot load the composed scene: " + mujoco_error_line(error));
   return m;
 }
 

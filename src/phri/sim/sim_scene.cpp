@@ -37,7 +37,7 @@ FlangeMount find_flange_mount(const SimRobotConfig& config) {
   const std::string& file = config.mjcf_path;
   char error[1024] = "";
   const MjModelPtr arm(mj_loadXML(file.c_str(), nullptr, error, sizeof(error)));
-  if (!arm) throw ConfigError(file, "", std::string("MuJoCo cannot load it: ") + error);
+  if (!arm) throw ConfigError(file, "", "MuJoCo cannot load it: " + mujoco_error_line(error));
   const std::string& site_name = config.ft_sensor.flange_site;
   const int site = mj_name2id(arm.get(), mjOBJ_SITE, site_name.c_str());
   if (site < 0) throw ConfigError(config.source, "plant.ft_sensor.flange_site", "no site '" + site_name + "' in " + file);
