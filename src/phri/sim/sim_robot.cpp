@@ -148,6 +148,12 @@ int SimRobot::bind_joint(int i) {
     lower_[i] = -100.0;
     upper_[i] = 100.0;
   }
+  const double q0 = config_.initial_q_rad[static_cast<std::size_t>(i)];
+  if (q0 < lower_[i] || q0 > upper_[i]) {
+    throw ConfigError(config_.source, "plant.initial.q_rad[" + std::to_string(i) + "]",
+                      std::to_string(q0) + " rad is beyond " + a.joint_name + "'s range [" + std::to_string(lower_[i]) +
+                          ", " + std::to_string(upper_[i]) + "] in " + config_.mjcf_path);
+  }
   torque_per_amp_[i] = a.torque_per_amp();
   nominal_torque_per_amp_[i] = config_.actuators[i].torque_per_amp();
   current_limit_[i] = a.current_limit_A;
