@@ -240,6 +240,57 @@ TEST(Config, RunLengthAndLogRingAreCapped) {
                       {.element = "logging.buffer_rows", .file = "test.yaml"});
 }
 
+// Physical ranges and the checks against the robot the file names (the corpus,
+// tests/config_corpus, covers every one end to end through `phri run`).
+TEST(Config, PhysicalRangesNameTheKeyPath) {
+  // The discrete observer rings for K T > 1 and diverges for K T > 2.
+  expect_config_error(loading_demo_with("observer_gain: 50.0", "observer_gain: 2500.0"),
+                      {.element = "controller.observer_gain", .mentions = {"period_s", "< 1"}, .file = "test.yaml"});
+  expect_config_error(loading_demo_with("mass_kg: 0.3                       # [kg]", "mass_kg: 100 #"),
+                      {.element = "robot.payloads[1].mass_kg", .file = "test.yaml"});
+  expect_config_error(loading_demo_with("mass_kg: 0.26931", "mass_kg: .nan"),
+                      {.element = "robot.payloads[0].mass_kg", .mentions = {"finite"}, .file = "test.yaml"});
+  expect_config_error(loading_demo_with("# torque_limit_Nm: [95, 95, 95, 95, 26, 45, 26]",
+                                        "torque_limit_Nm: [500, 95, 95, 95, 26, 45, 26] #"),
+                      {.element = "controller.qp.torque_limit_Nm[0]", .mentions = {"drive maximum"}, .file = "test.yaml"});
+  expect_config_error(loading_demo_with("# velocity_limit_rad_s: [2.09,", "velocity_limit_rad_s: [120,"),
+                      {.element = "controller.qp.velocity_limit_rad_s[0]", .file = "test.yaml"});
+  expect_config_error(loading_demo_with("transfer_gain: 5.0", "transfer_gain: 500"),
+                      {.element = "low_level.custom.transfer_gain", .file = "test.yaml"});
+  expect_config_error(loading_demo_with("posture_damping: 9.0", "posture_damping: 5000"),
+                      {.element = "controller.compliance.posture_damping", .file = "test.yaml"});
+}
+
+TEST(Config, EndEffectorFrameMustBeMovedByEveryJoint) {
+  expect_config_error(loading_demo_with("end_effector_frame: end_effector_link", "end_effector_frame: base_link"),
+                      {.element = "robot.end_effector_frame", .mentions = {"not moved by any joint"}, .file = "test.yaml"});
+  expect_config_error(loading_demo_with("end_effector_frame: end_effector_link", "end_effector_frame: forearm_link"),
+                      {.element = "robot.end_effector_frame", .mentions = {"upstream"}, .file = "test.yaml"});
+  expect_config_error(loading_demo_with("end_effector_frame: end_effector_link", "end_effector_frame: nowhere"),
+                      {.element = "robot.end_effector_frame", .mentions = {"no frame"}, .file = "test.yaml"});
+  EXPECT_NO_THROW(load_edited("end_effector_frame: end_effector_link", "end_effector_frame: bracelet_link"));
+}
+
+TEST(Config, PosturesWithinTheJointLimitsAndClearOfCollision) {
+  const std::string posture = "posture_q_rad: [0.0, 0.58, 3.14, -1.84, 0.0, 0.85, 1.57]";
+  const std::string home = "home_q_rad: [0.0, 0.58, 3.14, -1.84, 0.0, 0.85, 1.57]";
+  expect_config_error(loading_demo_with(home, "home_q_rad: [0.0, 0.58, 3.14, -2.8, 0.0, 0.85, 1.57]"),
+                      {.element = "fsm.startup.home_q_rad[3]", .mentions = {"joint_4", "2.57"}, .file = "test.yaml"});
+  expect_config_error(loading_demo_with(posture, "posture_q_rad: [0.0, 0.58, 3.14, -1.84, 0.0, 2.5, 1.57]"),
+                      {.element = "fsm.static.posture_q_rad[5]", .mentions = {"joint_6"}, .file = "test.yaml"});
+  expect_config_error(loading_demo_with("  seed: 1 ", "  initial: {q_rad: [0, 3.0, 0, 0, 0, 0, 0]}\n  seed: 1 "),
+                      {.element = "plant.initial.q_rad[1]", .mentions = {"joint_2"}, .file = "test.yaml"});
+  // Folded: the wrist on the base, within every joint limit.
+  expect_config_error(loading_demo_with(posture, "posture_q_rad: [0.0, 2.2, 0.0, 2.5, 0.0, 2.0, 0.0]"),
+                      {.element = "fsm.static.posture_q_rad", .mentions = {"self-collision", "base_link"}, .file = "test.yaml"});
+  // Without a collision model, only the limits are checked.
+  std::string yaml = read_file(kDemo);
+  yaml.replace(yaml.find(posture), posture.size(), "posture_q_rad: [0.0, 2.2, 0.0, 2.5, 0.0, 2.0, 0.0]");
+  const std::string collision = "collision: ../robots/kinova_gen3/collision.yaml";
+  yaml.replace(yaml.find(collision), collision.size(), "collision: ''");
+  EXPECT_NO_THROW(phri::Config::from_yaml_string(yaml, "test.yaml", kRoot + "/configs"));
+}
+
 TEST(Config, InconsistentPairsNameTheKeyThatMustChange) {
   expect_config_error(
       loading_demo_with("safety_distance_m: 0.015", "safety_distance_m: 0.03"),
