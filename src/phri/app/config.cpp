@@ -157,9 +157,10 @@ SimRobotConfig parse_plant(const YamlReader& r, const std::string& base_dir) {
 // ------------------------------------------------------------------------------------ controller
 void parse_compliance_deadband(const YamlReader& d, int dof, ControllerSettings& c) {
   d.allow_keys({"large_Nm", "small_Nm", "per_joint_Nm"});
-  c.deadband_large_Nm = non_negative_or(d, "large_Nm", c.deadband_large_Nm, 100.0);
-  c.deadband_small_Nm = non_negative_or(d, "small_Nm", c.deadband_small_Nm, 100.0);
-  if (d.has("per_joint_Nm")) c.qp.compliance_deadband = d.per_joint<Eigen::VectorXd>("per_joint_Nm", dof, 0.0, 100.0);
+  // The dead band hides model error (~1 N.m), not a push: 10 N.m is already a firm push at the wrist.
+  c.deadband_large_Nm = non_negative_or(d, "large_Nm", c.deadband_large_Nm, 10.0);
+  c.deadband_small_Nm = non_negative_or(d, "small_Nm", c.deadband_small_Nm, 10.0);
+  if (d.has("per_joint_Nm")) c.qp.compliance_deadband = d.per_joint<Eigen::VectorXd>("per_joint_Nm", dof, 0.0, 10.0);
 }
 
 // The end-effector task's gains, in the stiff and full-body modes.
@@ -179,8 +180,9 @@ void parse_posture_task(const YamlReader& m, ComplianceSettings& s) {
 // Dual compliance: the Schmitt trigger on the filtered wrench and the damping while touched.
 void parse_touch_trigger(const YamlReader& m, ControllerSettings& c) {
   ComplianceSettings& s = c.compliance;
-  s.touch_threshold = non_negative_or(m, "touch_threshold", s.touch_threshold, 1e4);
-  s.release_threshold = non_negative_or(m, "release_threshold", s.release_threshold, 1e4);
+  // Wrench levels of a hand: 1000 N (or N.m) is far beyond any touch (the demo's 8 / 4).
+  s.touch_threshold = non_negative_or(m, "touch_threshold", s.touch_threshold, 1e3);
+  s.release_threshold = non_negative_or(m, "release_threshold", s.release_threshold, 1e3);
   s.touched_ee_damping = non_negative_or(m, "touched_ee_damping", s.touched_ee_damping, kMaxTaskDamping_per_s);
   s.touched_posture_damping = non_negative_or(m, "touched_posture_damping", s.touched_posture_damping, kMaxTaskDamping_per_s);
   c.wrench_trigger_filter_s = non_negative_or(m, "trigger_filter_s", c.wrench_trigger_filter_s, 1.0);
@@ -305,7 +307,7 @@ void parse_fsm(const YamlReader& r, int dof, FsmSettings& f) {
                                                                                    : Scenario::kDynamic;
   }
   f.stiffness_step = r.number_or("stiffness_step", f.stiffness_step, 1.0, 10.0);
-  f.rest_speed_rad_s = positive_or(r, "rest_speed_rad_s", f.rest_speed_rad_s, 10.0);
+  f.rest_speed_rad_s = positive_or(r, "rest_speed_rad_s", f.rest_speed_rad_s, 0.5);  // "at rest": well below motion
   if (r.has("startup")) {
     const YamlReader s = r.at("startup");
     s.allow_keys({"enabled", "home_q_rad", "max_joint_speed_rad_s", "min_duration_s", "tolerance_rad", "timeout_s"});
@@ -314,7 +316,7 @@ void parse_fsm(const YamlReader& r, int dof, FsmSettings& f) {
     if (s.has("home_q_rad")) st.home_q_rad = s.per_joint("home_q_rad", dof, -kMaxJointAngle_rad, kMaxJointAngle_rad);
     st.max_joint_speed_rad_s = positive_or(s, "max_joint_speed_rad_s", st.max_joint_speed_rad_s, 5.0);
     st.min_duration_s = non_negative_or(s, "min_duration_s", st.min_duration_s, 1000.0);
-    st.tolerance_rad = positive_or(s, "tolerance_rad", st.tolerance_rad, 10.0);
+    st.tolerance_rad = positive_or(s, "tolerance_rad", st.tolerance_rad, 1.0);  // a posture error norm, not a turn
     st.timeout_s = non_negative_or(s, "timeout_s", st.timeout_s, 1000.0);
   }
   if (r.has("static")) {

@@ -62,6 +62,10 @@ const ActuatorTable& checked(const ActuatorTable& table, const Model& model, con
 const ControllerSettings& checked(const ControllerSettings& settings) {
   if (!(settings.period_s > 0)) throw ConfigError("ControllerSettings", "period_s", "must be > 0");
   if (!(settings.observer_gain > 0)) throw ConfigError("ControllerSettings", "observer_gain", "must be > 0");
+  // The discrete observer's residual r[k] = (1 - K T) r[k-1] + ... rings for K T > 1, diverges above 2.
+  if (!(settings.observer_gain * settings.period_s < 1.0)) {
+    throw ConfigError("ControllerSettings", "observer_gain", "observer_gain x period_s must be < 1");
+  }
   if (!(settings.wrench_trigger_filter_s >= 0)) throw ConfigError("ControllerSettings", "wrench_trigger_filter_s", "must be >= 0");
   return settings;
 }

@@ -68,11 +68,14 @@ SimRobotConfig::ActuatorOverride parse_actuator_override(const YamlReader& j, co
   j.allow_keys({"coulomb_Nm", "viscous_Nms_per_rad", "static_Nm", "reflected_inertia_kgm2", "torque_constant_scale"});
   SimRobotConfig::ActuatorOverride ov;
   ov.joint = joint;
-  if (j.has("coulomb_Nm")) ov.coulomb_Nm = j.number("coulomb_Nm", 0.0, 1e3);
-  if (j.has("viscous_Nms_per_rad")) ov.viscous_Nms_per_rad = j.number("viscous_Nms_per_rad", 0.0, 1e3);
-  if (j.has("static_Nm")) ov.static_Nm = j.number("static_Nm", 0.0, 1e3);
-  if (j.has("reflected_inertia_kgm2")) ov.reflected_inertia_kgm2 = j.number("reflected_inertia_kgm2", 0.0, 100.0);
-  if (j.has("torque_constant_scale")) ov.torque_constant_scale = j.number("torque_constant_scale", 0.1, 10.0);
+  // The ranges of actuators.yaml (robot/actuator_table.cpp): friction up to 100 N.m or N.m.s/rad,
+  // reflected inertia up to 10 kg.m^2 (the Gen3's 0.03); a true K_T within a factor 2 of the
+  // nominal one (a spread beyond is another motor, not a tolerance).
+  if (j.has("coulomb_Nm")) ov.coulomb_Nm = j.number("coulomb_Nm", 0.0, 100.0);
+  if (j.has("viscous_Nms_per_rad")) ov.viscous_Nms_per_rad = j.number("viscous_Nms_per_rad", 0.0, 100.0);
+  if (j.has("static_Nm")) ov.static_Nm = j.number("static_Nm", 0.0, 100.0);
+  if (j.has("reflected_inertia_kgm2")) ov.reflected_inertia_kgm2 = j.number("reflected_inertia_kgm2", 0.0, 10.0);
+  if (j.has("torque_constant_scale")) ov.torque_constant_scale = j.number("torque_constant_scale", 0.5, 2.0);
   return ov;
 }
 
@@ -198,7 +201,7 @@ void parse_drop_test(const YamlReader& d, SimRobotConfig::DropTest& s) {
 void parse_floor(const YamlReader& f, SimRobotConfig::Floor& s) {
   f.allow_keys({"enabled", "height_m"});
   s.enabled = f.boolean_or("enabled", false);
-  s.height_m = f.number_or("height_m", 0.0, -10.0, 10.0);
+  s.height_m = f.number_or("height_m", 0.0, -2.0, 2.0);  // within the arm's reach of its base
 }
 
 // One entry of `disturbances:`.
