@@ -42,8 +42,9 @@
 //   gamepad:     enabled, poll_interval_ms, trigger_press, trigger_release    -> GamepadSettings
 //   run:         duration_s, pacing (real_time | lockstep)                    -> RunSettings
 //
-// Validation at load: unknown keys, wrong types, out-of-range values and inconsistent pairs are a
-// phri::ConfigError naming the file and the key path, e.g. "controller.qp.collision.safety_distance_m"
+// Validation at load: unknown keys, duplicate keys, explicit nulls, wrong types, values outside
+// their physical range and inconsistent pairs are a phri::ConfigError naming the file and the key
+// path (the checks against the robot, app/config_checks.hpp, too), e.g. "controller.qp.collision.safety_distance_m"
 // (d_s must be < d_i), "controller.compliance.release_threshold" (must be < touch_threshold),
 // "events[3].event". Input files (urdf, actuators, collision, plant file) are relative to the
 // folder of the YAML that names them and must exist; the log path (an output) is relative to the
