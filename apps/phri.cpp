@@ -22,6 +22,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <sstream>
@@ -109,11 +111,12 @@ int run_command(const RunArguments& args) {
   const std::filesystem::path out(args.out_dir);
   config.logging.path = (out / std::filesystem::path(config.logging.path).filename()).string();
 
-  std::printf("phri run: %s, %.1f s, %s\n", args.config_path.c_str(), config.run.duration_s,
-              config.run.pacing == phri::LoopClock::Pacing::kLockstep ? "lockstep" : "real time");
+  // Everything that can refuse the configuration is built before the first line of output.
   phri::SimRobot robot(config.plant);
   phri::Controller cycle(config.controller);
   phri::Fsm fsm(config.fsm, cycle);
+  std::printf("phri run: %s, %.1f s, %s\n", args.config_path.c_str(), config.run.duration_s,
+              config.run.pacing == phri::LoopClock::Pacing::kLockstep ? "lockstep" : "real time");
   std::unique_ptr<phri::Gamepad> gamepad;
   if (config.gamepad.enabled) {
     gamepad = std::make_unique<phri::Gamepad>(config.gamepad);
@@ -145,6 +148,29 @@ int run_command(const RunArguments& args) {
   return summary.safe_hold ? 3 : 0;
 }
 
+// `--duration`: a finite number of seconds (CLI::Range lets NaN through: every comparison with it
+// is false) in [0.001, RunSettings::kMaxDuration_s], the configuration's own cap on run.duration_s.
+CLI::Validator duration_seconds() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        std::size_t used = 0;
+        double value = 0.0;
+        try {
+          value = std::stod(text, &used);
+        } catch (const std::exception&) {
+          return "expected a number of seconds, got '" + text + "'";
+        }
+        if (used != text.size()) return "expected a number of seconds, got '" + text + "'";
+        if (!std::isfinite(value)) return "must be a finite number of seconds, got '" + text + "'";
+        if (value < 0.001) return "must be at least 0.001 s, got " + text;
+        if (value > phri::RunSettings::kMaxDuration_s) {
+          return "at most 3600 s (the run keeps one cycle time per period), got " + text;
+        }
+        return std::string();
+      },
+      "SECONDS");
+}
+
 CLI::App* add_run_command(CLI::App& app, RunArguments& args) {
   auto* run = app.add_subcommand("run", "Run a session on the simulated arm from one configuration file");
   run->add_option("--config", args.config_path, "configuration YAML (e.g. configs/demo.yaml)")
@@ -152,7 +178,8 @@ CLI::App* add_run_command(CLI::App& app, RunArguments& args) {
       ->check(CLI::ExistingFile);
   auto* lockstep = run->add_flag("--lockstep", args.lockstep, "as fast as possible (same code path)");
   run->add_flag("--realtime", args.real_time, "paced by the 1 ms real-time clock")->excludes(lockstep);
-  run->add_option("--duration", args.duration_s, "robot time to run [s]")->check(CLI::Range(0.001, 86400.0));
+  run->add_option("--duration", args.duration_s, "robot time to run [s], at most 3600")
+      ->check(duration_seconds());
   run->add_option("--out", args.out_dir, "output folder (log, summary, figure)")->capture_default_str();
   run->add_flag("!--no-figure", args.figure, "skip the figure");
   return run;
@@ -225,6 +252,7 @@ CLI::App* add_torque_tracking_command(CLI::App& experiment, TrackingArguments& a
 // `phri identify-friction`: the experiment with its files found (see locate).
 int friction_identification_command(phri::FrictionIdentificationOptions friction) {
   for (std::string* path : {&friction.plant_config_path, &friction.urdf_path, &friction.figure_script}) *path = locate(*path);
+  phri::ensure_output_directory(friction.output_dir);  // before the work: an unwritable folder fails now
   return phri::run_friction_identification_command(friction, std::cout);
 }
 
@@ -241,14 +269,58 @@ int torque_tracking_command(TrackingArguments& args) {
                             &torque.figure_script, &args.sweep.figure_script}) {
     *path = locate(*path);
   }
-  if (!args.static_sweep) return phri::run_torque_tracking_command(torque, std::cout);
+  if (!args.static_sweep) {
+    phri::ensure_output_directory(torque.output_dir);  // before the work: an unwritable folder fails now
+    return phri::run_torque_tracking_command(torque, std::cout);
+  }
   args.sweep.tracking = torque;
   if (args.out_option->count() > 0) args.sweep.output_dir = torque.output_dir;
+  phri::ensure_output_directory(args.sweep.output_dir);
   return phri::run_static_sweep_command(args.sweep, std::cout);
 }
 
+// The command words of a command line (`phri bogus`, `phri experiment bogus`, `phri`): CLI11 only
+// says "A subcommand is required"; this names the word and the commands there are. Empty when the
+// words are commands (options and the leaf command's own arguments are left to CLI11).
+std::string command_word_error(CLI::App& app, int argc, char** argv) {
+  CLI::App* level = &app;
+  std::string words;
+  for (int i = 1;; ++i) {
+    const std::vector<CLI::App*> commands = level->get_subcommands([](CLI::App*) { return true; });
+    if (commands.empty()) return "";
+    std::string names;
+    for (const CLI::App* c : commands) names += (names.empty() ? "" : ", ") + c->get_name();
+    const std::string where = words.empty() ? "commands" : "'" + words + "' commands";
+    if (i >= argc) {
+      return words.empty() ? "a command is required (commands: " + names + ")"
+                           : "'" + words + "' needs a command (" + where + ": " + names + ")";
+    }
+    const std::string word = argv[i];
+    if (!word.empty() && word[0] == '-') {
+      // Before the first command only phri's own options (--help, --version) may come.
+      const std::string name = word.substr(0, word.find('='));
+      if (level != &app || app.get_option_no_throw(name) != nullptr || name == "-h" || name == "--help") return "";
+      return "unknown option '" + name + "' before the command (commands: " + names + ")";
+    }
+    words += (words.empty() ? "" : " ") + word;
+    const auto named = std::find_if(commands.begin(), commands.end(), [&](CLI::App* c) { return c->check_name(word); });
+    if (named == commands.end()) return "unknown command '" + words + "' (" + where + ": " + names + ")";
+    level = *named;
+  }
+}
+
+// One line whatever the message: a library's multi-line text (every phri error is one line
+// already) is joined with "; ".
 int print_error(const char* what) {
-  std::fprintf(stderr, "phri: error: %s\n", what);
+  std::string line;
+  for (const char* c = what; *c != '\0'; ++c) {
+    if (*c != '\n' && *c != '\r') {
+      line += *c;
+    } else if (!line.empty() && c[1] != '\0' && c[1] != '\n' && line.back() != ' ') {
+      line += "; ";
+    }
+  }
+  std::fprintf(stderr, "phri: error: %s\n", line.c_str());
   return 2;
 }
 
@@ -275,6 +347,7 @@ int main(int argc, char** argv) {
   friction_alias->add_option("--out", friction.output_dir, "output folder");
   friction_alias->add_option("--seed", friction.seed, "seed");
 
+  if (const std::string error = command_word_error(app, argc, argv); !error.empty()) return print_error(error.c_str());
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -166,6 +166,17 @@ TEST_F(Gen3Collision, BadYamlNamesTheKey) {
   expect_config_error(loading(capsule_a + "pairs:\n  - [base_link, forearm_link]\n"), {.element = "pairs[0][1]"});
   expect_config_error(loading(capsule_a + capsule_b + "pairs:\n  - [base_link]\n"), {.element = "pairs[0]"});
   expect_config_error(loading("capsules: [ {link: base_link\n"), {.mentions = {"invalid YAML"}, .file = "bad.yaml"});
+  expect_config_error(loading(capsule_a + capsule_b + "pairs:\n  - [base_link, forearm_link]\npairs: []\n"),
+                      {.element = "pairs", .mentions = {"duplicate key"}});
+  expect_config_error(loading("capsules:\n  - {link: base_link, p0: [0,0,0], p1: [0,0,1], radius: }\npairs: []\n"),
+                      {.element = "capsules[0].radius", .mentions = {"null"}});
+  expect_config_error(loading("capsules:\n  - {link: base_link, p0: [0,0,0], p1: [0,0,1], radius: 5}\npairs: []\n"),
+                      {.element = "capsules[0].radius", .mentions = {"must be in"}});
+  // Links connected by one joint: their capsules meet at the joint, always "in collision".
+  const std::string capsule_c = "  - {link: spherical_wrist_1_link, p0: [0,0,0], p1: [0,0,-0.1], radius: 0.035}\n";
+  expect_config_error(loading(capsule_a + capsule_b + capsule_c + "pairs:\n  - [base_link, forearm_link]\n"
+                                                                   "  - [forearm_link, spherical_wrist_1_link]\n"),
+                      {.element = "pairs[1]", .mentions = {"joint_5", "connected by one joint"}});
   expect_config_error(loading(capsule_a + capsule_b + "pairs:\n  - [forearm_link, forearm_link]\n"),
                       {.element = "pairs[0]", .mentions = {"same body"}});
 }

@@ -222,6 +222,75 @@ TEST(Config, OutOfRangeValuesNameTheirPath) {
                       {.element = "plant.noise.torque_sensor_std_Nm", .file = "test.yaml"});
 }
 
+// Sizes that would exhaust memory before the run starts: run.duration_s (one cycle time per period
+// is kept) and logging.buffer_rows (the log ring, ~700 B a row).
+TEST(Config, RunLengthAndLogRingAreCapped) {
+  expect_config_error(loading_demo_with("duration_s: 33.5", "duration_s: 1e9"),
+                      {.element = "run.duration_s", .mentions = {"at most 3600 s"}, .file = "test.yaml"});
+  expect_config_error(loading_demo_with("duration_s: 33.5", "duration_s: 3600.5"),
+                      {.element = "run.duration_s", .mentions = {"at most 3600 s"}, .file = "test.yaml"});
+  EXPECT_DOUBLE_EQ(load_edited("duration_s: 33.5", "duration_s: 3600").run.duration_s, 3600.0);
+  expect_config_error(loading_demo_with("buffer_rows: 16384", "buffer_rows: 4194304"),
+                      {.element = "logging.buffer_rows", .mentions = {"100 MiB"}, .file = "test.yaml"});
+  const std::size_t max_rows = phri::log_ring_max_rows();
+  EXPECT_LE(max_rows * sizeof(phri::LogRow), phri::kLogRingMaxBytes);
+  EXPECT_GT(2 * max_rows * sizeof(phri::LogRow), phri::kLogRingMaxBytes);
+  EXPECT_EQ(load_edited("buffer_rows: 16384", "buffer_rows: " + std::to_string(max_rows)).logging.capacity_rows, max_rows);
+  expect_config_error(loading_demo_with("buffer_rows: 16384", "buffer_rows: " + std::to_string(max_rows + 1)),
+                      {.element = "logging.buffer_rows", .file = "test.yaml"});
+}
+
+// Physical ranges and the checks against the robot the file names (the corpus,
+// tests/config_corpus, covers every one end to end through `phri run`).
+TEST(Config, PhysicalRangesNameTheKeyPath) {
+  // The discrete observer rings for K T > 1 and diverges for K T > 2.
+  expect_config_error(loading_demo_with("observer_gain: 50.0", "observer_gain: 2500.0"),
+                      {.element = "controller.observer_gain", .mentions = {"period_s", "< 1"}, .file = "test.yaml"});
+  expect_config_error(loading_demo_with("mass_kg: 0.3                       # [kg]", "mass_kg: 100 #"),
+                      {.element = "robot.payloads[1].mass_kg", .file = "test.yaml"});
+  expect_config_error(loading_demo_with("mass_kg: 0.26931", "mass_kg: .nan"),
+                      {.element = "robot.payloads[0].mass_kg", .mentions = {"finite"}, .file = "test.yaml"});
+  expect_config_error(loading_demo_with("# torque_limit_Nm: [95, 95, 95, 95, 26, 45, 26]",
+                                        "torque_limit_Nm: [500, 95, 95, 95, 26, 45, 26] #"),
+                      {.element = "controller.qp.torque_limit_Nm[0]", .mentions = {"drive maximum"}, .file = "test.yaml"});
+  expect_config_error(loading_demo_with("# velocity_limit_rad_s: [2.09,", "velocity_limit_rad_s: [120,"),
+                      {.element = "controller.qp.velocity_limit_rad_s[0]", .file = "test.yaml"});
+  expect_config_error(loading_demo_with("transfer_gain: 5.0", "transfer_gain: 500"),
+                      {.element = "low_level.custom.transfer_gain", .file = "test.yaml"});
+  expect_config_error(loading_demo_with("posture_damping: 9.0", "posture_damping: 5000"),
+                      {.element = "controller.compliance.posture_damping", .file = "test.yaml"});
+}
+
+TEST(Config, EndEffectorFrameMustBeMovedByEveryJoint) {
+  expect_config_error(loading_demo_with("end_effector_frame: end_effector_link", "end_effector_frame: base_link"),
+                      {.element = "robot.end_effector_frame", .mentions = {"not moved by any joint"}, .file = "test.yaml"});
+  expect_config_error(loading_demo_with("end_effector_frame: end_effector_link", "end_effector_frame: forearm_link"),
+                      {.element = "robot.end_effector_frame", .mentions = {"upstream"}, .file = "test.yaml"});
+  expect_config_error(loading_demo_with("end_effector_frame: end_effector_link", "end_effector_frame: nowhere"),
+                      {.element = "robot.end_effector_frame", .mentions = {"no frame"}, .file = "test.yaml"});
+  EXPECT_NO_THROW(load_edited("end_effector_frame: end_effector_link", "end_effector_frame: bracelet_link"));
+}
+
+TEST(Config, PosturesWithinTheJointLimitsAndClearOfCollision) {
+  const std::string posture = "posture_q_rad: [0.0, 0.58, 3.14, -1.84, 0.0, 0.85, 1.57]";
+  const std::string home = "home_q_rad: [0.0, 0.58, 3.14, -1.84, 0.0, 0.85, 1.57]";
+  expect_config_error(loading_demo_with(home, "home_q_rad: [0.0, 0.58, 3.14, -2.8, 0.0, 0.85, 1.57]"),
+                      {.element = "fsm.startup.home_q_rad[3]", .mentions = {"joint_4", "2.57"}, .file = "test.yaml"});
+  expect_config_error(loading_demo_with(posture, "posture_q_rad: [0.0, 0.58, 3.14, -1.84, 0.0, 2.5, 1.57]"),
+                      {.element = "fsm.static.posture_q_rad[5]", .mentions = {"joint_6"}, .file = "test.yaml"});
+  expect_config_error(loading_demo_with("  seed: 1 ", "  initial: {q_rad: [0, 3.0, 0, 0, 0, 0, 0]}\n  seed: 1 "),
+                      {.element = "plant.initial.q_rad[1]", .mentions = {"joint_2"}, .file = "test.yaml"});
+  // Folded: the wrist on the base, within every joint limit.
+  expect_config_error(loading_demo_with(posture, "posture_q_rad: [0.0, 2.2, 0.0, 2.5, 0.0, 2.0, 0.0]"),
+                      {.element = "fsm.static.posture_q_rad", .mentions = {"self-collision", "base_link"}, .file = "test.yaml"});
+  // Without a collision model, only the limits are checked.
+  std::string yaml = read_file(kDemo);
+  yaml.replace(yaml.find(posture), posture.size(), "posture_q_rad: [0.0, 2.2, 0.0, 2.5, 0.0, 2.0, 0.0]");
+  const std::string collision = "collision: ../robots/kinova_gen3/collision.yaml";
+  yaml.replace(yaml.find(collision), collision.size(), "collision: ''");
+  EXPECT_NO_THROW(phri::Config::from_yaml_string(yaml, "test.yaml", kRoot + "/configs"));
+}
+
 TEST(Config, InconsistentPairsNameTheKeyThatMustChange) {
   expect_config_error(
       loading_demo_with("safety_distance_m: 0.015", "safety_distance_m: 0.03"),
@@ -242,6 +311,36 @@ TEST(Config, InconsistentPairsNameTheKeyThatMustChange) {
       {.element = "fsm.static.posture_q_rad", .mentions = {"expected 7 numbers"}, .file = "test.yaml"});
   expect_config_error(loading_demo_with("period_s: 0.001", "period_s: 0.002"),
                       {.element = "controller.period_s", .mentions = {"plant"}, .file = "test.yaml"});
+}
+
+// yaml-cpp keeps the first of two equal keys silently, and the loaders took `key:` (null) as
+// absent, i.e. the default: both are refused at load, naming the key path.
+TEST(Config, DuplicateKeysAndExplicitNullsAreRefused) {
+  expect_config_error(loading_demo_with("observer_gain: 50.0", "observer_gain: 50.0\n  observer_gain: 5000.0"),
+                      {.element = "controller.observer_gain", .mentions = {"duplicate key"}, .file = "test.yaml"});
+  expect_config_error(loading_demo_with("run:                                     # the run itself",
+                                        "run:\n  pacing: lockstep\nrun:"),
+                      {.element = "run", .mentions = {"duplicate key"}, .file = "test.yaml"});
+  expect_config_error(loading_demo_with("  - {at: 8.0, event: full_body_compliance}",
+                                        "  - {at: 8.0, at: 9.0, event: full_body_compliance}"),
+                      {.element = "events[0].at", .mentions = {"duplicate key"}, .file = "test.yaml"});
+  expect_config_error(loading_demo_with("observer_gain: 50.0", "observer_gain:"),
+                      {.element = "controller.observer_gain", .mentions = {"null"}, .file = "test.yaml"});
+  expect_config_error(loading_demo_with("observer_gain: 50.0", "observer_gain: ~"),
+                      {.element = "controller.observer_gain", .mentions = {"null"}, .file = "test.yaml"});
+  expect_config_error(loading_demo_with("ramp_s: 2.0", "ramp_s: null"),
+                      {.element = "fsm.dynamic.ramp_s", .mentions = {"null"}, .file = "test.yaml"});
+  // ... and in the plant file named by `plant.file` (a copy of plant_gen3.yaml with a duplicate).
+  const std::string plant = read_file(kRoot + "/configs/plant_gen3.yaml");
+  const std::string copy = (std::filesystem::temp_directory_path() / "phri_test_config_plant_dup.yaml").string();
+  {
+    std::string edited = plant;
+    edited.replace(edited.find("  seed: 1 "), 10, "  seed: 2\n  seed: 1 ");
+    std::ofstream(copy) << edited;
+  }
+  expect_config_error(loading_demo_with("file: plant_gen3.yaml", "file: " + copy),
+                      {.element = "plant.seed", .mentions = {"duplicate key"}, .file = copy});
+  std::filesystem::remove(copy);
 }
 
 TEST(Config, FilesAndSyntax) {

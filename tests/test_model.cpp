@@ -420,6 +420,27 @@ TEST(ModelValidation, InertialProblemsNameTheLink) {
                       {.mentions = {"half_arm_1_link"}, .file = "bad.urdf"});
 }
 
+// Physical ranges: finite but absurd inertials are refused too, naming the link.
+TEST(ModelValidation, AbsurdInertialsNameTheLink) {
+  expect_config_error(loading_urdf(gen3_with("<mass value=\"1.1636\"", "<mass value=\"1e300\"")),
+                      {.element = "link 'half_arm_1_link' <inertial>", .mentions = {"1000 kg"}, .file = "bad.urdf"});
+  expect_config_error(loading_urdf(gen3_with("<mass value=\"1.1636\"", "<mass value=\"1500\"")),
+                      {.element = "link 'half_arm_1_link' <inertial>", .mentions = {"1000 kg"}, .file = "bad.urdf"});
+  EXPECT_NO_THROW((void)phri::Model::from_urdf_string(gen3_with("<mass value=\"1.1636\"", "<mass value=\"999\"")));
+  // Moments of a body several metres across for its mass (radius of gyration above 2 m).
+  expect_config_error(loading_urdf(gen3_with("ixx=\"0.011088\" ixy=\"5E-06\" ixz=\"0\" iyy=\"0.001072\" iyz=\"-0.000691\" izz=\"0.011255\"",
+                                             "ixx=\"50\" ixy=\"0\" ixz=\"0\" iyy=\"50\" iyz=\"0\" izz=\"50\"")),
+                      {.element = "link 'half_arm_1_link' <inertial>", .mentions = {"radius of gyration"}, .file = "bad.urdf"});
+}
+
+// A revolute joint's limits beyond one turn each way (+-200 rad): a typo, or a joint that should be
+// 'continuous'.
+TEST(ModelValidation, RevoluteLimitsBeyondOneTurn) {
+  expect_config_error(loading_urdf(gen3_with("lower=\"-2.24\" upper=\"2.24\"", "lower=\"-200\" upper=\"200\"")),
+                      {.element = "joint 'joint_2' <limit>", .mentions = {"2 pi", "continuous"}, .file = "bad.urdf"});
+  EXPECT_NO_THROW((void)phri::Model::from_urdf_string(gen3_with("lower=\"-2.24\" upper=\"2.24\"", "lower=\"-6.28\" upper=\"6.28\"")));
+}
+
 TEST(ModelValidation, JointProblemsNameTheJoint) {
   expect_config_error(loading_urdf(gen3_with("lower=\"-2.24\" upper=\"2.24\"", "lower=\"2.24\" upper=\"-2.24\"")),
                       {.mentions = {"joint_2", "lower"}, .file = "bad.urdf"});

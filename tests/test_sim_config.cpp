@@ -11,7 +11,9 @@
 #include <phri/robot/actuator_table.hpp>
 #include <phri/sim/external_force.hpp>
 #include <phri/sim/link_inertial.hpp>
+#include <phri/sim/mujoco_handles.hpp>
 #include <phri/sim/random_push_generator.hpp>
+#include <phri/sim/sim_scene.hpp>
 #include <phri/sim/sim_robot_config.hpp>
 #include <phri/sim/stick_slip_friction.hpp>
 
@@ -20,6 +22,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <functional>
 #include <numbers>
@@ -103,6 +106,35 @@ TEST(ActuatorTable, ValidationNamesTheKey) {
                       {.element = "joints[0].gear_ratios", .file = "act.yaml"});
 }
 
+TEST(ActuatorTable, DuplicateKeysAndNullsAreRefused) {
+  expect_config_error(loading_actuators_with("    gear_ratio: 100 ", "    gear_ratio: 10\n    gear_ratio: 100 "),
+                      {.element = "joints[0].gear_ratio", .mentions = {"duplicate key"}, .file = "act.yaml"});
+  expect_config_error(loading_actuators_with("coulomb_Nm: 2.15", "coulomb_Nm:"),
+                      {.element = "joints[0].friction.coulomb_Nm", .mentions = {"null"}, .file = "act.yaml"});
+}
+
+TEST(SimRobotConfig, DuplicateKeysAndNullsAreRefused) {
+  expect_config_error(loading_plant_with("  seed: 1 ", "  seed: 2\n  seed: 1 "),
+                      {.element = "plant.seed", .mentions = {"duplicate key"}, .file = "test.yaml"});
+  expect_config_error(loading_plant_with("torque_sensor_std_Nm: 0.05", "torque_sensor_std_Nm: ~"),
+                      {.element = "plant.noise.torque_sensor_std_Nm", .mentions = {"null"}, .file = "test.yaml"});
+}
+
+// Drive limits: the QP's torque bound within what the motor can produce (current x K_T x G_r),
+// currents and speeds within physical ranges.
+TEST(ActuatorTable, PhysicalRangesNameTheKey) {
+  expect_config_error(loading_actuators_with("torque_limit_Nm: 95", "torque_limit_Nm: 500"),
+                      {.element = "joints[0].torque_limit_Nm", .mentions = {"105", "drive's maximum"}, .file = "act.yaml"});
+  expect_config_error(loading_actuators_with("torque_limit_Nm: 95", "torque_limit_Nm: 1e-6"),
+                      {.element = "joints[0].torque_limit_Nm", .file = "act.yaml"});
+  expect_config_error(loading_actuators_with("current_limit_A: 9.5454545", "current_limit_A: 1e4"),
+                      {.element = "joints[0].current_limit_A", .file = "act.yaml"});
+  expect_config_error(loading_actuators_with("velocity_limit_rad_s: 2.0944", "velocity_limit_rad_s: 120"),
+                      {.element = "joints[0].velocity_limit_rad_s", .file = "act.yaml"});
+  expect_config_error(loading_actuators_with("static_Nm: 2.15", "static_Nm: 200"),
+                      {.element = "joints[0].friction.static_Nm", .file = "act.yaml"});
+}
+
 TEST(SimRobotConfig, LoadsTheShippedPlant) {
   const auto c = phri::SimRobotConfig::from_yaml_file(kPlantYaml);
   EXPECT_EQ(c.dof(), 7);
@@ -180,6 +212,26 @@ TEST(SimRobotConfig, CodeBuiltConfigGetsDefaults) {
   EXPECT_EQ(c.vendor.torque_velocity_damping_Nms_per_rad, shipped.vendor.torque_velocity_damping_Nms_per_rad);
 }
 
+// MuJoCo's XML errors come on several lines ("XML Error: ...\nElement 'joint', line 55\n"): the
+// ConfigError carries them as one.
+TEST(SimRobotConfig, MujocoErrorsAreOneLine) {
+  EXPECT_EQ(phri::mujoco_error_line("XML Error: bad\n\n  Element 'joint', line 55  \n"),
+            "XML Error: bad; Element 'joint', line 55");
+  EXPECT_EQ(phri::mujoco_error_line(""), "unknown error");
+  std::string mjcf = read_file(kRoot + "/robots/kinova_gen3/gen3_plant.xml");
+  mjcf = edited(mjcf, "<joint name=\"joint_2\" range=\"-2.24 2.24\"/>", "<joint name=\"joint_2\" bogus=\"1\"/>");
+  const std::string path = (std::filesystem::temp_directory_path() / "phri_test_sim_config_broken.xml").string();
+  std::ofstream(path) << mjcf;
+  auto c = phri::SimRobotConfig::from_yaml_file(kPlantYaml);
+  c.mjcf_path = path;
+  const auto error = expect_config_error([&] { (void)phri::SimScene::build_mjcf(c); },
+                                         {.mentions = {"bogus", "line 55"}, .file = path});
+  if (error) {
+    EXPECT_EQ(std::string(error->what()).find('\n'), std::string::npos) << error->what();
+  }
+  std::filesystem::remove(path);
+}
+
 TEST(SimRobotConfig, ReadsOptionalSections) {
   std::string yaml = read_file(kPlantYaml);
   yaml.replace(yaml.find("disturbances: []"), std::string("disturbances: []").size(),
@@ -247,6 +299,41 @@ TEST(DiscreteTransferFunction, RejectsBadCoefficients) {
       {.element = "coefficients", .mentions = {"order above 5"}});
   phri::DiscreteTransferFunction identity;
   EXPECT_DOUBLE_EQ(identity.step(3.5), 3.5);
+}
+
+// The poles of a denominator, by the companion matrix: stable inside the unit circle.
+TEST(DiscreteTransferFunction, LargestPoleMagnitude) {
+  using phri::DiscreteTransferFunction;
+  const std::vector<double> kinova = {1.0, -1.975063, 0.97518};
+  // Real roots (1.975063 +- sqrt(1.975063^2 - 4 x 0.97518)) / 2.
+  const double root = (1.975063 + std::sqrt(1.975063 * 1.975063 - 4.0 * 0.97518)) / 2.0;
+  EXPECT_NEAR(DiscreteTransferFunction::largest_pole_magnitude(kinova), root, 1e-9);
+  EXPECT_LT(DiscreteTransferFunction::largest_pole_magnitude(kinova), 1.0);
+  // z^2 - 2.1 z + 1.2: complex pair of magnitude sqrt(1.2).
+  const std::vector<double> unstable = {1.0, -2.1, 1.2};
+  EXPECT_NEAR(DiscreteTransferFunction::largest_pole_magnitude(unstable), std::sqrt(1.2), 1e-9);
+  // Scaled by a0, and a pole at -1.5.
+  const std::vector<double> scaled = {2.0, 3.0};
+  EXPECT_NEAR(DiscreteTransferFunction::largest_pole_magnitude(scaled), 1.5, 1e-12);
+  const std::vector<double> constant = {4.0};
+  EXPECT_EQ(DiscreteTransferFunction::largest_pole_magnitude(constant), 0.0);
+}
+
+// Physical ranges of the plant: each refused with its key path.
+TEST(SimRobotConfig, PhysicalRangesNameTheKeyPath) {
+  expect_config_error(loading_plant_with("encoder_counts_per_rev: 262144", "encoder_counts_per_rev: 1"),
+                      {.element = "plant.noise.encoder_counts_per_rev", .mentions = {"4096"}, .file = "test.yaml"});
+  EXPECT_NO_THROW(loading_plant_with("encoder_counts_per_rev: 262144", "encoder_counts_per_rev: 0")());
+  expect_config_error(loading_plant_with("denominator: [1.0, -1.975063, 0.97518]", "denominator: [1.0, -2.1, 1.2]"),
+                      {.element = "plant.vendor.torque_high_velocity.denominator", .mentions = {"unstable"}, .file = "test.yaml"});
+  expect_config_error(loading_plant_with("kp_Nm_per_rad: [12000,", "kp_Nm_per_rad: [1000000,"),
+                      {.element = "plant.vendor.position.kp_Nm_per_rad[0]", .file = "test.yaml"});
+  expect_config_error(loading_plant_with("integral_limit_Nm: [60, 60, 60, 60, 30,", "integral_limit_Nm: [60, 60, 60, 60, 80,"),
+                      {.element = "plant.vendor.position.integral_limit_Nm[4]", .mentions = {"drive maximum"}, .file = "test.yaml"});
+  expect_config_error(loading_plant_with("mass_kg: 0.3", "mass_kg: 100"), {.element = "plant.tool.mass_kg", .file = "test.yaml"});
+  expect_config_error(loading_plant_with("mass_kg: 1.25", "mass_kg: 100"), {.element = "plant.drop_test.mass_kg", .file = "test.yaml"});
+  expect_config_error(loading_plant_with("q_rad: [0.0, 0.26179939,", "q_rad: [0.0, 180,"),
+                      {.element = "plant.initial.q_rad[1]", .file = "test.yaml"});
 }
 
 // ------------------------------------------------------------------------------------- random

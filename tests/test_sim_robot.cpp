@@ -10,6 +10,7 @@
 #include <phri/sim/sim_scene.hpp>
 
 #include "allocation_counter.hpp"
+#include "config_error.hpp"
 
 #include <mujoco/mujoco.h>
 
@@ -122,6 +123,14 @@ TEST(SimRobotScene, MujocoGravityEqualsUrdfPlusPayload) {
   const mjModel* m = robot.mujoco_model();
   EXPECT_NEAR(m->body_mass[mj_name2id(m, mjOBJ_BODY, phri::SimScene::kToolBody)], 0.3, 1e-12);
   EXPECT_NEAR(m->dof_armature[0], 0.03, 1e-12);
+}
+
+// The plant cannot start beyond its MJCF's joint range (joint_2: +-2.24 rad).
+TEST(SimRobotScene, InitialPostureBeyondTheJointRangeIsRefused) {
+  SimRobotConfig c = load(false);
+  c.initial_q_rad[1] = 3.0;
+  phri::test::expect_config_error([&] { phri::SimRobot robot(c); },
+                                  {.element = "plant.initial.q_rad[1]", .mentions = {"joint_2", "2.24"}});
 }
 
 TEST(SimRobotPhysics, GravityHeldInCurrentModeDoesNotDrift) {

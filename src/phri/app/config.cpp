@@ -1,5 +1,8 @@
 #include <phri/app/config.hpp>
 
+#include <phri/app/config_checks.hpp>
+
+#include <phri/core/format.hpp>
 #include <phri/core/yaml_reader.hpp>
 #include <phri/robot/actuator_table.hpp>
 
@@ -10,6 +13,23 @@ namespace phri {
 namespace {
 
 constexpr double kHuge = 1e9;
+
+// Physical ranges (the reason next to each).
+// What the arm carries beyond its URDF: at most 20 kg, 5x the Gen3's rated 4 kg payload (above,
+// a unit mistake), inertia at most 1 kg.m^2 (20 kg at a 0.22 m radius of gyration), its COM
+// within 1 m of the frame that carries it.
+constexpr double kMaxPayload_kg = 20.0;
+constexpr double kMaxPayloadInertia_kgm2 = 1.0;
+// A joint position beyond one turn each way is a typo (degrees for radians), not a posture.
+constexpr double kMaxJointAngle_rad = 2.0 * 3.14159265358979323846;
+// Joint speed: 10 rad/s (~570 deg/s) is beyond any collaborative arm's joint (the Gen3's 2.1 /
+// 3.05 rad/s); 120 is deg/s typed as rad/s.
+constexpr double kMaxJointVelocity_rad_s = 10.0;
+// A torque bound below 0.1 N.m cannot even overcome a joint's friction.
+constexpr double kMinTorqueLimit_Nm = 0.1;
+// Damping-like gains of the acceleration-level tasks [1/s] (D qd added to qdd each period): with
+// D T >= 1 at the 1 kHz period one cycle would more than cancel the velocity. 1000 1/s.
+constexpr double kMaxTaskDamping_per_s = 1000.0;
 
 // Input files are made absolute, so that a second resolution (the plant's own loader, against its
 // base folder) cannot prefix them again when the configuration was named by a relative path.
@@ -57,7 +77,7 @@ void parse_robot(const YamlReader& r, const std::string& base_dir, ControllerSet
   c.actuators_path = input_file(r, "actuators", base_dir, false);
   c.collision_path = r.has("collision") ? input_file(r, "collision", base_dir, true) : "";
   c.end_effector_frame = r.text_or("end_effector_frame", c.end_effector_frame);
-  c.ft_sensor_offset_m = r.number_or("ft_sensor_offset_m", c.ft_sensor_offset_m, 0.0, 1.0);
+  c.ft_sensor_offset_m = r.number_or("ft_sensor_offset_m", c.ft_sensor_offset_m, 0.0, 0.5);  // an adapter, not a boom
   if (r.has("payloads")) {
     const YamlReader list = r.at("payloads");
     list.expect_sequence();
@@ -68,9 +88,11 @@ void parse_robot(const YamlReader& r, const std::string& base_dir, ControllerSet
       Payload payload;
       payload.name = p.text("name");
       payload.frame = p.text_or("frame", "");  // empty: the end-effector frame
-      payload.inertia.mass = p.number("mass_kg", 0.0, 100.0);
-      payload.inertia.com = p.vector3_or("com_m", Eigen::Vector3d::Zero(), -2.0, 2.0);
-      payload.inertia.inertia_com = p.vector3_or("inertia_kgm2", Eigen::Vector3d::Zero(), 0.0, 10.0).asDiagonal();
+      payload.inertia.mass = p.number("mass_kg", 0.0, kMaxPayload_kg);
+      if (!(payload.inertia.mass > 0.0)) throw p.error("mass_kg", "must be > 0");
+      payload.inertia.com = p.vector3_or("com_m", Eigen::Vector3d::Zero(), -1.0, 1.0);
+      payload.inertia.inertia_com =
+          p.vector3_or("inertia_kgm2", Eigen::Vector3d::Zero(), 0.0, kMaxPayloadInertia_kgm2).asDiagonal();
       c.payloads.push_back(payload);
     }
   }
@@ -109,12 +131,8 @@ SimRobotConfig parse_plant(const YamlReader& r, const std::string& base_dir) {
   YAML::Node plant;
   if (r.has("file")) {
     const std::string file = input_file(r, "file", base_dir, false);
-    YAML::Node loaded;
-    try {
-      loaded = YAML::LoadFile(file);
-    } catch (const YAML::Exception& e) {
-      throw ConfigError(file, "", std::string("invalid YAML: ") + e.what());
-    }
+    // Through YamlReader: the same syntax checks (duplicate keys, explicit nulls) as every file.
+    const YAML::Node loaded = YamlReader::load_file(file).node();
     if (!loaded.IsMap() || !loaded["plant"] || !loaded["plant"].IsMap()) {
       throw ConfigError(file, "plant", "expected a map under the key 'plant'");
     }
@@ -139,9 +157,10 @@ SimRobotConfig parse_plant(const YamlReader& r, const std::string& base_dir) {
 // ------------------------------------------------------------------------------------ controller
 void parse_compliance_deadband(const YamlReader& d, int dof, ControllerSettings& c) {
   d.allow_keys({"large_Nm", "small_Nm", "per_joint_Nm"});
-  c.deadband_large_Nm = non_negative_or(d, "large_Nm", c.deadband_large_Nm, 100.0);
-  c.deadband_small_Nm = non_negative_or(d, "small_Nm", c.deadband_small_Nm, 100.0);
-  if (d.has("per_joint_Nm")) c.qp.compliance_deadband = d.per_joint<Eigen::VectorXd>("per_joint_Nm", dof, 0.0, 100.0);
+  // The dead band hides model error (~1 N.m), not a push: 10 N.m is already a firm push at the wrist.
+  c.deadband_large_Nm = non_negative_or(d, "large_Nm", c.deadband_large_Nm, 10.0);
+  c.deadband_small_Nm = non_negative_or(d, "small_Nm", c.deadband_small_Nm, 10.0);
+  if (d.has("per_joint_Nm")) c.qp.compliance_deadband = d.per_joint<Eigen::VectorXd>("per_joint_Nm", dof, 0.0, 10.0);
 }
 
 // The end-effector task's gains, in the stiff and full-body modes.
@@ -154,17 +173,18 @@ void parse_end_effector_task(const YamlReader& m, ComplianceSettings& s) {
 
 void parse_posture_task(const YamlReader& m, ComplianceSettings& s) {
   s.posture_stiffness = non_negative_or(m, "posture_stiffness", s.posture_stiffness, 1e5);
-  s.posture_damping = non_negative_or(m, "posture_damping", s.posture_damping, 1e4);
+  s.posture_damping = non_negative_or(m, "posture_damping", s.posture_damping, kMaxTaskDamping_per_s);
   s.posture_weight = positive_or(m, "posture_weight", s.posture_weight, 1e9);
 }
 
 // Dual compliance: the Schmitt trigger on the filtered wrench and the damping while touched.
 void parse_touch_trigger(const YamlReader& m, ControllerSettings& c) {
   ComplianceSettings& s = c.compliance;
-  s.touch_threshold = non_negative_or(m, "touch_threshold", s.touch_threshold, 1e4);
-  s.release_threshold = non_negative_or(m, "release_threshold", s.release_threshold, 1e4);
-  s.touched_ee_damping = non_negative_or(m, "touched_ee_damping", s.touched_ee_damping, 1e4);
-  s.touched_posture_damping = non_negative_or(m, "touched_posture_damping", s.touched_posture_damping, 1e4);
+  // Wrench levels of a hand: 1000 N (or N.m) is far beyond any touch (the demo's 8 / 4).
+  s.touch_threshold = non_negative_or(m, "touch_threshold", s.touch_threshold, 1e3);
+  s.release_threshold = non_negative_or(m, "release_threshold", s.release_threshold, 1e3);
+  s.touched_ee_damping = non_negative_or(m, "touched_ee_damping", s.touched_ee_damping, kMaxTaskDamping_per_s);
+  s.touched_posture_damping = non_negative_or(m, "touched_posture_damping", s.touched_posture_damping, kMaxTaskDamping_per_s);
   c.wrench_trigger_filter_s = non_negative_or(m, "trigger_filter_s", c.wrench_trigger_filter_s, 1.0);
   require_below(m, "release_threshold", s.release_threshold, s.touch_threshold,
                 "must be below touch_threshold (the Schmitt trigger's hysteresis)");
@@ -201,36 +221,58 @@ void parse_collision_damper(const YamlReader& k, VelocityDamperSettings& d) {
                 "must be below influence_distance_m (d_s < d_i)");
 }
 
-void parse_qp(const YamlReader& q, int dof, WholeBodyQpSettings& s) {
+// qp.torque_limit_Nm overrides actuators.yaml's bounds: each within what its drive can produce.
+Eigen::VectorXd parse_torque_limits(const YamlReader& q, const ActuatorTable& drives) {
+  const Eigen::VectorXd limits = q.per_joint<Eigen::VectorXd>("torque_limit_Nm", drives.size(), kMinTorqueLimit_Nm, 1e5);
+  for (int i = 0; i < drives.size(); ++i) {
+    if (limits[i] > drives[i].max_motor_torque_Nm() * (1.0 + 1e-9)) {
+      throw q.error("torque_limit_Nm[" + std::to_string(i) + "]",
+                    format_general(limits[i], 6) + " N.m exceeds " + drives[i].joint_name + "'s drive maximum " +
+                        format_general(drives[i].max_motor_torque_Nm(), 6) + " N.m (actuators.yaml: current_limit_A x K_T x G_r)");
+    }
+  }
+  return limits;
+}
+
+void parse_qp(const YamlReader& q, const ActuatorTable& drives, WholeBodyQpSettings& s) {
   q.allow_keys({"torque_limit_Nm", "velocity_limit_rad_s", "velocity_limit_fraction", "joint_limits",
                 "velocity_limit_gain", "collision", "regularization", "brake_damping", "smoothing_time_constant_s"});
-  if (q.has("torque_limit_Nm")) s.torque_limit = q.per_joint<Eigen::VectorXd>("torque_limit_Nm", dof, 1e-3, 1e4);
+  const int dof = drives.size();
+  if (q.has("torque_limit_Nm")) s.torque_limit = parse_torque_limits(q, drives);
   if (q.has("velocity_limit_rad_s")) {
-    s.velocity_limit = q.per_joint<Eigen::VectorXd>("velocity_limit_rad_s", dof, 1e-3, 100.0);
+    s.velocity_limit = q.per_joint<Eigen::VectorXd>("velocity_limit_rad_s", dof, 1e-3, kMaxJointVelocity_rad_s);
   }
   s.velocity_limit_fraction = positive_or(q, "velocity_limit_fraction", s.velocity_limit_fraction, 1.0);
   if (q.has("joint_limits")) parse_joint_limit_damper(q.at("joint_limits"), s);
-  s.velocity_limit_gain = positive_or(q, "velocity_limit_gain", s.velocity_limit_gain, 1e4);
+  s.velocity_limit_gain = positive_or(q, "velocity_limit_gain", s.velocity_limit_gain, kMaxTaskDamping_per_s);
   if (q.has("collision")) parse_collision_damper(q.at("collision"), s.collision);
   s.regularization = non_negative_or(q, "regularization", s.regularization, 1.0);
-  s.brake_damping = positive_or(q, "brake_damping", s.brake_damping, 1e4);
+  s.brake_damping = positive_or(q, "brake_damping", s.brake_damping, kMaxTaskDamping_per_s);
   s.smoothing_time_constant = non_negative_or(q, "smoothing_time_constant_s", s.smoothing_time_constant, 10.0);
 }
 
 void parse_wrench(const YamlReader& w, WrenchEstimatorSettings& s) {
   w.allow_keys({"tool_mass_kg", "tool_com_m", "bias_samples"});
-  s.tool_mass_kg = non_negative_or(w, "tool_mass_kg", s.tool_mass_kg, 100.0);
-  s.tool_com_m = w.vector3_or("tool_com_m", s.tool_com_m, -2.0, 2.0);
+  s.tool_mass_kg = non_negative_or(w, "tool_mass_kg", s.tool_mass_kg, kMaxPayload_kg);
+  s.tool_com_m = w.vector3_or("tool_com_m", s.tool_com_m, -1.0, 1.0);
   s.bias_samples = static_cast<int>(w.integer_or("bias_samples", s.bias_samples, 0, 1000000));
 }
 
-void parse_controller(const YamlReader& r, int dof, ControllerSettings& c) {
+void parse_controller(const YamlReader& r, const ActuatorTable& drives, ControllerSettings& c) {
   r.allow_keys({"period_s", "observer_gain", "compliance_deadband", "compliance", "qp", "wrench"});
   c.period_s = positive_or(r, "period_s", c.period_s, 0.1);
   c.observer_gain = positive_or(r, "observer_gain", c.observer_gain, 1e4);
-  if (r.has("compliance_deadband")) parse_compliance_deadband(r.at("compliance_deadband"), dof, c);
+  // The discrete observer's residual follows r[k] = (1 - K T) r[k-1] + K T tau_ext[k]: it rings
+  // for K T > 1 and diverges for K T > 2. K T < 1 keeps it a first-order low-pass.
+  if (!(c.observer_gain * c.period_s < 1.0)) {
+    throw r.error("observer_gain", "observer_gain x period_s must be < 1 (the discrete observer rings above 1 and "
+                                   "diverges above 2), got " + format_general(c.observer_gain, 6) + " x " +
+                                       format_general(c.period_s, 6) + " = " +
+                                       format_general(c.observer_gain * c.period_s, 6));
+  }
+  if (r.has("compliance_deadband")) parse_compliance_deadband(r.at("compliance_deadband"), drives.size(), c);
   if (r.has("compliance")) parse_compliance(r.at("compliance"), c);
-  if (r.has("qp")) parse_qp(r.at("qp"), dof, c.qp);
+  if (r.has("qp")) parse_qp(r.at("qp"), drives, c.qp);
   if (r.has("wrench")) parse_wrench(r.at("wrench"), c.wrench);
 }
 
@@ -246,9 +288,11 @@ void parse_low_level(const YamlReader& r, ControllerSettings& c, FsmSettings& fs
     k.allow_keys({"transfer_gain", "integral_gain", "integral_leak", "integral_limit_fraction",
                   "friction_compensation", "rotor_inertia_compensation"});
     CustomTorqueSettings& s = c.custom_torque;
-    s.transfer_gain = non_negative_or(k, "transfer_gain", s.transfer_gain, 1e3);
-    s.integral_gain = non_negative_or(k, "integral_gain", s.integral_gain, 1e4);
-    s.integral_leak = non_negative_or(k, "integral_leak", s.integral_leak, 1e4);
+    // lambda on H(z): 50 is 10x the paper's 5; K_I and theta at most 1000 1/s, the control rate
+    // (an integrator that leaks or acts faster than one period is no integrator).
+    s.transfer_gain = non_negative_or(k, "transfer_gain", s.transfer_gain, 50.0);
+    s.integral_gain = non_negative_or(k, "integral_gain", s.integral_gain, 1e3);
+    s.integral_leak = non_negative_or(k, "integral_leak", s.integral_leak, 1e3);
     s.integral_limit_fraction = non_negative_or(k, "integral_limit_fraction", s.integral_limit_fraction, 1.0);
     s.friction_compensation = k.boolean_or("friction_compensation", s.friction_compensation);
     s.rotor_inertia_compensation = k.boolean_or("rotor_inertia_compensation", s.rotor_inertia_compensation);
@@ -263,23 +307,25 @@ void parse_fsm(const YamlReader& r, int dof, FsmSettings& f) {
                                                                                    : Scenario::kDynamic;
   }
   f.stiffness_step = r.number_or("stiffness_step", f.stiffness_step, 1.0, 10.0);
-  f.rest_speed_rad_s = positive_or(r, "rest_speed_rad_s", f.rest_speed_rad_s, 10.0);
+  f.rest_speed_rad_s = positive_or(r, "rest_speed_rad_s", f.rest_speed_rad_s, 0.5);  // "at rest": well below motion
   if (r.has("startup")) {
     const YamlReader s = r.at("startup");
     s.allow_keys({"enabled", "home_q_rad", "max_joint_speed_rad_s", "min_duration_s", "tolerance_rad", "timeout_s"});
     StartupSettings& st = f.startup;
     st.enabled = s.boolean_or("enabled", st.enabled);
-    if (s.has("home_q_rad")) st.home_q_rad = s.per_joint("home_q_rad", dof, -100.0, 100.0);
+    if (s.has("home_q_rad")) st.home_q_rad = s.per_joint("home_q_rad", dof, -kMaxJointAngle_rad, kMaxJointAngle_rad);
     st.max_joint_speed_rad_s = positive_or(s, "max_joint_speed_rad_s", st.max_joint_speed_rad_s, 5.0);
     st.min_duration_s = non_negative_or(s, "min_duration_s", st.min_duration_s, 1000.0);
-    st.tolerance_rad = positive_or(s, "tolerance_rad", st.tolerance_rad, 10.0);
+    st.tolerance_rad = positive_or(s, "tolerance_rad", st.tolerance_rad, 1.0);  // a posture error norm, not a turn
     st.timeout_s = non_negative_or(s, "timeout_s", st.timeout_s, 1000.0);
   }
   if (r.has("static")) {
     const YamlReader s = r.at("static");
     s.allow_keys({"posture_q_rad", "move_speed_m_s", "move_angular_speed_rad_s", "min_move_duration_s"});
     StaticScenarioSettings& st = f.static_scenario;
-    if (s.has("posture_q_rad")) st.posture_q_rad = s.per_joint("posture_q_rad", dof, -100.0, 100.0);
+    if (s.has("posture_q_rad")) {
+      st.posture_q_rad = s.per_joint("posture_q_rad", dof, -kMaxJointAngle_rad, kMaxJointAngle_rad);
+    }
     st.move_speed_m_s = positive_or(s, "move_speed_m_s", st.move_speed_m_s, 2.0);
     st.move_angular_speed_rad_s = positive_or(s, "move_angular_speed_rad_s", st.move_angular_speed_rad_s, 10.0);
     st.min_move_duration_s = non_negative_or(s, "min_move_duration_s", st.min_move_duration_s, 1000.0);
@@ -346,6 +392,45 @@ std::vector<TimedEvent> parse_events(const YamlReader& list, double duration_s) 
   return out;
 }
 
+// ------------------------------------------------------------------------------------ logging, gamepad, run
+void parse_logging(const YamlReader& l, Config& c) {
+  l.allow_keys({"enabled", "path", "buffer_rows", "legend"});
+  c.logging_enabled = l.boolean_or("enabled", c.logging_enabled);
+  c.logging.path = l.text_or("path", c.logging.path);
+  if (c.logging.path.empty()) throw l.error("path", "empty file name");
+  const long long rows = l.integer_or("buffer_rows", static_cast<long long>(c.logging.capacity_rows), 16, 1LL << 40);
+  if (rows > static_cast<long long>(log_ring_max_rows())) {
+    throw l.error("buffer_rows", "at most " + std::to_string(log_ring_max_rows()) + " rows of " +
+                                     std::to_string(sizeof(LogRow)) + " bytes (the log ring stays under 100 MiB), got " +
+                                     std::to_string(rows));
+  }
+  c.logging.capacity_rows = static_cast<std::size_t>(rows);
+  c.logging.write_legend = l.boolean_or("legend", c.logging.write_legend);
+}
+
+void parse_gamepad(const YamlReader& g, GamepadSettings& s) {
+  g.allow_keys({"enabled", "poll_interval_ms", "trigger_press", "trigger_release"});
+  s.enabled = g.boolean_or("enabled", s.enabled);
+  s.poll_interval_ms = static_cast<int>(g.integer_or("poll_interval_ms", s.poll_interval_ms, 1, 1000));
+  GamepadMapping& m = s.mapping;
+  m.trigger_press = positive_or(g, "trigger_press", m.trigger_press, 1.0);
+  m.trigger_release = non_negative_or(g, "trigger_release", m.trigger_release, 1.0);
+  require_below(g, "trigger_release", m.trigger_release, m.trigger_press, "must be below trigger_press");
+}
+
+void parse_run(const YamlReader& r, RunSettings& s) {
+  r.allow_keys({"duration_s", "pacing"});
+  s.duration_s = positive_or(r, "duration_s", s.duration_s, kHuge);
+  if (s.duration_s > RunSettings::kMaxDuration_s) {
+    throw r.error("duration_s", "at most 3600 s (the run keeps one cycle time per period), got " +
+                                    format_general(s.duration_s, 10));
+  }
+  if (r.has("pacing")) {
+    s.pacing = r.choice("pacing", {"real_time", "lockstep"}) == "real_time" ? LoopClock::Pacing::kRealTime
+                                                                          : LoopClock::Pacing::kLockstep;
+  }
+}
+
 Config parse(const YamlReader& root, const std::string& base_dir) {
   const std::string& source = root.file();
   root.allow_keys({"robot", "plant", "controller", "low_level", "fsm", "events", "logging", "gamepad", "run"});
@@ -353,7 +438,8 @@ Config parse(const YamlReader& root, const std::string& base_dir) {
   c.source = source;
 
   parse_robot(root.at("robot"), base_dir, c.controller);
-  const int dof = ActuatorTable::from_yaml_file(c.controller.actuators_path).size();
+  const ActuatorTable drives = ActuatorTable::from_yaml_file(c.controller.actuators_path);
+  const int dof = drives.size();
 
   const YamlReader plant = root.at("plant");
   c.plant = parse_plant(plant, base_dir);
@@ -363,7 +449,7 @@ Config parse(const YamlReader& root, const std::string& base_dir) {
                           std::to_string(dof));
   }
 
-  if (root.has("controller")) parse_controller(root.at("controller"), dof, c.controller);
+  if (root.has("controller")) parse_controller(root.at("controller"), drives, c.controller);
   if (std::abs(c.controller.period_s - c.plant.control_period_s) > 1e-12) {
     throw ConfigError(source, "controller.period_s",
                       "must equal the plant's control period (plant.timing.control_period_s)");
@@ -373,39 +459,12 @@ Config parse(const YamlReader& root, const std::string& base_dir) {
   // The FSM's start-up runs in Position; without it the run starts in the torque loop.
   c.controller.initial_loop = c.fsm.startup.enabled ? LowLevelMode::kPosition : c.fsm.torque_loop;
 
-  if (root.has("logging")) {
-    const YamlReader l = root.at("logging");
-    l.allow_keys({"enabled", "path", "buffer_rows", "legend"});
-    c.logging_enabled = l.boolean_or("enabled", c.logging_enabled);
-    c.logging.path = l.text_or("path", c.logging.path);
-    if (c.logging.path.empty()) throw l.error("path", "empty file name");
-    c.logging.capacity_rows = static_cast<std::size_t>(
-        l.integer_or("buffer_rows", static_cast<long long>(c.logging.capacity_rows), 16, 1 << 22));
-    c.logging.write_legend = l.boolean_or("legend", c.logging.write_legend);
-  }
+  if (root.has("logging")) parse_logging(root.at("logging"), c);
   c.logging.dof = std::min(dof, kLogMaxJoints);
-
-  if (root.has("gamepad")) {
-    const YamlReader g = root.at("gamepad");
-    g.allow_keys({"enabled", "poll_interval_ms", "trigger_press", "trigger_release"});
-    c.gamepad.enabled = g.boolean_or("enabled", c.gamepad.enabled);
-    c.gamepad.poll_interval_ms = static_cast<int>(g.integer_or("poll_interval_ms", c.gamepad.poll_interval_ms, 1, 1000));
-    GamepadMapping& m = c.gamepad.mapping;
-    m.trigger_press = positive_or(g, "trigger_press", m.trigger_press, 1.0);
-    m.trigger_release = non_negative_or(g, "trigger_release", m.trigger_release, 1.0);
-    require_below(g, "trigger_release", m.trigger_release, m.trigger_press, "must be below trigger_press");
-  }
-
-  if (root.has("run")) {
-    const YamlReader r = root.at("run");
-    r.allow_keys({"duration_s", "pacing"});
-    c.run.duration_s = positive_or(r, "duration_s", c.run.duration_s, kHuge);
-    if (r.has("pacing")) {
-      c.run.pacing = r.choice("pacing", {"real_time", "lockstep"}) == "real_time" ? LoopClock::Pacing::kRealTime
-                                                                                  : LoopClock::Pacing::kLockstep;
-    }
-  }
+  if (root.has("gamepad")) parse_gamepad(root.at("gamepad"), c.gamepad);
+  if (root.has("run")) parse_run(root.at("run"), c.run);
   if (root.has("events")) c.fsm.timeline = parse_events(root.at("events"), c.run.duration_s);
+  check_config_against_robot(c);
   return c;
 }
 

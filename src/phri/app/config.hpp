@@ -42,8 +42,9 @@
 //   gamepad:     enabled, poll_interval_ms, trigger_press, trigger_release    -> GamepadSettings
 //   run:         duration_s, pacing (real_time | lockstep)                    -> RunSettings
 //
-// Validation at load: unknown keys, wrong types, out-of-range values and inconsistent pairs are a
-// phri::ConfigError naming the file and the key path, e.g. "controller.qp.collision.safety_distance_m"
+// Validation at load: unknown keys, duplicate keys, explicit nulls, wrong types, values outside
+// their physical range and inconsistent pairs are a phri::ConfigError naming the file and the key
+// path (the checks against the robot, app/config_checks.hpp, too), e.g. "controller.qp.collision.safety_distance_m"
 // (d_s must be < d_i), "controller.compliance.release_threshold" (must be < touch_threshold),
 // "events[3].event". Input files (urdf, actuators, collision, plant file) are relative to the
 // folder of the YAML that names them and must exist; the log path (an output) is relative to the
@@ -63,6 +64,10 @@
 namespace phri {
 
 struct RunSettings {
+  /// Longest run: one hour of robot time. The run loop keeps one cycle time (a double) per period
+  /// for its statistics, sized before the loop: 3.6e6 cycles at 1 kHz are 29 MB (1e9 s ended in
+  /// std::bad_alloc); a longer session is several runs.
+  static constexpr double kMaxDuration_s = 3600.0;
   double duration_s = 30.0;  ///< robot time after which the run ends (if `stop` has not ended it)
   LoopClock::Pacing pacing = LoopClock::Pacing::kRealTime;
 };

@@ -110,8 +110,19 @@ std::string Logger::legend_path_for(const std::string& csv_path) {
   return p.string() + ".legend.yaml";
 }
 
+namespace {
+// The ring size, checked before the ring is allocated (kLogRingMaxBytes).
+std::size_t checked_capacity(const LoggerSettings& settings) {
+  if (settings.capacity_rows > log_ring_max_rows()) {
+    throw ConfigError(settings.path, "capacity_rows",
+                      "at most " + std::to_string(log_ring_max_rows()) + " rows (the ring stays under 100 MiB)");
+  }
+  return settings.capacity_rows;
+}
+}  // namespace
+
 Logger::Logger(const LoggerSettings& settings)
-    : settings_(settings), legend_path_(legend_path_for(settings.path)), ring_(settings.capacity_rows) {
+    : settings_(settings), legend_path_(legend_path_for(settings.path)), ring_(checked_capacity(settings)) {
   if (settings.dof < 1 || settings.dof > kLogMaxJoints) {
     throw ConfigError(settings.path, "dof", "the logger records 1 to " + std::to_string(kLogMaxJoints) + " joints");
   }

@@ -1,5 +1,7 @@
 #include <phri/core/discrete_transfer_function.hpp>
 
+#include <Eigen/Eigenvalues>
+
 #include <algorithm>
 #include <cmath>
 #include <phri/core/error.hpp>
@@ -50,6 +52,17 @@ void DiscreteTransferFunction::reset_to_steady_state(double input) {
     const auto k = static_cast<std::size_t>(i);
     state_[k] = b_[k + 1] * input - a_[k + 1] * output + (i + 1 < order_ ? state_[k + 1] : 0.0);
   }
+}
+
+double DiscreteTransferFunction::largest_pole_magnitude(std::span<const double> denominator) {
+  const auto n = static_cast<Eigen::Index>(denominator.size()) - 1;
+  if (n < 1) return 0.0;
+  // Companion matrix of the monic z^n + c1 z^(n-1) + ... + cn, c_i = a_i / a0.
+  Eigen::MatrixXd companion = Eigen::MatrixXd::Zero(n, n);
+  for (Eigen::Index i = 0; i < n; ++i) companion(0, i) = -denominator[static_cast<std::size_t>(i + 1)] / denominator[0];
+  for (Eigen::Index i = 1; i < n; ++i) companion(i, i - 1) = 1.0;
+  const Eigen::EigenSolver<Eigen::MatrixXd> solver(companion, false);
+  return solver.eigenvalues().cwiseAbs().maxCoeff();
 }
 
 }  // namespace phri

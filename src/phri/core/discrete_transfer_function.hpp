@@ -53,6 +53,11 @@ public:
   const std::array<double, kMaxOrder + 1>& numerator() const { return b_; }
   const std::array<double, kMaxOrder + 1>& denominator() const { return a_; }
 
+  /// Largest pole magnitude of a denominator {a0, a1, ..., an} (a0 != 0): the roots of
+  /// a0 z^n + a1 z^(n-1) + ... + an, as the eigenvalues of its companion matrix. The filter is
+  /// stable when it is < 1 (every pole inside the unit circle); 0 for a constant denominator.
+  static double largest_pole_magnitude(std::span<const double> denominator);
+
 private:
   int order_ = 0;
   std::array<double, kMaxOrder + 1> b_{1.0, 0.0, 0.0, 0.0, 0.0, 0.0};

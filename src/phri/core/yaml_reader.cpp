@@ -2,6 +2,7 @@
 
 #include <phri/core/format.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -15,6 +16,35 @@ constexpr int kMessageDigits = 10;
 
 std::string range_text(double min, double max) {
   return "[" + format_general(min, kMessageDigits) + ", " + format_general(max, kMessageDigits) + "]";
+}
+
+std::string child_path(const std::string& path, const std::string& key) { return path.empty() ? key : path + "." + key; }
+
+// What yaml-cpp lets through silently, refused for the whole document as soon as it is parsed:
+// a key given twice in one map (yaml-cpp keeps both, and node[key] answers the first) and a key
+// whose value is an explicit null (`key:`, `key: ~`, `key: null`), which the loaders would take as
+// "absent" and replace by the default. No configuration file documents null as a value: to use the
+// default, leave the key out.
+void check_document(const YAML::Node& node, const std::string& file, const std::string& path) {
+  if (node.IsSequence()) {
+    for (std::size_t i = 0; i < node.size(); ++i) check_document(node[i], file, path + "[" + std::to_string(i) + "]");
+    return;
+  }
+  if (!node.IsMap()) return;
+  std::vector<std::string> seen;
+  for (const auto& item : node) {
+    if (!item.first.IsScalar()) throw ConfigError(file, path, "keys must be strings");
+    const std::string key = item.first.Scalar();
+    const std::string key_path = child_path(path, key);
+    if (std::find(seen.begin(), seen.end(), key) != seen.end()) {
+      throw ConfigError(file, key_path, "duplicate key (given twice in the same map)");
+    }
+    seen.push_back(key);
+    if (!item.second || item.second.IsNull()) {
+      throw ConfigError(file, key_path, "no value (explicit null); leave the key out to use the default");
+    }
+    check_document(item.second, file, key_path);
+  }
 }
 
 }  // namespace
@@ -35,11 +65,14 @@ YamlReader YamlReader::load_file(const std::string& path) {
 }
 
 YamlReader YamlReader::load_string(const std::string& text, const std::string& source_name) {
+  YAML::Node root;
   try {
-    return YamlReader(YAML::Load(text), source_name, "");
+    root = YAML::Load(text);
   } catch (const YAML::Exception& e) {
     throw ConfigError(source_name, "", std::string("invalid YAML: ") + e.what());
   }
+  check_document(root, source_name, "");
+  return YamlReader(std::move(root), source_name, "");
 }
 
 YamlReader::YamlReader(YAML::Node node, std::string file, std::string path)

@@ -40,7 +40,9 @@ std::string resolve_path(const std::string& base_dir, const std::string& file, P
 
 class YamlReader {
 public:
-  /// Parses a YAML file; throws ConfigError(path, "", reason) when it cannot be read or parsed.
+  /// Parses a YAML file; throws ConfigError(path, "", reason) when it cannot be read or parsed, and
+  /// ConfigError(path, key path, reason) for a key given twice in one map or an explicit null value
+  /// (`key:`, `key: ~`): yaml-cpp would keep the first silently, a loader would take null as absent.
   static YamlReader load_file(const std::string& path);
   /// Parses YAML text; `source_name` stands for the file name in error messages.
   static YamlReader load_string(const std::string& text, const std::string& source_name);

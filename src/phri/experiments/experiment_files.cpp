@@ -17,8 +17,15 @@ void ensure_output_directory(const std::string& dir) {
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
   if (ec || !std::filesystem::is_directory(dir)) {
-    throw IoError(dir, "cannot create the output directory: " + ec.message());
+    throw IoError(dir, "cannot create the output directory: " + (ec ? ec.message() : "not a directory"));
   }
+  // Writable: a probe file, created and removed (a read-only mount, a folder without write permission).
+  const std::filesystem::path probe = std::filesystem::path(dir) / ".phri_write_probe";
+  std::ofstream file(probe, std::ios::binary | std::ios::trunc);
+  const bool writable = static_cast<bool>(file << "probe\n");
+  file.close();
+  std::filesystem::remove(probe, ec);
+  if (!writable) throw IoError(dir, "cannot write into the output directory");
 }
 
 void write_text_file(const std::string& path, const std::string& text) {

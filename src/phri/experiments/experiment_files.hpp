@@ -10,7 +10,9 @@
 
 namespace phri {
 
-/// Creates `dir` (and its parents) when missing; throws IoError when that fails.
+/// Creates `dir` (and its parents) when missing and checks that a file can be written there;
+/// throws IoError when either fails. Commands call it before their work, so that an unwritable
+/// output folder is refused at once rather than after minutes of simulation.
 void ensure_output_directory(const std::string& dir);
 
 /// Writes `text` to `path`, replacing it; throws IoError when the file cannot be written.

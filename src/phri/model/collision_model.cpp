@@ -13,6 +13,15 @@ namespace phri {
 // ---------------------------------------------------------------------------------- loading
 namespace {
 
+// A capsule's radius at most 0.5 m (an arm link is ~0.1 m across: the Gen3's capsules are 0.035 to
+// 0.045 m) and its end points within 2 m of its link frame (every link lies within the arm's reach).
+constexpr double kMaxCapsuleRadius_m = 0.5;
+constexpr double kMaxCapsuleExtent_m = 2.0;
+
+// The pair's bodies are connected by one joint (or are the base and the first body): their
+// capsules meet at that joint by construction, so the pair would always read "in collision".
+bool adjacent(int body_a, int body_b) { return std::abs(body_a - body_b) == 1; }
+
 void read_collision_yaml(const YamlReader& root, const Model& model, std::vector<Capsule>& capsules,
                          std::vector<CapsulePair>& pairs) {
   root.expect_map();
@@ -32,10 +41,11 @@ void read_collision_yaml(const YamlReader& root, const Model& model, std::vector
     capsule.link = link_of(item.at("link"));
     const Frame& frame = model.frame(model.frame_id(capsule.link));
     capsule.body = frame.body;
-    const auto p0 = item.numbers("p0", 3, -1e3, 1e3), p1 = item.numbers("p1", 3, -1e3, 1e3);
+    const auto p0 = item.numbers("p0", 3, -kMaxCapsuleExtent_m, kMaxCapsuleExtent_m);
+    const auto p1 = item.numbers("p1", 3, -kMaxCapsuleExtent_m, kMaxCapsuleExtent_m);
     capsule.p0 = frame.placement * Eigen::Vector3d(p0[0], p0[1], p0[2]);
     capsule.p1 = frame.placement * Eigen::Vector3d(p1[0], p1[1], p1[2]);
-    capsule.radius = item.number("radius", 1e-6, 10.0);
+    capsule.radius = item.number("radius", 1e-6, kMaxCapsuleRadius_m);
     for (const Capsule& other : capsules) {
       if (other.link == capsule.link) throw item.error("link", "a second capsule for '" + capsule.link + "'");
     }
@@ -57,8 +67,13 @@ void read_collision_yaml(const YamlReader& root, const Model& model, std::vector
     CapsulePair pair;
     pair.first = capsule_index(item.at(std::size_t{0}));
     pair.second = capsule_index(item.at(std::size_t{1}));
-    if (capsules[static_cast<std::size_t>(pair.first)].body == capsules[static_cast<std::size_t>(pair.second)].body) {
-      throw item.error("", "both capsules move with the same body: their distance never changes");
+    const int body_a = capsules[static_cast<std::size_t>(pair.first)].body;
+    const int body_b = capsules[static_cast<std::size_t>(pair.second)].body;
+    if (body_a == body_b) throw item.error("", "both capsules move with the same body: their distance never changes");
+    if (adjacent(body_a, body_b)) {
+      const std::string joint = model.joint(std::max(body_a, body_b)).name;
+      throw item.error("", "links connected by one joint ('" + joint +
+                               "'): their capsules meet at the joint, the pair would always be in collision");
     }
     pairs.push_back(pair);
   }

@@ -61,6 +61,15 @@ std::mutex g_parse_mutex;
 
 bool finite(double x) { return std::isfinite(x); }
 
+// Physical ranges of a link (the reason next to each).
+// No link of a robot arm weighs a tonne (the Gen3's weigh 0.4 to 1.7 kg; an industrial arm's
+// heaviest link ~100 kg): above is a unit mistake or a corrupted file (1e300).
+constexpr double kMaxLinkMass_kg = 1000.0;
+// Radius of gyration sqrt(I / m) at most 2 m: every point of an arm link lies within its reach.
+constexpr double kMaxGyrationRadius_m = 2.0;
+// A revolute joint's limits within one turn each way; a joint that turns freely is 'continuous'.
+constexpr double kMaxRevoluteLimit_rad = 2.0 * 3.14159265358979323846;
+
 Eigen::Isometry3d to_isometry(const urdf::Pose& pose) {
   Eigen::Isometry3d out = Eigen::Isometry3d::Identity();
   Eigen::Quaterniond quat(pose.rotation.w, pose.rotation.x, pose.rotation.y, pose.rotation.z);
@@ -241,6 +250,13 @@ private:
           joint.lower = limits->lower;
           joint.upper = limits->upper;
         }
+        if (joint.type == JointType::kRevolute &&
+            std::max(std::abs(limits->lower), std::abs(limits->upper)) > kMaxRevoluteLimit_rad + 1e-9) {
+          fail(where + " <limit>", "revolute limits [" + format_general(limits->lower, 6) + ", " +
+                                       format_general(limits->upper, 6) +
+                                       "] rad go beyond one turn each way (|q| <= 2 pi); a joint that turns "
+                                       "freely is type 'continuous'");
+        }
       }
     } else if (joint.type != JointType::kContinuous) {
       fail(where, "a revolute or prismatic joint needs a <limit>");
@@ -262,6 +278,9 @@ private:
     if (in.mass < 0.0 || (in.mass == 0.0 && !tensor.isZero(0.0))) {
       fail(where, "mass must be positive (got " + format_general(in.mass, 6) + ")");
     }
+    if (in.mass > kMaxLinkMass_kg) {
+      fail(where, "mass " + format_general(in.mass, 6) + " kg is above 1000 kg: no arm link weighs that");
+    }
     if (in.mass == 0.0) {
       if (body >= 0 && on_path_.count(link.name) && link.parent_joint && moves(*link.parent_joint)) {
         fail(where, "mass must be positive (got 0) on a link moved by a joint");
@@ -269,6 +288,11 @@ private:
       return;  // a massless frame link
     }
     check_inertia_tensor(tensor, where);
+    const double largest_moment = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(tensor, Eigen::EigenvaluesOnly).eigenvalues()[2];
+    if (largest_moment > in.mass * kMaxGyrationRadius_m * kMaxGyrationRadius_m) {
+      fail(where, "principal moment " + format_general(largest_moment, 6) + " kg.m^2 is too large for the mass " +
+                      format_general(in.mass, 6) + " kg (radius of gyration above 2 m)");
+    }
     if (body < 0) return;  // fixed to the base: no effect on the dynamics
     const Eigen::Isometry3d inertial_frame = placement_in_body * to_isometry(in.origin);
     Inertia local;

@@ -1,10 +1,83 @@
+#include <phri/core/format.hpp>
 #include <phri/core/yaml_reader.hpp>
 #include <phri/robot/actuator_table.hpp>
 
+#include <algorithm>
 #include <cmath>
 
 namespace phri {
 namespace {
+
+// Physical ranges of a joint drive (the reason for each bound next to it).
+// Gear ratio: harmonic and planetary gears of robot joints are 30..320 (the Gen3's 100); 1 is a
+// direct drive, above 1000 no joint gearbox.
+constexpr double kMinGearRatio = 1.0, kMaxGearRatio = 1000.0;
+// Motor torque constant K_T (motor side): 1e-3..10 N.m/A spans motors from a few W to a few kW
+// (the Gen3's 0.11 / 0.076).
+constexpr double kMinTorqueConstant = 1e-3, kMaxTorqueConstant = 10.0;
+// Rotor inertia (motor side): up to 1e-2 kg.m^2, a motor of several kW (the Gen3's 3e-6).
+constexpr double kMaxRotorInertia = 1e-2;
+// Motor current: 100 A is a kW motor at 48 V; a collaborative arm's drives run at ~10 A
+// (the Gen3's limits here: 9.5 / 6.8 A). 1e4 A is a unit mistake.
+constexpr double kMaxCurrent_A = 100.0;
+// The QP's torque bound: at least 0.1 N.m (below, the drive cannot even hold the link's weight or
+// overcome its own friction), at most what the motor can produce (checked below).
+constexpr double kMinTorqueLimit_Nm = 0.1;
+// Joint velocity: 10 rad/s is ~570 deg/s, beyond any collaborative arm (the Gen3's 2.1 / 3.05
+// rad/s); 120 is a degrees-per-second value typed as rad/s.
+constexpr double kMaxJointVelocity_rad_s = 10.0;
+// Friction torques up to 100 N.m and viscous 100 N.m.s/rad (the Gen3's ~2 and ~2); thresholds of
+// the friction model up to 1 rad/s and 100 rad/s^2 (the Gen3's 0.1 and 1).
+constexpr double kMaxFriction_Nm = 100.0;
+
+void parse_friction(const YamlReader& f, const ActuatorParameters& a, FrictionParameters& out) {
+  f.allow_keys({"coulomb_Nm", "viscous_Nms_per_rad", "static_Nm", "velocity_threshold_rad_s",
+                "acceleration_threshold_rad_s2"});
+  out.coulomb_Nm = f.number("coulomb_Nm", 0.0, kMaxFriction_Nm);
+  out.viscous_Nms_per_rad = f.number("viscous_Nms_per_rad", 0.0, kMaxFriction_Nm);
+  out.static_Nm = f.number("static_Nm", 0.0, kMaxFriction_Nm);
+  if (out.static_Nm < out.coulomb_Nm) {
+    throw f.error("static_Nm", "must be >= coulomb_Nm (breakaway friction is not below kinetic friction)");
+  }
+  // A drive whose breakaway friction it cannot overcome never moves.
+  if (!(out.static_Nm < a.max_motor_torque_Nm())) {
+    throw f.error("static_Nm", "must be below the drive's maximum torque " + format_general(a.max_motor_torque_Nm(), 6) +
+                                   " N.m (current_limit_A x K_T x G_r)");
+  }
+  out.velocity_threshold_rad_s = f.number("velocity_threshold_rad_s", 0.0, 1.0);
+  out.acceleration_threshold_rad_s2 = f.number("acceleration_threshold_rad_s2", 0.0, 100.0);
+}
+
+// The limits: the current within kMaxCurrent_A, the torque bound within what that current gives.
+void parse_limits(const YamlReader& j, ActuatorParameters& a) {
+  a.current_limit_A = j.number("current_limit_A", 1e-3, kMaxCurrent_A);
+  a.torque_limit_Nm = j.number("torque_limit_Nm", kMinTorqueLimit_Nm, 1e5);
+  if (a.torque_limit_Nm > a.max_motor_torque_Nm() * (1.0 + 1e-9)) {
+    throw j.error("torque_limit_Nm", format_general(a.torque_limit_Nm, 6) + " N.m exceeds the drive's maximum " +
+                                         format_general(a.max_motor_torque_Nm(), 6) +
+                                         " N.m (current_limit_A x torque_constant_Nm_per_A x gear_ratio)");
+  }
+  a.velocity_limit_rad_s = j.number("velocity_limit_rad_s", 1e-3, kMaxJointVelocity_rad_s);
+}
+
+ActuatorParameters parse_joint(const YamlReader& j) {
+  j.allow_keys({"name", "size", "gear_ratio", "torque_constant_Nm_per_A", "rotor_inertia_kgm2", "reflected_inertia_kgm2",
+                "current_limit_A", "torque_limit_Nm", "velocity_limit_rad_s", "friction"});
+  ActuatorParameters a;
+  a.joint_name = j.text("name");
+  a.size = j.choice("size", {"large", "small"}) == "large" ? ActuatorSize::kLarge : ActuatorSize::kSmall;
+  a.gear_ratio = j.number("gear_ratio", kMinGearRatio, kMaxGearRatio);
+  a.torque_constant_Nm_per_A = j.number("torque_constant_Nm_per_A", kMinTorqueConstant, kMaxTorqueConstant);
+  a.rotor_inertia_kgm2 = j.number("rotor_inertia_kgm2", 0.0, kMaxRotorInertia);
+  a.reflected_inertia_kgm2 = j.number("reflected_inertia_kgm2", 0.0, kMaxRotorInertia * kMaxGearRatio * kMaxGearRatio);
+  const double computed = a.rotor_inertia_kgm2 * a.gear_ratio * a.gear_ratio;
+  if (std::abs(computed - a.reflected_inertia_kgm2) > 1e-3 * std::max(computed, 1e-12)) {
+    throw j.error("reflected_inertia_kgm2", "differs from rotor_inertia_kgm2 * gear_ratio^2 = " + std::to_string(computed));
+  }
+  parse_limits(j, a);
+  parse_friction(j.at("friction"), a, a.friction);
+  return a;
+}
 
 ActuatorTable parse(const YamlReader& root) {
   root.allow_keys({"joints"});
@@ -13,38 +86,10 @@ ActuatorTable parse(const YamlReader& root) {
   std::vector<ActuatorParameters> joints;
   for (std::size_t i = 0; i < list.size(); ++i) {
     const YamlReader j = list.at(i);
-    j.allow_keys({"name", "size", "gear_ratio", "torque_constant_Nm_per_A", "rotor_inertia_kgm2",
-                  "reflected_inertia_kgm2", "current_limit_A", "torque_limit_Nm", "velocity_limit_rad_s",
-                  "friction"});
-    ActuatorParameters a;
-    a.joint_name = j.text("name");
+    ActuatorParameters a = parse_joint(j);
     for (const auto& other : joints) {
       if (other.joint_name == a.joint_name) throw j.error("name", "duplicate joint '" + a.joint_name + "'");
     }
-    a.size = j.choice("size", {"large", "small"}) == "large" ? ActuatorSize::kLarge : ActuatorSize::kSmall;
-    a.gear_ratio = j.number("gear_ratio", 1e-3, 1e5);
-    a.torque_constant_Nm_per_A = j.number("torque_constant_Nm_per_A", 1e-6, 100.0);
-    a.rotor_inertia_kgm2 = j.number("rotor_inertia_kgm2", 0.0, 1.0);
-    a.reflected_inertia_kgm2 = j.number("reflected_inertia_kgm2", 0.0, 100.0);
-    const double computed = a.rotor_inertia_kgm2 * a.gear_ratio * a.gear_ratio;
-    if (std::abs(computed - a.reflected_inertia_kgm2) > 1e-3 * std::max(computed, 1e-12)) {
-      throw j.error("reflected_inertia_kgm2", "differs from rotor_inertia_kgm2 * gear_ratio^2 = " +
-                                                  std::to_string(computed));
-    }
-    a.current_limit_A = j.number("current_limit_A", 1e-6, 1e4);
-    a.torque_limit_Nm = j.number("torque_limit_Nm", 1e-6, 1e5);
-    a.velocity_limit_rad_s = j.number("velocity_limit_rad_s", 1e-6, 1e3);
-    const YamlReader f = j.at("friction");
-    f.allow_keys({"coulomb_Nm", "viscous_Nms_per_rad", "static_Nm", "velocity_threshold_rad_s",
-                  "acceleration_threshold_rad_s2"});
-    a.friction.coulomb_Nm = f.number("coulomb_Nm", 0.0, 1e3);
-    a.friction.viscous_Nms_per_rad = f.number("viscous_Nms_per_rad", 0.0, 1e3);
-    a.friction.static_Nm = f.number("static_Nm", 0.0, 1e3);
-    if (a.friction.static_Nm < a.friction.coulomb_Nm) {
-      throw f.error("static_Nm", "must be >= coulomb_Nm (breakaway friction is not below kinetic friction)");
-    }
-    a.friction.velocity_threshold_rad_s = f.number("velocity_threshold_rad_s", 0.0, 1e3);
-    a.friction.acceleration_threshold_rad_s2 = f.number("acceleration_threshold_rad_s2", 0.0, 1e6);
     joints.push_back(a);
   }
   return ActuatorTable(std::move(joints));

@@ -3,6 +3,7 @@
 // mj_deleteData. Only MuJoCo's forward declarations here, so that public headers holding a handle
 // (sim_robot.hpp) stay free of MuJoCo's headers.
 #include <memory>
+#include <string>
 
 struct mjModel_;
 struct mjData_;
@@ -19,5 +20,9 @@ struct MjDataDeleter {
 
 using MjModelPtr = std::unique_ptr<mjModel_, MjModelDeleter>;
 using MjDataPtr = std::unique_ptr<mjData_, MjDataDeleter>;
+
+/// MuJoCo's error buffer (mj_loadXML's, several lines: "XML Error: ...\nElement 'joint', line 55\n")
+/// as one line for a ConfigError: lines trimmed, empty ones dropped, the rest joined by "; ".
+std::string mujoco_error_line(const char* error);
 
 }  // namespace phri

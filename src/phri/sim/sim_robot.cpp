@@ -1,6 +1,7 @@
 #include <phri/core/error.hpp>
 #include <phri/sim/sim_robot.hpp>
 #include <phri/sim/link_inertial.hpp>
+#include <phri/sim/mujoco_handles.hpp>
 #include <phri/sim/sim_scene.hpp>
 
 #include <Eigen/Geometry>
@@ -45,7 +46,7 @@ MjModelPtr load_scene(const std::string& xml, const std::string& source) {
   char error[1024] = "";
   MjModelPtr m(mj_loadXML(name, &vfs, error, sizeof(error)));
   mj_deleteVFS(&vfs);
-  if (!m) throw ConfigError(source, "scene", std::string("MuJoCo cannot load the composed scene: ") + error);
+  if (!m) throw ConfigError(source, "scene", "MuJoCo cannot load the composed scene: " + mujoco_error_line(error));
   return m;
 }
 
@@ -146,6 +147,12 @@ int SimRobot::bind_joint(int i) {
   } else {
     lower_[i] = -100.0;
     upper_[i] = 100.0;
+  }
+  const double q0 = config_.initial_q_rad[static_cast<std::size_t>(i)];
+  if (q0 < lower_[i] || q0 > upper_[i]) {
+    throw ConfigError(config_.source, "plant.initial.q_rad[" + std::to_string(i) + "]",
+                      std::to_string(q0) + " rad is beyond " + a.joint_name + "'s range [" + std::to_string(lower_[i]) +
+                          ", " + std::to_string(upper_[i]) + "] in " + config_.mjcf_path);
   }
   torque_per_amp_[i] = a.torque_per_amp();
   nominal_torque_per_amp_[i] = config_.actuators[i].torque_per_amp();

@@ -1,3 +1,5 @@
+#include <phri/core/discrete_transfer_function.hpp>
+#include <phri/core/format.hpp>
 #include <phri/core/random_generator.hpp>
 #include <phri/core/yaml_reader.hpp>
 #include <phri/sim/sim_robot_config.hpp>
@@ -12,6 +14,29 @@ namespace {
 constexpr std::uint64_t kTorqueConstantMismatchStream = 4;
 
 constexpr double kHuge = 1e9;
+
+// Physical ranges (the reason for each bound next to it).
+// A joint position beyond one turn each way is a typo (degrees for radians), not a posture.
+constexpr double kMaxJointAngle_rad = 2.0 * 3.14159265358979323846;
+// What the arm may carry at its flange: 20 kg, 5x the Gen3's rated 4 kg payload; a drop-test mass
+// or a tool above it is a unit mistake (g for kg), and the drives could not hold it anyway.
+constexpr double kMaxCarriedMass_kg = 20.0;
+// Principal moments of a carried body: 1 kg.m^2 is 20 kg at a 0.22 m radius of gyration.
+constexpr double kMaxCarriedInertia_kgm2 = 1.0;
+// An encoder coarser than 12 bits per joint turn (1.5 mrad) is no arm encoder: the Gen3's is
+// ~2^18; a quantum of radians would make the velocity estimate and the position loop meaningless.
+constexpr double kMinEncoderCounts = 4096.0;
+// Vendor position servo: the defaults are 12000 / 3000 N.m/rad (robots/kinova_gen3/README.md).
+// 50000 N.m/rad is about the torsional stiffness of a harmonic drive of this size: a servo cannot
+// be stiffer than the gearbox it acts through. Kd, Ki scaled alike (defaults 150 / 60000).
+constexpr double kMaxVendorKp_Nm_per_rad = 5.0e4;
+constexpr double kMaxVendorKd_Nms_per_rad = 1.0e3;
+constexpr double kMaxVendorKi_Nm_per_rad_s = 5.0e5;
+// Vendor torque loop's velocity damping (defaults 15 / 5): 100 N.m.s/rad is 20x the viscous friction.
+constexpr double kMaxVendorDamping_Nms_per_rad = 100.0;
+// Coefficients of the vendor filter H(z): the paper's are below 2 in magnitude; a stable filter of
+// order <= 5 normalised by a0 has |a_i| <= C(5, i) <= 10.
+constexpr double kMaxFilterCoefficient = 10.0;
 
 ExternalForce::Profile parse_profile(const std::string& name) {
   if (name == "step") return ExternalForce::Profile::kStep;
@@ -36,18 +61,21 @@ void parse_timing(const YamlReader& t, SimRobotConfig& c) {
 
 std::vector<double> parse_initial_q(const YamlReader& init, int n) {
   init.allow_keys({"q_rad"});
-  return init.per_joint("q_rad", n, -100.0, 100.0);
+  return init.per_joint("q_rad", n, -kMaxJointAngle_rad, kMaxJointAngle_rad);
 }
 
 SimRobotConfig::ActuatorOverride parse_actuator_override(const YamlReader& j, const std::string& joint) {
   j.allow_keys({"coulomb_Nm", "viscous_Nms_per_rad", "static_Nm", "reflected_inertia_kgm2", "torque_constant_scale"});
   SimRobotConfig::ActuatorOverride ov;
   ov.joint = joint;
-  if (j.has("coulomb_Nm")) ov.coulomb_Nm = j.number("coulomb_Nm", 0.0, 1e3);
-  if (j.has("viscous_Nms_per_rad")) ov.viscous_Nms_per_rad = j.number("viscous_Nms_per_rad", 0.0, 1e3);
-  if (j.has("static_Nm")) ov.static_Nm = j.number("static_Nm", 0.0, 1e3);
-  if (j.has("reflected_inertia_kgm2")) ov.reflected_inertia_kgm2 = j.number("reflected_inertia_kgm2", 0.0, 100.0);
-  if (j.has("torque_constant_scale")) ov.torque_constant_scale = j.number("torque_constant_scale", 0.1, 10.0);
+  // The ranges of actuators.yaml (robot/actuator_table.cpp): friction up to 100 N.m or N.m.s/rad,
+  // reflected inertia up to 10 kg.m^2 (the Gen3's 0.03); a true K_T within a factor 2 of the
+  // nominal one (a spread beyond is another motor, not a tolerance).
+  if (j.has("coulomb_Nm")) ov.coulomb_Nm = j.number("coulomb_Nm", 0.0, 100.0);
+  if (j.has("viscous_Nms_per_rad")) ov.viscous_Nms_per_rad = j.number("viscous_Nms_per_rad", 0.0, 100.0);
+  if (j.has("static_Nm")) ov.static_Nm = j.number("static_Nm", 0.0, 100.0);
+  if (j.has("reflected_inertia_kgm2")) ov.reflected_inertia_kgm2 = j.number("reflected_inertia_kgm2", 0.0, 10.0);
+  if (j.has("torque_constant_scale")) ov.torque_constant_scale = j.number("torque_constant_scale", 0.5, 2.0);
   return ov;
 }
 
@@ -70,33 +98,42 @@ void parse_friction(const YamlReader& f, SimRobotConfig::Friction& s) {
 void parse_noise(const YamlReader& z, int n, SimRobotConfig::Noise& s) {
   z.allow_keys({"torque_sensor_std_Nm", "torque_sensor_offset_Nm", "velocity_std_rad_s", "current_std_A",
                 "encoder_counts_per_rev"});
-  s.torque_sensor_std_Nm = z.number_or("torque_sensor_std_Nm", s.torque_sensor_std_Nm, 0.0, 10.0);
-  if (z.has("torque_sensor_offset_Nm")) s.torque_sensor_offset_Nm = z.per_joint("torque_sensor_offset_Nm", n, -10.0, 10.0);
-  s.velocity_std_rad_s = z.number_or("velocity_std_rad_s", s.velocity_std_rad_s, 0.0, 1.0);
-  s.current_std_A = z.number_or("current_std_A", s.current_std_A, 0.0, 10.0);
-  s.encoder_counts_per_rev = z.number_or("encoder_counts_per_rev", s.encoder_counts_per_rev, 0.0, 1e12);
+  // Sensor noise and offsets: at most a few N.m / 0.1 rad/s / 1 A (the Gen3's are ~0.05 N.m,
+  // 0.002 rad/s, 0.01 A): more is a broken sensor, not noise.
+  s.torque_sensor_std_Nm = z.number_or("torque_sensor_std_Nm", s.torque_sensor_std_Nm, 0.0, 2.0);
+  if (z.has("torque_sensor_offset_Nm")) s.torque_sensor_offset_Nm = z.per_joint("torque_sensor_offset_Nm", n, -5.0, 5.0);
+  s.velocity_std_rad_s = z.number_or("velocity_std_rad_s", s.velocity_std_rad_s, 0.0, 0.1);
+  s.current_std_A = z.number_or("current_std_A", s.current_std_A, 0.0, 1.0);
+  // 0: no quantisation (tests); otherwise at least kMinEncoderCounts, at most 2^32.
+  s.encoder_counts_per_rev = z.number_or("encoder_counts_per_rev", s.encoder_counts_per_rev, 0.0, 4294967296.0);
+  if (s.encoder_counts_per_rev != 0.0 && s.encoder_counts_per_rev < kMinEncoderCounts) {
+    throw z.error("encoder_counts_per_rev", "must be 0 (no quantisation) or >= 4096 (12 bits per turn; the Gen3's "
+                                            "is ~2^18), got " + std::to_string(s.encoder_counts_per_rev));
+  }
 }
 
 void parse_ft_sensor(const YamlReader& f, SimRobotConfig::FtSensor& s) {
   f.allow_keys({"flange_site", "sensor_offset_m", "flange_side_mass_kg", "flange_side_com_m", "flange_side_inertia_kgm2",
                 "rate_Hz", "force_std_N", "torque_std_Nm", "force_bias_N", "torque_bias_Nm"});
   s.flange_site = f.text_or("flange_site", s.flange_site);
-  s.sensor_offset_m = f.number_or("sensor_offset_m", s.sensor_offset_m, 0.0, 1.0);
-  s.flange_side_mass_kg = f.number_or("flange_side_mass_kg", s.flange_side_mass_kg, 1e-4, 100.0);
-  s.flange_side_com_m = f.vector3_or("flange_side_com_m", s.flange_side_com_m, -1.0, 1.0);
-  s.flange_side_inertia_kgm2 = f.vector3_or("flange_side_inertia_kgm2", s.flange_side_inertia_kgm2, 1e-9, 10.0);
+  s.sensor_offset_m = f.number_or("sensor_offset_m", s.sensor_offset_m, 0.0, 0.5);  // an adapter, not a boom
+  s.flange_side_mass_kg = f.number_or("flange_side_mass_kg", s.flange_side_mass_kg, 1e-4, kMaxCarriedMass_kg);
+  s.flange_side_com_m = f.vector3_or("flange_side_com_m", s.flange_side_com_m, -0.5, 0.5);
+  s.flange_side_inertia_kgm2 =
+      f.vector3_or("flange_side_inertia_kgm2", s.flange_side_inertia_kgm2, 1e-9, kMaxCarriedInertia_kgm2);
   s.rate_Hz = f.number_or("rate_Hz", s.rate_Hz, 1.0, 100000.0);
-  s.force_std_N = f.number_or("force_std_N", s.force_std_N, 0.0, 100.0);
-  s.torque_std_Nm = f.number_or("torque_std_Nm", s.torque_std_Nm, 0.0, 10.0);
-  s.force_bias_N = f.vector3_or("force_bias_N", s.force_bias_N, -1000.0, 1000.0);
-  s.torque_bias_Nm = f.vector3_or("torque_bias_Nm", s.torque_bias_Nm, -100.0, 100.0);
+  // Noise and bias: within the SensONE's range (~±500 N, ±10 N.m) and far above its datasheet noise.
+  s.force_std_N = f.number_or("force_std_N", s.force_std_N, 0.0, 10.0);
+  s.torque_std_Nm = f.number_or("torque_std_Nm", s.torque_std_Nm, 0.0, 1.0);
+  s.force_bias_N = f.vector3_or("force_bias_N", s.force_bias_N, -100.0, 100.0);
+  s.torque_bias_Nm = f.vector3_or("torque_bias_Nm", s.torque_bias_Nm, -10.0, 10.0);
 }
 
 void parse_tool(const YamlReader& t, SimRobotConfig::Tool& s) {
   t.allow_keys({"mass_kg", "com_m", "inertia_kgm2"});
-  s.mass_kg = t.number_or("mass_kg", s.mass_kg, 1e-4, 100.0);
-  s.com_m = t.vector3_or("com_m", s.com_m, -1.0, 1.0);
-  s.inertia_kgm2 = t.vector3_or("inertia_kgm2", s.inertia_kgm2, 1e-9, 10.0);
+  s.mass_kg = t.number_or("mass_kg", s.mass_kg, 1e-4, kMaxCarriedMass_kg);
+  s.com_m = t.vector3_or("com_m", s.com_m, -0.5, 0.5);
+  s.inertia_kgm2 = t.vector3_or("inertia_kgm2", s.inertia_kgm2, 1e-9, kMaxCarriedInertia_kgm2);
 }
 
 void parse_mismatch(const YamlReader& m, SimRobotConfig::Mismatch& s) {
@@ -112,9 +149,12 @@ void parse_mismatch(const YamlReader& m, SimRobotConfig::Mismatch& s) {
 // vendor.position: the gains of the vendor's position loop, one per joint.
 void parse_vendor_position(const YamlReader& pos, int n, SimRobotConfig::Vendor& v) {
   pos.allow_keys({"kp_Nm_per_rad", "kd_Nms_per_rad", "ki_Nm_per_rad_s", "integral_limit_Nm"});
-  if (pos.has("kp_Nm_per_rad")) v.position_kp_Nm_per_rad = pos.per_joint("kp_Nm_per_rad", n, 0.0, 1e6);
-  if (pos.has("kd_Nms_per_rad")) v.position_kd_Nms_per_rad = pos.per_joint("kd_Nms_per_rad", n, 0.0, 1e4);
-  if (pos.has("ki_Nm_per_rad_s")) v.position_ki_Nm_per_rad_s = pos.per_joint("ki_Nm_per_rad_s", n, 0.0, 1e7);
+  if (pos.has("kp_Nm_per_rad")) v.position_kp_Nm_per_rad = pos.per_joint("kp_Nm_per_rad", n, 0.0, kMaxVendorKp_Nm_per_rad);
+  if (pos.has("kd_Nms_per_rad")) v.position_kd_Nms_per_rad = pos.per_joint("kd_Nms_per_rad", n, 0.0, kMaxVendorKd_Nms_per_rad);
+  if (pos.has("ki_Nm_per_rad_s")) {
+    v.position_ki_Nm_per_rad_s = pos.per_joint("ki_Nm_per_rad_s", n, 0.0, kMaxVendorKi_Nm_per_rad_s);
+  }
+  // At most the drive's torque: checked against actuators.yaml in validate().
   if (pos.has("integral_limit_Nm")) v.position_integral_limit_Nm = pos.per_joint("integral_limit_Nm", n, 0.0, 1e4);
 }
 
@@ -123,15 +163,17 @@ void parse_vendor_torque(const YamlReader& t, int n, SimRobotConfig::Vendor& v) 
   t.allow_keys({"feedback_gain", "velocity_damping_Nms_per_rad"});
   if (t.has("feedback_gain")) v.torque_feedback_gain = t.per_joint("feedback_gain", n, 0.0, 0.95);
   if (t.has("velocity_damping_Nms_per_rad")) {
-    v.torque_velocity_damping_Nms_per_rad = t.per_joint("velocity_damping_Nms_per_rad", n, 0.0, 1e3);
+    v.torque_velocity_damping_Nms_per_rad = t.per_joint("velocity_damping_Nms_per_rad", n, 0.0, kMaxVendorDamping_Nms_per_rad);
   }
 }
 
 // vendor.torque_high_velocity: the filter of the high-velocity torque loop.
 void parse_vendor_high_velocity(const YamlReader& h, SimRobotConfig::Vendor& v) {
   h.allow_keys({"numerator", "denominator", "rate_Hz"});
-  if (h.has("numerator")) v.high_velocity_numerator = h.numbers("numerator", -1, -1e6, 1e6);
-  if (h.has("denominator")) v.high_velocity_denominator = h.numbers("denominator", -1, -1e6, 1e6);
+  if (h.has("numerator")) v.high_velocity_numerator = h.numbers("numerator", -1, -kMaxFilterCoefficient, kMaxFilterCoefficient);
+  if (h.has("denominator")) {
+    v.high_velocity_denominator = h.numbers("denominator", -1, -kMaxFilterCoefficient, kMaxFilterCoefficient);
+  }
   v.high_velocity_rate_Hz = h.number_or("rate_Hz", v.high_velocity_rate_Hz, 1.0, 100000.0);
 }
 
@@ -146,9 +188,9 @@ void parse_drop_test(const YamlReader& d, SimRobotConfig::DropTest& s) {
   d.allow_keys({"enabled", "mass_kg", "radius_m", "cable_length_m", "cable_stiffness_N_per_m", "cable_damping_Ns_per_m",
                 "anchor_m", "release_time_s", "latch_stiffness_N_per_m"});
   s.enabled = d.boolean_or("enabled", false);
-  s.mass_kg = d.number_or("mass_kg", s.mass_kg, 1e-3, 100.0);
+  s.mass_kg = d.number_or("mass_kg", s.mass_kg, 1e-3, kMaxCarriedMass_kg);
   s.radius_m = d.number_or("radius_m", s.radius_m, 1e-3, 0.5);
-  s.cable_length_m = d.number_or("cable_length_m", s.cable_length_m, 0.0, 10.0);
+  s.cable_length_m = d.number_or("cable_length_m", s.cable_length_m, 0.0, 2.0);  // the arm's reach is ~1 m
   s.cable_stiffness_N_per_m = d.number_or("cable_stiffness_N_per_m", s.cable_stiffness_N_per_m, 1.0, 1e7);
   s.cable_damping_Ns_per_m = d.number_or("cable_damping_Ns_per_m", s.cable_damping_Ns_per_m, 0.0, 1e5);
   s.anchor_m = d.vector3_or("anchor_m", s.anchor_m, -1.0, 1.0);
@@ -159,7 +201,7 @@ void parse_drop_test(const YamlReader& d, SimRobotConfig::DropTest& s) {
 void parse_floor(const YamlReader& f, SimRobotConfig::Floor& s) {
   f.allow_keys({"enabled", "height_m"});
   s.enabled = f.boolean_or("enabled", false);
-  s.height_m = f.number_or("height_m", 0.0, -10.0, 10.0);
+  s.height_m = f.number_or("height_m", 0.0, -2.0, 2.0);  // within the arm's reach of its base
 }
 
 // One entry of `disturbances:`.
@@ -167,11 +209,12 @@ ExternalForce parse_disturbance(const YamlReader& e) {
   e.allow_keys({"body", "point_m", "frame", "force_N", "torque_Nm", "profile", "start_s", "duration_s", "rise_s"});
   ExternalForce f;
   f.body = e.text("body");
-  f.point_m = e.vector3_or("point_m", Eigen::Vector3d::Zero(), -10.0, 10.0);
+  f.point_m = e.vector3_or("point_m", Eigen::Vector3d::Zero(), -2.0, 2.0);  // on the body: within the arm's size
   f.frame = e.choice_or("frame", "world", {"world", "local"}) == "world" ? ExternalForce::Frame::kWorld
                                                                         : ExternalForce::Frame::kLocal;
-  f.force_N = e.vector3_or("force_N", Eigen::Vector3d::Zero(), -1e4, 1e4);
-  f.torque_Nm = e.vector3_or("torque_Nm", Eigen::Vector3d::Zero(), -1e3, 1e3);
+  // A person pushes with a few hundred N at most; 1000 N / 100 N.m is already a hard impact.
+  f.force_N = e.vector3_or("force_N", Eigen::Vector3d::Zero(), -1e3, 1e3);
+  f.torque_Nm = e.vector3_or("torque_Nm", Eigen::Vector3d::Zero(), -100.0, 100.0);
   f.profile = parse_profile(e.choice("profile", {"step", "ramp", "half_sine"}));
   f.start_s = e.number("start_s", 0.0, kHuge);
   f.duration_s = e.number("duration_s", 1e-6, kHuge);
@@ -286,6 +329,94 @@ int SimRobotConfig::substeps_per_cycle() const {
   return static_cast<int>(std::lround(control_period_s * physics_rate_Hz));
 }
 
+namespace {
+
+// The vendor loops: sizes, the torque loop's gain, the integral clamp within the drive's torque,
+// and H(z) a stable filter.
+void validate_vendor(const SimRobotConfig& c) {
+  const std::string& f = c.source;
+  const auto& vendor = c.vendor;
+  check_size(c, vendor.position_kp_Nm_per_rad, "plant.vendor.position.kp_Nm_per_rad");
+  check_size(c, vendor.position_kd_Nms_per_rad, "plant.vendor.position.kd_Nms_per_rad");
+  check_size(c, vendor.position_ki_Nm_per_rad_s, "plant.vendor.position.ki_Nm_per_rad_s");
+  check_size(c, vendor.position_integral_limit_Nm, "plant.vendor.position.integral_limit_Nm");
+  check_size(c, vendor.torque_feedback_gain, "plant.vendor.torque.feedback_gain");
+  check_size(c, vendor.torque_velocity_damping_Nms_per_rad, "plant.vendor.torque.velocity_damping_Nms_per_rad");
+  for (double g : vendor.torque_feedback_gain) {
+    // The torque loop closes through the (almost algebraic) transmission: it needs gain < 1 to be
+    // stable with a one-sample measurement delay (see KinovaDriveEmulator).
+    if (!(g >= 0.0 && g < 0.95)) throw ConfigError(f, "plant.vendor.torque.feedback_gain", "must be in [0, 0.95)");
+  }
+  for (int i = 0; i < c.dof(); ++i) {
+    // The integral term adds to a torque the motor must produce: no more than the drive can.
+    const double limit = vendor.position_integral_limit_Nm[static_cast<std::size_t>(i)];
+    const double drive = c.actuators[i].max_motor_torque_Nm();
+    if (!(limit <= drive)) {
+      throw ConfigError(f, "plant.vendor.position.integral_limit_Nm[" + std::to_string(i) + "]",
+                        format_general(limit, 6) + " N.m exceeds " + c.actuators[i].joint_name +
+                            "'s drive maximum " + format_general(drive, 6) + " N.m (current_limit_A x K_T x G_r)");
+    }
+  }
+  const auto& num = vendor.high_velocity_numerator;
+  const auto& den = vendor.high_velocity_denominator;
+  if (num.empty() || den.empty() || num.size() > 6 || den.size() > 6 || den[0] == 0.0) {
+    throw ConfigError(f, "plant.vendor.torque_high_velocity", "needs 1..6 numerator and denominator coefficients, a0 != 0");
+  }
+  for (const double x : num) {
+    if (!std::isfinite(x)) throw ConfigError(f, "plant.vendor.torque_high_velocity.numerator", "must be finite");
+  }
+  const double pole = DiscreteTransferFunction::largest_pole_magnitude(den);
+  if (!(pole < 1.0)) {
+    throw ConfigError(f, "plant.vendor.torque_high_velocity.denominator",
+                      "unstable filter: a pole of magnitude " + format_general(pole, 6) +
+                          " (every root of a0 z^n + a1 z^(n-1) + ... + an must lie inside the unit circle)");
+  }
+}
+
+// The plant's drives after the overrides.
+void validate_plant_drives(const SimRobotConfig& c) {
+  for (const auto& o : c.actuator_overrides) {
+    if (c.actuators.index_of(o.joint) < 0) throw ConfigError(c.source, "plant.actuator_overrides." + o.joint, "unknown joint");
+  }
+  const ActuatorTable plant = c.plant_actuators();
+  for (int i = 0; i < plant.size(); ++i) {
+    if (plant[i].reflected_inertia_kgm2 < 1e-3) {
+      // The stick-slip friction's presliding stiffness is scaled on it (see StickSlipFriction).
+      throw ConfigError(c.source, "plant.actuator_overrides." + plant[i].joint_name + ".reflected_inertia_kgm2",
+                        "plant reflected rotor inertia must be >= 1e-3 kg.m^2");
+    }
+    if (plant[i].friction.static_Nm < plant[i].friction.coulomb_Nm) {
+      throw ConfigError(c.source, "plant.actuator_overrides." + plant[i].joint_name + ".static_Nm",
+                        "plant static friction must be >= its Coulomb friction");
+    }
+  }
+}
+
+void validate_scripted_forces(const SimRobotConfig& c) {
+  const std::string& f = c.source;
+  if (c.drop_test.enabled && !(c.drop_test.cable_length_m > 0.0)) {
+    throw ConfigError(f, "plant.drop_test.cable_length_m", "must be positive");
+  }
+  const auto& r = c.random_pushes;
+  if (r.enabled) {
+    if (r.max_force_N < r.min_force_N || r.max_interval_s < r.min_interval_s || r.max_duration_s < r.min_duration_s) {
+      throw ConfigError(f, "plant.random_pushes", "every max_* must be >= its min_*");
+    }
+    if (!(r.min_duration_s > 0.0)) throw ConfigError(f, "plant.random_pushes.min_duration_s", "must be positive");
+  }
+  for (std::size_t i = 0; i < c.disturbances.size(); ++i) {
+    const auto& d = c.disturbances[i];
+    const std::string key = "plant.disturbances[" + std::to_string(i) + "]";
+    if (d.body.empty()) throw ConfigError(f, key + ".body", "empty body name");
+    if (!(d.duration_s > 0.0)) throw ConfigError(f, key + ".duration_s", "must be positive");
+    if (!d.force_N.allFinite() || !d.torque_Nm.allFinite() || !d.point_m.allFinite()) {
+      throw ConfigError(f, key, "values must be finite");
+    }
+  }
+}
+
+}  // namespace
+
 void SimRobotConfig::validate() const {
   const std::string& f = source;
   if (actuators.size() == 0) throw ConfigError(f, "plant.robot.actuators", "no actuators loaded");
@@ -302,57 +433,18 @@ void SimRobotConfig::validate() const {
     throw ConfigError(f, "plant.ft_sensor.rate_Hz", "must divide the physics rate");
   }
   check_size(*this, initial_q_rad, "plant.initial.q_rad");
+  for (std::size_t i = 0; i < initial_q_rad.size(); ++i) {
+    if (!(std::abs(initial_q_rad[i]) <= kMaxJointAngle_rad)) {
+      throw ConfigError(f, "plant.initial.q_rad[" + std::to_string(i) + "]", "must be within one turn (|q| <= 2 pi)");
+    }
+  }
   check_size(*this, noise.torque_sensor_offset_Nm, "plant.noise.torque_sensor_offset_Nm");
-  check_size(*this, vendor.position_kp_Nm_per_rad, "plant.vendor.position.kp_Nm_per_rad");
-  check_size(*this, vendor.position_kd_Nms_per_rad, "plant.vendor.position.kd_Nms_per_rad");
-  check_size(*this, vendor.position_ki_Nm_per_rad_s, "plant.vendor.position.ki_Nm_per_rad_s");
-  check_size(*this, vendor.position_integral_limit_Nm, "plant.vendor.position.integral_limit_Nm");
-  check_size(*this, vendor.torque_feedback_gain, "plant.vendor.torque.feedback_gain");
-  check_size(*this, vendor.torque_velocity_damping_Nms_per_rad, "plant.vendor.torque.velocity_damping_Nms_per_rad");
-  for (double g : vendor.torque_feedback_gain) {
-    // The torque loop closes through the (almost algebraic) transmission: it needs gain < 1 to be
-    // stable with a one-sample measurement delay (see KinovaDriveEmulator).
-    if (!(g >= 0.0 && g < 0.95)) throw ConfigError(f, "plant.vendor.torque.feedback_gain", "must be in [0, 0.95)");
+  if (noise.encoder_counts_per_rev != 0.0 && !(noise.encoder_counts_per_rev >= kMinEncoderCounts)) {
+    throw ConfigError(f, "plant.noise.encoder_counts_per_rev", "must be 0 (no quantisation) or >= 4096");
   }
-  const auto& num = vendor.high_velocity_numerator;
-  const auto& den = vendor.high_velocity_denominator;
-  if (num.empty() || den.empty() || num.size() > 6 || den.size() > 6 || den[0] == 0.0) {
-    throw ConfigError(f, "plant.vendor.torque_high_velocity", "needs 1..6 numerator and denominator coefficients, a0 != 0");
-  }
-  for (const auto& o : actuator_overrides) {
-    if (actuators.index_of(o.joint) < 0) throw ConfigError(f, "plant.actuator_overrides." + o.joint, "unknown joint");
-  }
-  const ActuatorTable plant = plant_actuators();
-  for (int i = 0; i < plant.size(); ++i) {
-    if (plant[i].reflected_inertia_kgm2 < 1e-3) {
-      // The stick-slip friction's presliding stiffness is scaled on it (see StickSlipFriction).
-      throw ConfigError(f, "plant.actuator_overrides." + plant[i].joint_name + ".reflected_inertia_kgm2",
-                        "plant reflected rotor inertia must be >= 1e-3 kg.m^2");
-    }
-    if (plant[i].friction.static_Nm < plant[i].friction.coulomb_Nm) {
-      throw ConfigError(f, "plant.actuator_overrides." + plant[i].joint_name + ".static_Nm",
-                        "plant static friction must be >= its Coulomb friction");
-    }
-  }
-  if (drop_test.enabled && !(drop_test.cable_length_m > 0.0)) {
-    throw ConfigError(f, "plant.drop_test.cable_length_m", "must be positive");
-  }
-  const auto& r = random_pushes;
-  if (r.enabled) {
-    if (r.max_force_N < r.min_force_N || r.max_interval_s < r.min_interval_s || r.max_duration_s < r.min_duration_s) {
-      throw ConfigError(f, "plant.random_pushes", "every max_* must be >= its min_*");
-    }
-    if (!(r.min_duration_s > 0.0)) throw ConfigError(f, "plant.random_pushes.min_duration_s", "must be positive");
-  }
-  for (std::size_t i = 0; i < disturbances.size(); ++i) {
-    const auto& d = disturbances[i];
-    const std::string key = "plant.disturbances[" + std::to_string(i) + "]";
-    if (d.body.empty()) throw ConfigError(f, key + ".body", "empty body name");
-    if (!(d.duration_s > 0.0)) throw ConfigError(f, key + ".duration_s", "must be positive");
-    if (!d.force_N.allFinite() || !d.torque_Nm.allFinite() || !d.point_m.allFinite()) {
-      throw ConfigError(f, key, "values must be finite");
-    }
-  }
+  validate_vendor(*this);
+  validate_plant_drives(*this);
+  validate_scripted_forces(*this);
 }
 
 ActuatorTable SimRobotConfig::plant_actuators() const {

@@ -37,7 +37,7 @@ FlangeMount find_flange_mount(const SimRobotConfig& config) {
   const std::string& file = config.mjcf_path;
   char error[1024] = "";
   const MjModelPtr arm(mj_loadXML(file.c_str(), nullptr, error, sizeof(error)));
-  if (!arm) throw ConfigError(file, "", std::string("MuJoCo cannot load it: ") + error);
+  if (!arm) throw ConfigError(file, "", "MuJoCo cannot load it: " + mujoco_error_line(error));
   const std::string& site_name = config.ft_sensor.flange_site;
   const int site = mj_name2id(arm.get(), mjOBJ_SITE, site_name.c_str());
   if (site < 0) throw ConfigError(config.source, "plant.ft_sensor.flange_site", "no site '" + site_name + "' in " + file);
@@ -168,6 +168,26 @@ std::string SimScene::build_mjcf(const SimRobotConfig& config) {
   insert_before_end_tag(xml, "worldbody", world_additions_mjcf(config), file);
   insert_before_end_tag(xml, "mujoco", ft_sensors_mjcf(), file);
   return xml;
+}
+
+std::vector<SimScene::ArmJoint> SimScene::arm_joints(const SimRobotConfig& config) {
+  const std::string& file = config.mjcf_path;
+  char error[1024] = "";
+  const MjModelPtr arm(mj_loadXML(file.c_str(), nullptr, error, sizeof(error)));
+  if (!arm) throw ConfigError(file, "", "MuJoCo cannot load it: " + mujoco_error_line(error));
+  std::vector<ArmJoint> out;
+  for (const ActuatorParameters& a : config.actuators.joints()) {
+    const int j = mj_name2id(arm.get(), mjOBJ_JOINT, a.joint_name.c_str());
+    if (j < 0) throw ConfigError(file, a.joint_name, "joint of actuators.yaml missing in the MJCF");
+    ArmJoint joint;
+    joint.name = a.joint_name;
+    joint.hinge = arm->jnt_type[j] == mjJNT_HINGE;
+    joint.limited = arm->jnt_limited[j] != 0;
+    joint.lower = arm->jnt_range[2 * j];
+    joint.upper = arm->jnt_range[2 * j + 1];
+    out.push_back(joint);
+  }
+  return out;
 }
 
 }  // namespace phri

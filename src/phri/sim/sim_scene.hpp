@@ -17,6 +17,7 @@
 #include <phri/sim/sim_robot_config.hpp>
 
 #include <string>
+#include <vector>
 
 namespace phri {
 
@@ -33,6 +34,18 @@ struct SimScene {
   /// The scene MJCF text for `config`. Reads config.mjcf_path; throws phri::ConfigError when the
   /// arm file cannot be read or loaded, has no flange site, or already uses one of the names above.
   static std::string build_mjcf(const SimRobotConfig& config);
+
+  /// A joint of the arm's MJCF as the plant simulates it (for the controller's URDF to be checked
+  /// against: same type, same limits).
+  struct ArmJoint {
+    std::string name;
+    bool hinge = true;    ///< false: slide (or another type)
+    bool limited = false;
+    double lower = 0.0, upper = 0.0;  ///< [rad] when limited
+  };
+  /// The joints of config.actuators, in order, from config.mjcf_path (the arm alone). Throws
+  /// phri::ConfigError when the file cannot be loaded or lacks one of them.
+  static std::vector<ArmJoint> arm_joints(const SimRobotConfig& config);
 };
 
 }  // namespace phri

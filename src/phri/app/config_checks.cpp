@@ -1,0 +1,131 @@
+#include <phri/app/config_checks.hpp>
+
+#include <phri/control/controller.hpp>
+#include <phri/core/error.hpp>
+#include <phri/core/format.hpp>
+#include <phri/model/algorithms.hpp>
+#include <phri/model/collision_model.hpp>
+#include <phri/sim/sim_scene.hpp>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+namespace phri {
+namespace {
+
+// Joint limits of the URDF and of the plant agree to this (the MJCF copies the URDF's values).
+constexpr double kLimitTolerance_rad = 1e-3;
+
+std::string range_text(double lower, double upper) {
+  return "[" + format_general(lower, 6) + ", " + format_general(upper, 6) + "]";
+}
+
+// One joint of the controller's URDF against the same joint of the plant's MJCF.
+void check_joint_matches_plant(const Joint& joint, const SimScene::ArmJoint& plant, const std::string& urdf,
+                               const std::string& mjcf) {
+  const std::string where = "joint '" + joint.name + "'";
+  if (!plant.hinge) throw ConfigError(mjcf, joint.name, "the plant's joint is not a hinge (phri simulates revolute arms)");
+  if (joint.type == JointType::kPrismatic) {
+    throw ConfigError(urdf, where, "prismatic in the URDF but a hinge in the plant (" + mjcf + ")");
+  }
+  if (joint.type == JointType::kContinuous || !joint.has_position_limits()) {
+    if (plant.limited) {
+      throw ConfigError(urdf, where, "unlimited in the URDF but limited to " + range_text(plant.lower, plant.upper) +
+                                         " rad in the plant (" + mjcf + ")");
+    }
+    return;
+  }
+  if (plant.limited && (joint.lower < plant.lower - kLimitTolerance_rad || joint.upper > plant.upper + kLimitTolerance_rad)) {
+    throw ConfigError(urdf, where + " <limit>",
+                      "limits " + range_text(joint.lower, joint.upper) + " rad go beyond the plant's range " +
+                          range_text(plant.lower, plant.upper) + " (" + mjcf + ")");
+  }
+}
+
+void check_urdf_matches_plant(const Model& model, const Config& config) {
+  const std::vector<SimScene::ArmJoint> plant = SimScene::arm_joints(config.plant);
+  const std::string& urdf = config.controller.urdf_path;
+  for (const Joint& joint : model.joints()) {
+    const SimScene::ArmJoint* match = nullptr;
+    for (const SimScene::ArmJoint& p : plant) {
+      if (p.name == joint.name) match = &p;
+    }
+    if (match == nullptr) {
+      throw ConfigError(urdf, "joint '" + joint.name + "'", "not a joint of the plant (" + config.plant.actuators_path + ")");
+    }
+    check_joint_matches_plant(joint, *match, urdf, config.plant.mjcf_path);
+  }
+}
+
+void check_end_effector_frame(const Model& model, const Config& config) {
+  const std::string& name = config.controller.end_effector_frame;
+  if (!model.has_frame(name)) {
+    throw ConfigError(config.source, "robot.end_effector_frame", "no frame '" + name + "' in " + config.controller.urdf_path);
+  }
+  const int body = model.frame(model.frame_id(name)).body;
+  if (body != model.nq() - 1) {
+    const std::string what = body < 0 ? "is not moved by any joint" : "is upstream of the last joint '" +
+                                                                          model.joint(model.nq() - 1).name + "'";
+    throw ConfigError(config.source, "robot.end_effector_frame",
+                      "'" + name + "' " + what + ": the end-effector task and the F/T sensor need a frame that every joint moves");
+  }
+}
+
+// A posture of the run: one value per joint, within the URDF's limits.
+void check_within_limits(const Model& model, const std::vector<double>& q, const std::string& source,
+                         const std::string& key) {
+  for (int i = 0; i < model.nq() && i < static_cast<int>(q.size()); ++i) {
+    const Joint& joint = model.joint(i);
+    const double value = q[static_cast<std::size_t>(i)];
+    if (joint.has_position_limits() && (value < joint.lower || value > joint.upper)) {
+      throw ConfigError(source, key + "[" + std::to_string(i) + "]",
+                        format_general(value, 6) + " rad is beyond " + joint.name + "'s limits " +
+                            range_text(joint.lower, joint.upper) + " (URDF)");
+    }
+  }
+}
+
+// A posture of the run, clear of self-collision: every pair at least the damper's safety distance apart.
+void check_clear_of_collision(const Model& model, const CollisionModel& collision, const std::vector<double>& q,
+                              double safety_distance, const std::string& source, const std::string& key) {
+  Data data(model);
+  CollisionData distances(model, collision);
+  forward_kinematics(model, data, Eigen::Map<const Eigen::VectorXd>(q.data(), static_cast<Eigen::Index>(q.size())));
+  compute_collision_distances(model, data, collision, distances, false);
+  for (int k = 0; k < collision.num_pairs(); ++k) {
+    if (distances.distance[k] >= safety_distance) continue;
+    const CapsulePair& pair = collision.pairs()[static_cast<std::size_t>(k)];
+    throw ConfigError(source, key,
+                      "in self-collision: capsules of " + collision.capsules()[static_cast<std::size_t>(pair.first)].link +
+                          " and " + collision.capsules()[static_cast<std::size_t>(pair.second)].link + " are " +
+                          format_general(distances.distance[k], 4) +
+                          " m apart, below controller.qp.collision.safety_distance_m " + format_general(safety_distance, 4));
+  }
+}
+
+}  // namespace
+
+void check_config_against_robot(const Config& config) {
+  const ControllerSettings& settings = config.controller;
+  {
+    // The plain URDF first: the frame the options hang the F/T sensor and payloads on must be right.
+    const Model plain = Model::from_urdf_file(settings.urdf_path);
+    check_end_effector_frame(plain, config);
+  }
+  const Model model = Model::from_urdf_file(settings.urdf_path, Controller::model_options(settings));
+  check_urdf_matches_plant(model, config);
+  const std::vector<std::pair<std::string, const std::vector<double>*>> postures = {
+      {"plant.initial.q_rad", &config.plant.initial_q_rad},
+      {"fsm.startup.home_q_rad", &config.fsm.startup.home_q_rad},
+      {"fsm.static.posture_q_rad", &config.fsm.static_scenario.posture_q_rad}};
+  for (const auto& [key, q] : postures) check_within_limits(model, *q, config.source, key);
+  if (settings.collision_path.empty()) return;
+  const CollisionModel collision = CollisionModel::from_yaml_file(settings.collision_path, model);
+  for (const auto& [key, q] : postures) {
+    if (static_cast<int>(q->size()) != model.nq()) continue;  // sizes: checked where they are read
+    check_clear_of_collision(model, collision, *q, settings.qp.collision.safety_distance, config.source, key);
+  }
+}
+
+}  // namespace phri
