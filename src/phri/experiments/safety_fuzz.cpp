@@ -251,6 +251,7 @@ bool run_push(Rig& rig, const Shared& s, const PushSpec& p, const Eigen::VectorX
     if (scale > 0.0) rig.monitor().push_torque_ratio(p.body, p.point_local, scale * p.force_N, p.local_frame, m);
     const double deviation = dual ? (rig.speed() < th.rest_speed_rad_s ? 0.0 : std::numeric_limits<double>::infinity())
                                   : (rig.q() - q_ref).cwiseAbs().maxCoeff();
+    if (!dual) m.final_deviation_rad = deviation;
     if (t >= start + p.duration_s) m.max_deviation_rad = std::max(m.max_deviation_rad, dual ? 0.0 : deviation);
     tracker.sample(t, deviation, rig.speed(), rig.safe_stop_time());
   }
@@ -385,6 +386,7 @@ void fault_run(const Shared& s, const std::string& id, ComplianceMode mode, LowL
       rig.step(m);
       const double deviation = (rig.q() - path.q.col(rig.cycles() - 1)).cwiseAbs().maxCoeff();
       m.max_deviation_rad = std::max(m.max_deviation_rad, deviation);
+      m.final_deviation_rad = deviation;
       tracker.sample(rig.time(), deviation, rig.speed(), rig.safe_stop_time());
     }
     tracker.finish(m);

@@ -60,7 +60,8 @@ struct WindowMetrics {
   double min_limit_margin_rad = std::numeric_limits<double>::infinity();   ///< < 0: beyond a limit
   double min_capsule_distance_m = std::numeric_limits<double>::infinity();
   double max_required_torque_ratio = 0.0;  ///< push: max over time and joints of |g - J^T F|_i / τ_limit_i
-  double max_deviation_rad = 0.0;          ///< from the reference, over the window
+  double max_deviation_rad = 0.0;          ///< from the reference, after the push / from the fault on
+  double final_deviation_rad = 0.0;        ///< from the reference when the window closed
   bool nan_command = false;
   bool crashed = false;
   long refused_writes = 0;                 ///< not injected

@@ -212,7 +212,7 @@ void failure_list(const SafetyFuzzResult& result, const SafetyFuzzOptions& o, st
     return;
   }
   if (f.size() > kMaxRows) s << "The " << kMaxRows << " worst of " << f.size() << " (all in safety_fuzz.csv).\n\n";
-  s << "| # | run | window | mode | loop | what | violations | max qd/limit | limit margin deg | capsule mm | deviation rad | "
+  s << "| # | run | window | mode | loop | what | violations | max qd/limit | limit margin deg | capsule mm | deviation max / final rad | "
        "safe stop | replay |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (std::size_t i = 0; i < std::min(f.size(), kMaxRows); ++i) {
     const FuzzRecord& r = *f[i];
@@ -220,7 +220,7 @@ void failure_list(const SafetyFuzzResult& result, const SafetyFuzzOptions& o, st
     s << "| " << i + 1 << " | `" << r.run_id << "` | " << r.index << " | " << to_string(r.mode) << " | " << to_string(r.loop)
       << " | " << what(r) << " | " << violation_list(r.verdict.violations) << " | " << number(m.max_speed_ratio, 3) << " | "
       << number(m.min_limit_margin_rad * 180.0 / std::numbers::pi, 2) << " | " << number(1e3 * m.min_capsule_distance_m, 1)
-      << " | " << number(m.max_deviation_rad, 3) << " | " << (m.safe_stop ? r.safe_stop_reason : "-") << " | `"
+      << " | " << number(m.max_deviation_rad, 3) << " / " << number(m.final_deviation_rad, 3) << " | " << (m.safe_stop ? r.safe_stop_reason : "-") << " | `"
       << replay_command(r, o) << "` |\n";
   }
 }
@@ -230,7 +230,7 @@ void failure_list(const SafetyFuzzResult& result, const SafetyFuzzOptions& o, st
 std::string safety_fuzz_csv(const SafetyFuzzResult& result) {
   std::ostringstream s;
   s << "run_id,index,kind,mode,loop,plant_seed,start_s,target,joint,force_N,profile,duration_s,fault_cycles,"
-       "max_speed_ratio,min_limit_margin_rad,min_capsule_distance_mm,required_torque_ratio,max_deviation_rad,"
+       "max_speed_ratio,min_limit_margin_rad,min_capsule_distance_mm,required_torque_ratio,max_deviation_rad,final_deviation_rad,"
        "recovery_time_s,safe_stop,safe_stop_reason,safe_stop_rest_time_s,refused_writes,unhandled_refusals,nan_command,"
        "crashed,violations,operator_possible,controller_failure,error\n";
   for (const FuzzRecord& r : result.records) {
@@ -242,7 +242,7 @@ std::string safety_fuzz_csv(const SafetyFuzzResult& result) {
       << format_fixed(r.force_N, 2) << ',' << r.profile << ',' << format_fixed(r.duration_s, 3) << ',' << r.fault_cycles << ','
       << number(m.max_speed_ratio, 4) << ',' << number(m.min_limit_margin_rad, 5) << ','
       << number(1e3 * m.min_capsule_distance_m, 2) << ',' << number(m.max_required_torque_ratio, 3) << ','
-      << number(m.max_deviation_rad, 4) << ',' << number(m.recovery_time_s, 3) << ',' << (m.safe_stop ? 1 : 0) << ','
+      << number(m.max_deviation_rad, 4) << ',' << number(m.final_deviation_rad, 4) << ',' << number(m.recovery_time_s, 3) << ',' << (m.safe_stop ? 1 : 0) << ','
       << r.safe_stop_reason << ',' << number(m.safe_stop_rest_time_s, 3) << ',' << m.refused_writes << ','
       << m.unhandled_refusals << ',' << (m.nan_command ? 1 : 0) << ',' << (m.crashed ? 1 : 0) << ','
       << violation_list(r.verdict.violations) << ',' << (r.verdict.operator_possible ? 1 : 0) << ','
