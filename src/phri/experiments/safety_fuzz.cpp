@@ -249,10 +249,15 @@ bool run_push(Rig& rig, const Shared& s, const PushSpec& p, const Eigen::VectorX
     // The plant applied the force over the period that ended at t: its value mid-period.
     const double scale = force.scale_at(t - 0.5 * s.dt);
     if (scale > 0.0) rig.monitor().push_torque_ratio(p.body, p.point_local, scale * p.force_N, p.local_frame, m);
+    int joint = -1;
     const double deviation = dual ? (rig.speed() < th.rest_speed_rad_s ? 0.0 : std::numeric_limits<double>::infinity())
-                                  : (rig.q() - q_ref).cwiseAbs().maxCoeff();
-    if (!dual) m.final_deviation_rad = deviation;
+                                  : rig.monitor().deviation(rig.q(), q_ref, joint);
+    if (!dual) {
+      m.final_deviation_rad = deviation;
+      m.final_deviation_joint = joint;
+    }
     if (t >= start + p.duration_s) m.max_deviation_rad = std::max(m.max_deviation_rad, dual ? 0.0 : deviation);
+    m.final_speed_rad_s = rig.speed();
     tracker.sample(t, deviation, rig.speed(), rig.safe_stop_time());
   }
   rig.robot().set_live_disturbance(-1, force);
@@ -384,9 +389,12 @@ void fault_run(const Shared& s, const std::string& id, ComplianceMode mode, LowL
     const long end = std::min<long>(path.q.cols(), spec.start_cycle + fault_window_cycles(s, fault_cycles));
     while (rig.cycles() < end && !tracker.done() && !m.crashed) {
       rig.step(m);
-      const double deviation = (rig.q() - path.q.col(rig.cycles() - 1)).cwiseAbs().maxCoeff();
+      int joint = -1;
+      const double deviation = rig.monitor().deviation(rig.q(), path.q.col(rig.cycles() - 1), joint);
       m.max_deviation_rad = std::max(m.max_deviation_rad, deviation);
       m.final_deviation_rad = deviation;
+      m.final_deviation_joint = joint;
+      m.final_speed_rad_s = rig.speed();
       tracker.sample(rig.time(), deviation, rig.speed(), rig.safe_stop_time());
     }
     tracker.finish(m);

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <numbers>
 
 namespace phri {
 
@@ -78,6 +79,21 @@ void SafetyMonitor::update(const Eigen::VectorXd& q, const Eigen::VectorXd& qd, 
   m.max_speed_ratio = std::max(m.max_speed_ratio, speed_ratio_);
   m.min_limit_margin_rad = std::min(m.min_limit_margin_rad, limit_margin_);
   m.min_capsule_distance_m = std::min(m.min_capsule_distance_m, capsule_distance_);
+}
+
+double SafetyMonitor::deviation(const Eigen::VectorXd& q, const Eigen::Ref<const Eigen::VectorXd>& reference,
+                                int& joint) const {
+  double worst = 0.0;
+  joint = -1;
+  for (Eigen::Index i = 0; i < q.size(); ++i) {
+    double d = q[i] - reference[i];
+    if (!model_.joint(static_cast<int>(i)).has_position_limits()) d = std::remainder(d, 2.0 * std::numbers::pi);
+    if (!(std::abs(d) <= worst)) {  // NaN counts as the worst
+      worst = std::abs(d);
+      joint = static_cast<int>(i);
+    }
+  }
+  return worst;
 }
 
 double SafetyMonitor::push_torque_ratio(int body, const Eigen::Vector3d& point_local, const Eigen::Vector3d& force_N,

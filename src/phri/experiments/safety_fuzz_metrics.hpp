@@ -62,6 +62,8 @@ struct WindowMetrics {
   double max_required_torque_ratio = 0.0;  ///< push: max over time and joints of |g - J^T F|_i / τ_limit_i
   double max_deviation_rad = 0.0;          ///< from the reference, after the push / from the fault on
   double final_deviation_rad = 0.0;        ///< from the reference when the window closed
+  int final_deviation_joint = -1;          ///< the joint of final_deviation_rad (0-based; -1: none)
+  double final_speed_rad_s = 0.0;          ///< max_i |q̇_i| when the window closed
   bool nan_command = false;
   bool crashed = false;
   long refused_writes = 0;                 ///< not injected
@@ -101,6 +103,10 @@ public:
   /// `m` and returned.
   double push_torque_ratio(int body, const Eigen::Vector3d& point_local, const Eigen::Vector3d& force_N, bool local_frame,
                            WindowMetrics& m);
+
+  /// How far q is from `reference`: max_i |q_i - reference_i|, a continuous joint's difference taken
+  /// modulo 2 pi (a full turn is the same pose); `joint` gets the i of the maximum.
+  double deviation(const Eigen::VectorXd& q, const Eigen::Ref<const Eigen::VectorXd>& reference, int& joint) const;
 
   /// The latest update()'s values.
   double speed_ratio() const { return speed_ratio_; }

@@ -154,6 +154,40 @@ void fault_table(const SafetyFuzzResult& result, std::ostream& s) {
   s << "\n";
 }
 
+// The windows that did not come back: where the arm ended (deviation from its reference when the
+// window closed, the joint furthest off) and whether it had come to rest there.
+void no_recovery_table(const SafetyFuzzResult& result, std::ostream& s) {
+  std::map<std::pair<int, int>, std::vector<const FuzzRecord*>> pairs;
+  for (const FuzzRecord& r : result.records) {
+    if (r.verdict.controller_failure() && (r.verdict.violations & kViolationNoRecovery)) {
+      pairs[{static_cast<int>(r.mode), static_cast<int>(r.loop)}].push_back(&r);
+    }
+  }
+  if (pairs.empty()) return;
+  s << "## Not recovered: where the arm ended\n\nFinal deviation from the reference when the window closed (3 s after "
+       "the push or fault), the joints furthest off (count), and how many had come to rest (max abs(qd) < 0.01 rad/s).\n\n"
+       "| mode | loop | windows | final deviation median / p90 / max rad | joints furthest off | at rest |\n"
+       "|---|---|---|---|---|---|\n";
+  for (const auto& [key, list] : pairs) {
+    std::vector<double> d;
+    std::map<int, int> joints;
+    long at_rest = 0;
+    for (const FuzzRecord* r : list) {
+      d.push_back(r->metrics.final_deviation_rad);
+      ++joints[r->metrics.final_deviation_joint + 1];
+      at_rest += r->metrics.final_speed_rad_s < 0.01;
+    }
+    std::sort(d.begin(), d.end());
+    auto at = [&](double f) { return d[static_cast<std::size_t>(std::lround(f * static_cast<double>(d.size() - 1)))]; };
+    s << "| " << to_string(static_cast<ComplianceMode>(key.first)) << " | " << to_string(static_cast<LowLevelMode>(key.second))
+      << " | " << list.size() << " | " << number(at(0.5), 3) << " / " << number(at(0.9), 3) << " / " << number(d.back(), 3)
+      << " |";
+    for (const auto& [joint, n] : joints) s << " j" << joint << ": " << n;
+    s << " | " << at_rest << " |\n";
+  }
+  s << "\n";
+}
+
 template <typename Better>
 const FuzzRecord* worst(const SafetyFuzzResult& result, bool failures_only, Better better) {
   const FuzzRecord* w = nullptr;
@@ -178,7 +212,7 @@ void margins(const SafetyFuzzResult& result, std::ostream& s) {
   const FuzzRecord* rows[3][2] = {{worst(result, false, speed), worst(result, true, speed)},
                                   {worst(result, false, limit), worst(result, true, limit)},
                                   {worst(result, false, capsule), worst(result, true, capsule)}};
-  const char* names[3] = {"max |qd| / velocity limit", "joint-limit margin (< 0: penetration)", "smallest capsule distance"};
+  const char* names[3] = {"max abs(qd) / velocity limit", "joint-limit margin (< 0: penetration)", "smallest capsule distance"};
   for (int k = 0; k < 3; ++k) {
     s << "| " << names[k] << " |";
     for (int j = 0; j < 2; ++j) {
@@ -220,7 +254,8 @@ void failure_list(const SafetyFuzzResult& result, const SafetyFuzzOptions& o, st
     s << "| " << i + 1 << " | `" << r.run_id << "` | " << r.index << " | " << to_string(r.mode) << " | " << to_string(r.loop)
       << " | " << what(r) << " | " << violation_list(r.verdict.violations) << " | " << number(m.max_speed_ratio, 3) << " | "
       << number(m.min_limit_margin_rad * 180.0 / std::numbers::pi, 2) << " | " << number(1e3 * m.min_capsule_distance_m, 1)
-      << " | " << number(m.max_deviation_rad, 3) << " / " << number(m.final_deviation_rad, 3) << " | " << (m.safe_stop ? r.safe_stop_reason : "-") << " | `"
+      << " | " << number(m.max_deviation_rad, 3)  << " / " << number(m.final_deviation_rad, 3)
+      << (m.final_deviation_joint >= 0 ? " (j" + std::to_string(m.final_deviation_joint + 1) + ")" : std::string()) << " | " << (m.safe_stop ? r.safe_stop_reason : "-") << " | `"
       << replay_command(r, o) << "` |\n";
   }
 }
@@ -230,7 +265,7 @@ void failure_list(const SafetyFuzzResult& result, const SafetyFuzzOptions& o, st
 std::string safety_fuzz_csv(const SafetyFuzzResult& result) {
   std::ostringstream s;
   s << "run_id,index,kind,mode,loop,plant_seed,start_s,target,joint,force_N,profile,duration_s,fault_cycles,"
-       "max_speed_ratio,min_limit_margin_rad,min_capsule_distance_mm,required_torque_ratio,max_deviation_rad,final_deviation_rad,"
+       "max_speed_ratio,min_limit_margin_rad,min_capsule_distance_mm,required_torque_ratio,max_deviation_rad,final_deviation_rad,final_deviation_joint,final_speed_rad_s,"
        "recovery_time_s,safe_stop,safe_stop_reason,safe_stop_rest_time_s,refused_writes,unhandled_refusals,nan_command,"
        "crashed,violations,operator_possible,controller_failure,error\n";
   for (const FuzzRecord& r : result.records) {
@@ -242,7 +277,8 @@ std::string safety_fuzz_csv(const SafetyFuzzResult& result) {
       << format_fixed(r.force_N, 2) << ',' << r.profile << ',' << format_fixed(r.duration_s, 3) << ',' << r.fault_cycles << ','
       << number(m.max_speed_ratio, 4) << ',' << number(m.min_limit_margin_rad, 5) << ','
       << number(1e3 * m.min_capsule_distance_m, 2) << ',' << number(m.max_required_torque_ratio, 3) << ','
-      << number(m.max_deviation_rad, 4) << ',' << number(m.final_deviation_rad, 4) << ',' << number(m.recovery_time_s, 3) << ',' << (m.safe_stop ? 1 : 0) << ','
+      << number(m.max_deviation_rad, 4) << ',' << number(m.final_deviation_rad, 4) << ','
+      << m.final_deviation_joint + 1 << ',' << number(m.final_speed_rad_s, 4) << ',' << number(m.recovery_time_s, 3) << ',' << (m.safe_stop ? 1 : 0) << ','
       << r.safe_stop_reason << ',' << number(m.safe_stop_rest_time_s, 3) << ',' << m.refused_writes << ','
       << m.unhandled_refusals << ',' << (m.nan_command ? 1 : 0) << ',' << (m.crashed ? 1 : 0) << ','
       << violation_list(r.verdict.violations) << ',' << (r.verdict.operator_possible ? 1 : 0) << ','
@@ -267,13 +303,14 @@ std::string safety_fuzz_report(const SafetyFuzzResult& result, const SafetyFuzzO
     << " mm; a non-finite command; a crash or a diverged plant; a refused write (unhandled: no safe stop the next cycle); "
        "not back within "
     << t.recovery_tolerance_rad << " rad of the reference (held pose; fault-free path; dual compliance: at rest) within "
-    << t.recovery_time_s << " s, and not in a safe stop; a safe stop still moving (|qd| >= " << t.rest_speed_rad_s
+    << t.recovery_time_s << " s, and not in a safe stop; a safe stop still moving (max abs(qd) >= " << t.rest_speed_rad_s
     << " rad/s) " << t.safe_stop_rest_time_s
     << " s after it began. Operator-possible: the push needed more than a joint's torque limit to hold the arm "
        "(|g(q) - J_p^T F|_i > tau_limit_i, controller model, true q).\n\n";
   pair_table(result, s);
   category_table(result, s);
   fault_table(result, s);
+  no_recovery_table(result, s);
   margins(result, s);
   failure_list(result, o, s);
   return s.str();
