@@ -182,7 +182,9 @@ void no_recovery_table(const SafetyFuzzResult& result, std::ostream& s) {
     s << "| " << to_string(static_cast<ComplianceMode>(key.first)) << " | " << to_string(static_cast<LowLevelMode>(key.second))
       << " | " << list.size() << " | " << number(at(0.5), 3) << " / " << number(at(0.9), 3) << " / " << number(d.back(), 3)
       << " |";
-    for (const auto& [joint, n] : joints) s << " j" << joint << ": " << n;
+    for (const auto& [joint, n] : joints) {
+      if (joint > 0) s << " j" << joint << ": " << n;  // 0: dual compliance, judged at rest only
+    }
     s << " | " << at_rest << " |\n";
   }
   s << "\n";
