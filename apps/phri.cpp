@@ -4,6 +4,7 @@
 //   phri info --urdf FILE                      model summary of a robot description
 //   phri identify-friction [options]           the paper's friction identification (simulated arm)
 //   phri experiment torque-tracking [options]  the paper's torque-tracking comparison
+//   phri experiment safety-fuzz [options]      seeded pushes and sensor faults against the safety stage
 // Every bad argument or file, and every failure of a run or an experiment (phri::Error: ConfigError,
 // IoError, ExperimentError), gives one line on stderr naming what is wrong and a non-zero exit status.
 #include <phri/app/config.hpp>
@@ -15,6 +16,7 @@
 #include <phri/core/version.hpp>
 #include <phri/experiments/experiment_files.hpp>
 #include <phri/experiments/friction_identification.hpp>
+#include <phri/experiments/safety_fuzz.hpp>
 #include <phri/experiments/torque_tracking.hpp>
 #include <phri/experiments/torque_tracking_sweep.hpp>
 #include <phri/model/algorithms.hpp>
@@ -249,6 +251,45 @@ CLI::App* add_torque_tracking_command(CLI::App& experiment, TrackingArguments& a
   return tracking;
 }
 
+struct SafetyFuzzArguments {
+  phri::SafetyFuzzOptions fuzz;
+  std::string faults = "all";
+  bool no_targeted = false;
+  bool fail_on_violation = false;
+};
+
+CLI::App* add_safety_fuzz_command(CLI::App& experiment, SafetyFuzzArguments& args) {
+  auto* fuzz = experiment.add_subcommand("safety-fuzz", "Seeded random pushes and sensor faults against the safety stage");
+  phri::SafetyFuzzOptions& o = args.fuzz;
+  fuzz->add_option("--pushes", o.pushes, "random pushes, split over the 16 mode x loop pairs")
+      ->check(CLI::Range(0, 1000000))
+      ->capture_default_str();
+  fuzz->add_option("--seed", o.seed, "seed of the pushes, faults and plants")->capture_default_str();
+  fuzz->add_option("--out", o.output_dir, "output folder")->capture_default_str();
+  fuzz->add_option("--jobs", o.jobs, "threads")->check(CLI::Range(1, 64))->capture_default_str();
+  fuzz->add_option("--faults", args.faults, "sensor faults: all, subset or none")
+      ->check(CLI::IsMember({"all", "subset", "none"}))
+      ->capture_default_str();
+  fuzz->add_option("--pushes-per-run", o.pushes_per_run, "pushes on one plant + controller")
+      ->check(CLI::Range(1, 1000))
+      ->capture_default_str();
+  fuzz->add_flag("--no-targeted", args.no_targeted, "leave out the pushes toward the joint limits and the wrist folds");
+  fuzz->add_option("--replay", o.replay, "run only this run (an id from report.md)");
+  fuzz->add_option("--plant", o.plant_config_path, "plant configuration")->check(CLI::ExistingFile);
+  fuzz->add_flag("--fail-on-violation", args.fail_on_violation, "exit with status 1 when a controller failure was found");
+  return fuzz;
+}
+
+int safety_fuzz_command(SafetyFuzzArguments& args) {
+  phri::SafetyFuzzOptions& o = args.fuzz;
+  o.faults = args.faults == "none" ? phri::FaultSet::kNone : args.faults == "subset" ? phri::FaultSet::kSubset : phri::FaultSet::kAll;
+  o.targeted_pushes = !args.no_targeted;
+  for (std::string* path : {&o.plant_config_path, &o.urdf_path, &o.actuators_path, &o.collision_path, &o.figure_script}) {
+    *path = locate(*path);
+  }
+  return phri::run_safety_fuzz_command(o, args.fail_on_violation, std::cout);
+}
+
 // `phri identify-friction`: the experiment with its files found (see locate).
 int friction_identification_command(phri::FrictionIdentificationOptions friction) {
   for (std::string* path : {&friction.plant_config_path, &friction.urdf_path, &friction.figure_script}) *path = locate(*path);
@@ -337,12 +378,14 @@ int main(int argc, char** argv) {
   InfoArguments info_args;
   phri::FrictionIdentificationOptions friction;
   TrackingArguments tracking_args;
+  SafetyFuzzArguments fuzz_args;
   const CLI::App* run = add_run_command(app, run_args);
   const CLI::App* info = add_info_command(app, info_args);
   const CLI::App* identify = add_identify_command(app, friction);
   auto* experiment = app.add_subcommand("experiment", "Run one of the paper's experiments on the simulated arm");
   experiment->require_subcommand(1);
   const CLI::App* tracking = add_torque_tracking_command(*experiment, tracking_args);
+  const CLI::App* fuzz = add_safety_fuzz_command(*experiment, fuzz_args);
   auto* friction_alias = experiment->add_subcommand("friction-identification", "Same as 'phri identify-friction'");
   friction_alias->add_option("--out", friction.output_dir, "output folder");
   friction_alias->add_option("--seed", friction.seed, "seed");
@@ -358,6 +401,7 @@ int main(int argc, char** argv) {
     if (info->parsed()) return print_model_summary(info_args.urdf_path, info_args.tip, info_args.frame);
     if (identify->parsed() || friction_alias->parsed()) return friction_identification_command(friction);
     if (tracking->parsed()) return torque_tracking_command(tracking_args);
+    if (fuzz->parsed()) return safety_fuzz_command(fuzz_args);
   } catch (const phri::Error& e) {
     return print_error(e.what());
   } catch (const std::exception& e) {  // from a library below (yaml-cpp, the standard library)

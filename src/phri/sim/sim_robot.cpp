@@ -272,12 +272,31 @@ void SimRobot::reset() {
   state_.cycle = 0;
 }
 
+int SimRobot::body_id(const std::string& name) const {
+  const int b = mj_name2id(m_.get(), mjOBJ_BODY, name.c_str());
+  return b > 0 ? b : -1;
+}
+
+void SimRobot::set_live_disturbance(int body, const ExternalForce& force) {
+  live_body_ = body > 0 && body < m_->nbody ? body : -1;
+  // Field by field: the body name is not copied (no allocation).
+  live_force_.point_m = force.point_m;
+  live_force_.frame = force.frame;
+  live_force_.force_N = force.force_N;
+  live_force_.torque_Nm = force.torque_Nm;
+  live_force_.profile = force.profile;
+  live_force_.start_s = force.start_s;
+  live_force_.duration_s = force.duration_s;
+  live_force_.rise_s = force.rise_s;
+}
+
 void SimRobot::restart_noise_and_counters() {
   joint_noise_.reseed(config_.seed, kJointNoiseStream);
   ft_noise_.reseed(config_.seed, kFtNoiseStream);
   pushes_ = RandomPushGenerator(config_.random_pushes, push_links_, config_.seed);
   fault_ = false;
   has_pending_ = false;
+  live_body_ = -1;
   substep_count_ = 0;
   wrench_sequence_ = 0;
   state_ = RobotState(n_);
@@ -529,6 +548,13 @@ void SimRobot::apply_external_forces(double t) {
     if (s == 0.0) continue;
     apply_force(disturbance_bodies_[i], f.point_m, f.frame == ExternalForce::Frame::kLocal, s * f.force_N,
                 s * f.torque_Nm);
+  }
+  if (live_body_ > 0) {
+    const double s = live_force_.scale_at(t);
+    if (s != 0.0) {
+      apply_force(live_body_, live_force_.point_m, live_force_.frame == ExternalForce::Frame::kLocal,
+                  s * live_force_.force_N, s * live_force_.torque_Nm);
+    }
   }
   if (const RandomPushGenerator::Push* push = pushes_.active(t)) {
     const double s = push->scale_at(t);

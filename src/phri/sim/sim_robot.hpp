@@ -98,8 +98,18 @@ public:
   const Eigen::VectorXd& position_lower_rad() const { return lower_; }
   const Eigen::VectorXd& position_upper_rad() const { return upper_; }
   const KinovaDriveEmulator& drive() const { return drive_; }
-  /// Back to the initial state: same configuration and seeds, so the same run again.
+  /// Back to the initial state: same configuration and seeds, so the same run again (the live
+  /// disturbance cleared).
   void reset();
+
+  /// The scene's body named `name`, for set_live_disturbance; -1 when there is none (or the world).
+  int body_id(const std::string& name) const;
+  /// One disturbance on top of config().disturbances, chosen while the simulation runs (an
+  /// experiment that starts each push when the arm has settled from the previous one): `force`
+  /// (its `body` name is not read) on body `body` (body_id), from the next read() on, following
+  /// its profile over its start_s and duration_s. Replaces the previous one; body -1 clears it.
+  /// No allocation.
+  void set_live_disturbance(int body, const ExternalForce& force);
 
   /// MuJoCo model and data, read-only (viewers, tests comparing with MuJoCo's own quantities).
   const mjModel_* mujoco_model() const { return m_.get(); }
@@ -186,6 +196,8 @@ private:
   int drop_body_ = -1, drop_qadr_ = -1, drop_dadr_ = -1;
   double latch_damping_ = 0.0;
   std::vector<int> disturbance_bodies_;
+  int live_body_ = -1;        // set_live_disturbance
+  ExternalForce live_force_;  // its body name unused
 
   RobotState state_;
   Truth truth_;

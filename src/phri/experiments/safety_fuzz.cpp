@@ -1,0 +1,639 @@
+#include <phri/experiments/safety_fuzz.hpp>
+
+#include <phri/control/controller.hpp>
+#include <phri/core/error.hpp>
+#include <phri/core/format.hpp>
+#include <phri/experiments/experiment_files.hpp>
+#include <phri/experiments/fault_injecting_robot.hpp>
+#include <phri/model/algorithms.hpp>
+#include <phri/sim/sim_robot.hpp>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <exception>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <ostream>
+#include <thread>
+
+namespace phri {
+namespace {
+
+// MuJoCo's XML compiler keeps global state in some versions: plants are built one at a time.
+// Everything after construction (mj_step on a plant's own mjData) runs in parallel.
+std::mutex& plant_construction_mutex() {
+  static std::mutex m;
+  return m;
+}
+
+// What every run shares, loaded once and read only: the plant's base configuration, the
+// controller's robot, the pushes toward the limits and the fault catalogue.
+struct Shared {
+  const SafetyFuzzOptions& o;
+  SimRobotConfig plant;
+  Model model;
+  ActuatorTable actuators;
+  std::optional<CollisionModel> collision;
+  Eigen::VectorXd velocity_limit, torque_limit;
+  std::vector<PushSpec> targeted;
+  std::vector<FaultCase> faults;
+  double dt = 1e-3;
+};
+
+ControllerSettings controller_settings(ComplianceMode mode) {
+  ControllerSettings s;
+  s.initial_compliance = mode;
+  s.initial_loop = LowLevelMode::kPosition;
+  return s;
+}
+
+// The joint-limit pushes (each limited joint, both ways) and the wrist fold, from the start pose.
+std::vector<PushSpec> targeted_pushes(const Shared& s) {
+  Data data(s.model);
+  Eigen::VectorXd q = Eigen::Map<const Eigen::VectorXd>(s.o.start_q_rad.data(), static_cast<Eigen::Index>(s.o.start_q_rad.size()));
+  forward_kinematics(s.model, data, q);
+  update_frame_placements(s.model, data);
+  std::vector<PushSpec> pushes;
+  for (int j = 0; j < s.model.nq(); ++j) {
+    if (!s.model.joint(j).has_position_limits()) continue;
+    for (int toward : {-1, 1}) {
+      PushSpec p = joint_limit_push(s.model, data, j, toward, s.o.targeted_force_N, s.o.limit_push_s);
+      if (p.body >= 0) pushes.push_back(p);
+    }
+  }
+  if (s.model.has_frame("spherical_wrist_2_link")) {
+    pushes.push_back(wrist_fold_push(s.model, data, "spherical_wrist_2_link", Eigen::Vector3d(0, 0, 0.1),
+                                     s.o.targeted_force_N, s.o.wrist_fold_s));
+  }
+  return pushes;
+}
+
+std::unique_ptr<Shared> load_shared(const SafetyFuzzOptions& o) {
+  const std::string src = "<safety fuzz options>";
+  if (o.pushes < 0 || o.pushes_per_run < 1 || o.jobs < 1) {
+    throw ConfigError(src, "pushes/pushes_per_run/jobs", "need pushes >= 0, pushes_per_run >= 1, jobs >= 1");
+  }
+  if (o.modes.empty() || o.loops.empty()) throw ConfigError(src, "modes/loops", "nothing to run");
+  if (!(o.position_phase_s >= 0.3 && o.settle_s >= 0.0)) throw ConfigError(src, "position_phase_s", "must be >= 0.3 s (F/T bias)");
+  SimRobotConfig plant = SimRobotConfig::from_yaml_file(o.plant_config_path);
+  if (static_cast<int>(o.start_q_rad.size()) != plant.dof()) throw ConfigError(src, "start_q_rad", "needs one value per joint");
+  plant.initial_q_rad = o.start_q_rad;
+  plant.mismatch.enabled = o.model_mismatch;
+  const ControllerSettings settings = controller_settings(ComplianceMode::kStiff);
+  Model model = Model::from_urdf_file(o.urdf_path, Controller::model_options(settings));
+  ActuatorTable actuators = ActuatorTable::from_yaml_file(o.actuators_path);
+  std::optional<CollisionModel> collision;
+  if (!o.collision_path.empty()) collision = CollisionModel::from_yaml_file(o.collision_path, model);
+  if (!collision) throw ConfigError(src, "collision_path", "the pushes land on the collision capsules: a collision model is needed");
+  auto s = std::unique_ptr<Shared>(new Shared{o, std::move(plant), std::move(model), std::move(actuators), std::move(collision),
+                                              Eigen::VectorXd(), Eigen::VectorXd(), {}, {}, 1e-3});
+  const int n = s->model.nv();
+  s->velocity_limit.resize(n);
+  s->torque_limit.resize(n);
+  for (int i = 0; i < n; ++i) {
+    s->velocity_limit[i] = s->actuators[i].velocity_limit_rad_s;
+    s->torque_limit[i] = s->actuators[i].torque_limit_Nm;
+  }
+  s->dt = s->plant.control_period_s;
+  s->targeted = targeted_pushes(*s);
+  s->faults = fault_catalogue(o.faults, n, o.seed);
+  return s;
+}
+
+bool setpoint_finite(const RobotCommand& c) {
+  switch (c.mode) {
+    case LowLevelMode::kPosition: return c.q_rad.allFinite();
+    case LowLevelMode::kKinovaTorque:
+    case LowLevelMode::kKinovaTorqueHighVelocity: return c.tau_Nm.allFinite();
+    case LowLevelMode::kCurrent: return c.current_A.allFinite();
+  }
+  return false;
+}
+
+std::unique_ptr<SimRobot> make_plant(const Shared& s, std::uint64_t plant_seed) {
+  SimRobotConfig config = s.plant;
+  config.seed = plant_seed;
+  const std::lock_guard<std::mutex> lock(plant_construction_mutex());
+  return std::make_unique<SimRobot>(config);
+}
+
+// One plant, its fault injector and one controller, driven read -> step -> write as
+// app/run_session.cpp does, with the checks of SafetyMonitor on the plant's truth every cycle.
+class Rig {
+public:
+  Rig(const Shared& s, ComplianceMode mode, LowLevelMode loop, std::uint64_t plant_seed, const FaultSpec& fault)
+      : s_(s),
+        loop_(loop),
+        robot_(make_plant(s, plant_seed)),
+        io_(*robot_, fault),
+        cycle_(s.model, s.actuators, s.collision, controller_settings(mode)),
+        command_(robot_->dof()),
+        targets_(robot_->dof()),
+        monitor_(s.model, &*s.collision, s.velocity_limit, s.torque_limit) {}
+
+  // One control cycle; the checks go into m.
+  void step(WindowMetrics& m) {
+    const RobotState& state = io_.read();
+    if (state.fault) m.crashed = true;
+    const CycleStatus status = cycle_.step(state, targets_, command_);
+    targets_.clear();
+    if (refusal_pending_ && status != CycleStatus::kSafeStop) ++m.unhandled_refusals;
+    refusal_pending_ = false;
+    if (!setpoint_finite(command_)) m.nan_command = true;
+    if (io_.write(command_) != WriteStatus::kOk) {
+      const bool injected = io_.fault_active() && io_.fault().kind == FaultKind::kWriteRefused;
+      if (!injected) ++m.refused_writes;
+      cycle_.report_fault(SafetyFault::kWriteRefused, state.time_s);
+      refusal_pending_ = true;
+    }
+    const SimRobot::Truth& truth = robot_->truth();
+    monitor_.update(truth.q_rad, truth.qd_rad_s, m);
+    speed_ = truth.qd_rad_s.cwiseAbs().maxCoeff();
+  }
+
+  // Position loop for position_phase_s, the switch to the loop under test, settle_s. The checks
+  // into m (recovery does not apply); false when the start-up already violated something or stopped.
+  bool warm_up(WindowMetrics& m) {
+    const long n1 = std::lround(s_.o.position_phase_s / s_.dt), n2 = std::lround(s_.o.settle_s / s_.dt);
+    for (long k = 0; k < n1 + n2; ++k) {
+      if (k == n1) targets_.low_level_mode = loop_;
+      step(m);
+    }
+    m.recovery_time_s = 0.0;
+    m.safe_stop = cycle_.supervisor().safe_stop();
+    m.safe_stop_rest_time_s = m.safe_stop ? -1.0 : 0.0;
+    return classify(m, s_.o.thresholds).violations == 0 && !m.safe_stop;
+  }
+
+  double time() const { return robot_->state().time_s; }
+  long cycles() const { return io_.cycles(); }
+  double speed() const { return speed_; }
+  double safe_stop_time() const {
+    return cycle_.supervisor().safe_stop() ? cycle_.supervisor().safe_stop_transition().time_s : -1.0;
+  }
+  std::string safe_stop_reason() const {
+    if (!cycle_.supervisor().safe_stop()) return {};
+    const SafetyTransition& tr = cycle_.supervisor().safe_stop_transition();
+    std::string r(to_string(tr.reason));
+    if (tr.joint >= 0) r += " (joint " + std::to_string(tr.joint + 1) + ")";
+    return r;
+  }
+  const Eigen::VectorXd& q() const { return robot_->truth().q_rad; }
+  SimRobot& robot() { return *robot_; }
+  SafetyMonitor& monitor() { return monitor_; }
+
+private:
+  const Shared& s_;
+  LowLevelMode loop_;
+  std::unique_ptr<SimRobot> robot_;
+  FaultInjectingRobot io_;
+  Controller cycle_;
+  RobotCommand command_;
+  ControllerTargets targets_;
+  SafetyMonitor monitor_;
+  bool refusal_pending_ = false;
+  double speed_ = 0.0;
+};
+
+// What a task hands back: its records, and what it cost.
+struct TaskOutput {
+  std::vector<FuzzRecord> records;
+  int rigs = 0;
+  double simulated_s = 0.0;
+};
+
+FuzzRecord base_record(const std::string& run_id, int index, FuzzCaseKind kind, ComplianceMode mode, LowLevelMode loop,
+                       std::uint64_t plant_seed) {
+  FuzzRecord r;
+  r.run_id = run_id;
+  r.index = index;
+  r.kind = kind;
+  r.mode = mode;
+  r.loop = loop;
+  r.plant_seed = plant_seed;
+  return r;
+}
+
+void describe_push(FuzzRecord& r, const PushSpec& p) {
+  r.kind = p.kind == PushKind::kRandom ? FuzzCaseKind::kRandomPush
+           : p.kind == PushKind::kJointLimit ? FuzzCaseKind::kLimitPush
+                                              : FuzzCaseKind::kWristFold;
+  r.target = p.link;
+  r.joint = p.joint;
+  r.force_N = p.magnitude_N;
+  r.profile = std::string(to_string(p.profile));
+  r.duration_s = p.duration_s;
+}
+
+// One push on a warmed-up rig, until the arm is back and settled, or stopped, or out of time.
+// The reference is q_ref (the held pose); in dual compliance the arm keeps the pose it is pushed
+// to, so "back" there means at rest. Returns whether the rig can take the next push.
+bool run_push(Rig& rig, const Shared& s, const PushSpec& p, const Eigen::VectorXd& q_ref, bool dual, FuzzRecord& r) {
+  const SafetyFuzzThresholds& th = s.o.thresholds;
+  WindowMetrics& m = r.metrics;
+  const double start = rig.time();
+  r.start_s = start;
+  const ExternalForce force = p.disturbance(start);
+  const int plant_body = rig.robot().body_id(p.link);
+  if (plant_body < 0) throw ConfigError(s.o.plant_config_path, "bodies", "the plant has no body '" + p.link + "' to push");
+  rig.robot().set_live_disturbance(plant_body, force);
+  RecoveryTracker tracker(th, start + p.duration_s, s.o.min_pause_s);
+  const long max_cycles = std::lround((p.duration_s + th.recovery_time_s + th.safe_stop_rest_time_s + 0.5) / s.dt);
+  for (long k = 0; k < max_cycles && !tracker.done() && !m.crashed; ++k) {
+    rig.step(m);
+    const double t = rig.time();
+    // The plant applied the force over the period that ended at t: its value mid-period.
+    const double scale = force.scale_at(t - 0.5 * s.dt);
+    if (scale > 0.0) rig.monitor().push_torque_ratio(p.body, p.point_local, scale * p.force_N, p.local_frame, m);
+    int joint = -1;
+    const double deviation = dual ? (rig.speed() < th.rest_speed_rad_s ? 0.0 : std::numeric_limits<double>::infinity())
+                                  : rig.monitor().deviation(rig.q(), q_ref, joint);
+    if (!dual) {
+      m.final_deviation_rad = deviation;
+      m.final_deviation_joint = joint;
+    }
+    if (t >= start + p.duration_s) m.max_deviation_rad = std::max(m.max_deviation_rad, dual ? 0.0 : deviation);
+    m.final_speed_rad_s = rig.speed();
+    tracker.sample(t, deviation, rig.speed(), rig.safe_stop_time());
+  }
+  rig.robot().set_live_disturbance(-1, force);
+  tracker.finish(m);
+  r.verdict = classify(m, th);
+  r.safe_stop_reason = rig.safe_stop_reason();
+  if (m.crashed) r.error = "the simulated plant diverged";
+  return !m.safe_stop && !m.crashed && m.recovery_time_s >= 0.0;
+}
+
+std::uint64_t plant_seed_of(std::uint64_t base, int rebuild) { return mix_seed(base, static_cast<std::uint64_t>(rebuild)) >> 2; }
+
+// A run of pushes on one pair: a plant and a controller, warmed up, take the pushes one after the
+// other; after a safe stop, a window without recovery or a crash, a fresh pair goes on.
+void push_run(const Shared& s, const std::string& id, ComplianceMode mode, LowLevelMode loop,
+              const std::vector<PushSpec>& pushes, std::uint64_t base_seed, TaskOutput& out) {
+  std::size_t next = 0;
+  for (int rebuild = 0; next < pushes.size(); ++rebuild) {
+    const std::uint64_t seed = plant_seed_of(base_seed, rebuild);
+    FuzzRecord r = base_record(id, static_cast<int>(next), FuzzCaseKind::kStartup, mode, loop, seed);
+    try {
+      Rig rig(s, mode, loop, seed, FaultSpec{});
+      ++out.rigs;
+      if (!rig.warm_up(r.metrics)) {
+        r.verdict = classify(r.metrics, s.o.thresholds);
+        r.safe_stop_reason = rig.safe_stop_reason();
+        out.records.push_back(r);
+        out.simulated_s += rig.time();
+        return;  // the pushes left cannot be tested on this pair
+      }
+      const Eigen::VectorXd q_ref = rig.q();
+      bool usable = true;
+      while (usable && next < pushes.size()) {
+        FuzzRecord push = base_record(id, static_cast<int>(next), FuzzCaseKind::kRandomPush, mode, loop, seed);
+        describe_push(push, pushes[next]);
+        usable = run_push(rig, s, pushes[next], q_ref, mode == ComplianceMode::kDual, push);
+        out.records.push_back(push);
+        ++next;
+      }
+      out.simulated_s += rig.time();
+    } catch (const ConfigError&) {
+      throw;
+    } catch (const std::exception& e) {
+      describe_push(r, pushes[next]);
+      r.metrics.crashed = true;
+      r.error = e.what();
+      r.verdict = classify(r.metrics, s.o.thresholds);
+      out.records.push_back(r);
+      ++next;
+    }
+  }
+}
+
+// The fault-free path of a (mode, loop): the plant's true q after every read().
+struct ReferencePath {
+  Eigen::MatrixXd q;  // nq x cycles
+  bool ready = false;
+};
+
+long fault_window_cycles(const Shared& s, long fault_cycles) {
+  const SafetyFuzzThresholds& th = s.o.thresholds;
+  return fault_cycles + std::lround((th.recovery_time_s + th.safe_stop_rest_time_s + 0.2) / s.dt);
+}
+
+long warm_up_cycles(const Shared& s) { return std::lround(s.o.position_phase_s / s.dt) + std::lround(s.o.settle_s / s.dt); }
+
+std::uint64_t fault_seed(const Shared& s, ComplianceMode mode, LowLevelMode loop) {
+  return mix_seed(mix_seed(s.o.seed, 0xFA17), static_cast<std::uint64_t>(static_cast<int>(mode) * 8 + static_cast<int>(loop))) >> 2;
+}
+
+
+// The fault-free run of a (mode, loop) with the faulted runs' plant seed: its path, and its own
+// checks (a record of kind kReference).
+void reference_run(const Shared& s, const std::string& id, ComplianceMode mode, LowLevelMode loop, ReferencePath& path,
+                   TaskOutput& out) {
+  const std::uint64_t seed = fault_seed(s, mode, loop);
+  FuzzRecord r = base_record(id, 0, FuzzCaseKind::kReference, mode, loop, seed);
+  r.target = "none";
+  long longest = 0;
+  for (long c : s.o.fault_cycles) longest = std::max(longest, c);
+  const long total = warm_up_cycles(s) + fault_window_cycles(s, longest);
+  try {
+    Rig rig(s, mode, loop, seed, FaultSpec{});
+    ++out.rigs;
+    path.q = Eigen::MatrixXd::Zero(s.model.nq(), total);
+    rig.warm_up(r.metrics);
+    r.start_s = rig.time();
+    while (rig.cycles() < total && !r.metrics.crashed) {
+      rig.step(r.metrics);
+      path.q.col(rig.cycles() - 1) = rig.q();
+    }
+    r.metrics.recovery_time_s = 0.0;
+    r.metrics.safe_stop = rig.safe_stop_time() >= 0.0;
+    r.metrics.safe_stop_time_s = rig.safe_stop_time();
+    r.safe_stop_reason = rig.safe_stop_reason();
+    out.simulated_s += rig.time();
+    path.ready = true;
+  } catch (const ConfigError&) {
+    throw;
+  } catch (const std::exception& e) {
+    r.metrics.crashed = true;
+    r.error = e.what();
+  }
+  r.verdict = classify(r.metrics, s.o.thresholds);
+  out.records.push_back(r);
+}
+
+// One fault case for `fault_cycles` cycles right after the warm-up, compared with the reference path.
+void fault_run(const Shared& s, const std::string& id, ComplianceMode mode, LowLevelMode loop, const FaultCase& fault,
+               long fault_cycles, const ReferencePath& path, TaskOutput& out) {
+  const std::uint64_t seed = fault_seed(s, mode, loop);
+  FuzzRecord r = base_record(id, 0, FuzzCaseKind::kFault, mode, loop, seed);
+  r.target = fault.name;
+  const bool per_joint = fault.spec.signal != FaultSignal::kWrench &&
+                         (fault.spec.kind == FaultKind::kNaN || fault.spec.kind == FaultKind::kInf || fault.spec.kind == FaultKind::kAdd);
+  r.joint = per_joint ? fault.spec.joint : -1;
+  r.fault_cycles = fault_cycles;
+  FaultSpec spec = fault.spec;
+  spec.start_cycle = warm_up_cycles(s);
+  spec.cycles = fault_cycles;
+  try {
+    Rig rig(s, mode, loop, seed, spec);
+    ++out.rigs;
+    WindowMetrics warm;
+    rig.warm_up(warm);  // identical to the reference's start-up (its record judges it)
+    WindowMetrics& m = r.metrics;
+    r.start_s = rig.time();
+    RecoveryTracker tracker(s.o.thresholds, rig.time() + static_cast<double>(fault_cycles) * s.dt, s.o.fault_observation_s);
+    const long end = std::min<long>(path.q.cols(), spec.start_cycle + fault_window_cycles(s, fault_cycles));
+    while (rig.cycles() < end && !tracker.done() && !m.crashed) {
+      rig.step(m);
+      int joint = -1;
+      const double deviation = rig.monitor().deviation(rig.q(), path.q.col(rig.cycles() - 1), joint);
+      m.max_deviation_rad = std::max(m.max_deviation_rad, deviation);
+      m.final_deviation_rad = deviation;
+      m.final_deviation_joint = joint;
+      m.final_speed_rad_s = rig.speed();
+      tracker.sample(rig.time(), deviation, rig.speed(), rig.safe_stop_time());
+    }
+    tracker.finish(m);
+    r.safe_stop_reason = rig.safe_stop_reason();
+    if (m.crashed) r.error = "the simulated plant diverged";
+    out.simulated_s += rig.time();
+  } catch (const ConfigError&) {
+    throw;
+  } catch (const std::exception& e) {
+    r.metrics.crashed = true;
+    r.error = e.what();
+  }
+  r.verdict = classify(r.metrics, s.o.thresholds);
+  out.records.push_back(r);
+}
+
+// ---- the task list: one task per run, each a deterministic function of the options
+
+struct Task {
+  std::string id;
+  double cost = 1.0;  // simulated seconds, roughly: the longest go first
+  std::function<void(TaskOutput&)> run;
+};
+
+std::string pair_id(ComplianceMode mode, LowLevelMode loop) {
+  return std::string(to_string(mode)) + "/" + std::string(to_string(loop));
+}
+
+std::uint64_t pair_key(ComplianceMode mode, LowLevelMode loop) {
+  return static_cast<std::uint64_t>(static_cast<int>(mode) * 8 + static_cast<int>(loop));
+}
+
+// The random pushes of every pair, pushes_per_run per run.
+void add_push_tasks(const Shared& s, std::vector<Task>& tasks) {
+  const SafetyFuzzOptions& o = s.o;
+  const int pairs = static_cast<int>(o.modes.size() * o.loops.size());
+  int pair = 0;
+  for (ComplianceMode mode : o.modes) {
+    for (LowLevelMode loop : o.loops) {
+      const int count = o.pushes / pairs + (pair < o.pushes % pairs ? 1 : 0);
+      ++pair;
+      const std::uint64_t key = mix_seed(o.seed, pair_key(mode, loop));
+      for (int first = 0, run = 0; first < count; first += o.pushes_per_run, ++run) {
+        std::vector<PushSpec> pushes;
+        for (int i = first; i < std::min(count, first + o.pushes_per_run); ++i) {
+          RandomGenerator rng(mix_seed(key, static_cast<std::uint64_t>(i)), 1);
+          pushes.push_back(draw_random_push(rng, s.model, *s.collision, o.push_ranges));
+        }
+        const std::string id = "push/" + pair_id(mode, loop) + "/" + std::to_string(run);
+        const std::uint64_t base = mix_seed(key, 0x5EED0000ULL + static_cast<std::uint64_t>(run));
+        double cost = 1.0;
+        for (const PushSpec& p : pushes) cost += p.duration_s + 0.6;
+        tasks.push_back({id, cost, [&s, id, mode, loop, pushes, base](TaskOutput& out) {
+                           push_run(s, id, mode, loop, pushes, base, out);
+                         }});
+      }
+    }
+  }
+}
+
+void add_targeted_tasks(const Shared& s, std::vector<Task>& tasks) {
+  if (!s.o.targeted_pushes || s.targeted.empty()) return;
+  for (ComplianceMode mode : s.o.modes) {
+    for (LowLevelMode loop : s.o.loops) {
+      const std::string id = "targeted/" + pair_id(mode, loop);
+      const std::uint64_t base = mix_seed(mix_seed(s.o.seed, pair_key(mode, loop)), 0x7A46E7ULL);
+      double cost = 1.0;
+      for (const PushSpec& p : s.targeted) cost += p.duration_s + 1.0;
+      tasks.push_back({id, cost, [&s, id, mode, loop, base](TaskOutput& out) {
+                         push_run(s, id, mode, loop, s.targeted, base, out);
+                       }});
+    }
+  }
+}
+
+// References first (their own phase), then one task per fault case and duration.
+void add_fault_tasks(const Shared& s, std::vector<Task>& references, std::vector<Task>& tasks,
+                     std::vector<std::unique_ptr<ReferencePath>>& paths) {
+  if (s.faults.empty()) return;
+  for (ComplianceMode mode : s.o.fault_modes) {
+    for (LowLevelMode loop : s.o.loops) {
+      paths.push_back(std::make_unique<ReferencePath>());
+      ReferencePath* path = paths.back().get();
+      const std::string ref_id = "reference/" + pair_id(mode, loop);
+      references.push_back({ref_id, 4.0, [&s, ref_id, mode, loop, path](TaskOutput& out) {
+                              reference_run(s, ref_id, mode, loop, *path, out);
+                            }});
+      for (const FaultCase& fault : s.faults) {
+        for (long cycles : s.o.fault_cycles) {
+          const std::string id = "fault/" + pair_id(mode, loop) + "/" + fault.name + "/" + std::to_string(cycles);
+          tasks.push_back({id, 2.0, [&s, id, mode, loop, &fault, cycles, path, ref_id](TaskOutput& out) {
+                             if (!path->ready) throw ExperimentError("safety fuzz", "no reference path for " + ref_id);
+                             fault_run(s, id, mode, loop, fault, cycles, *path, out);
+                           }});
+        }
+      }
+    }
+  }
+}
+
+
+// Runs `tasks` on `jobs` threads (the longest first); each task's output lands at its index, so
+// the result does not depend on the scheduling. The first error (a ConfigError, say) is rethrown.
+class TaskPool {
+public:
+  TaskPool(std::vector<Task>& tasks, std::vector<TaskOutput>& outputs, std::ostream* progress, const char* phase)
+      : tasks_(tasks), outputs_(outputs), progress_(progress), phase_(phase) {}
+
+  void run(int jobs) {
+    order_.resize(tasks_.size());
+    for (std::size_t i = 0; i < order_.size(); ++i) order_[i] = i;
+    std::stable_sort(order_.begin(), order_.end(), [&](std::size_t a, std::size_t b) { return tasks_[a].cost > tasks_[b].cost; });
+    outputs_.assign(tasks_.size(), TaskOutput{});
+    const int threads = std::max(1, std::min<int>(jobs, static_cast<int>(tasks_.size())));
+    std::vector<std::thread> workers;
+    for (int t = 1; t < threads; ++t) workers.emplace_back([this] { work(); });
+    work();
+    for (std::thread& w : workers) w.join();
+    if (error_) std::rethrow_exception(error_);
+  }
+
+private:
+  void work() {
+    for (;;) {
+      const std::size_t k = next_.fetch_add(1);
+      if (k >= order_.size() || failed_.load()) return;
+      const std::size_t i = order_[k];
+      try {
+        tasks_[i].run(outputs_[i]);
+      } catch (...) {
+        const std::lock_guard<std::mutex> lock(mutex_);
+        if (!error_) error_ = std::current_exception();
+        failed_.store(true);
+        return;
+      }
+      report(i);
+    }
+  }
+
+  void report(std::size_t i) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    ++done_;
+    for (const FuzzRecord& r : outputs_[i].records) {
+      if (r.kind == FuzzCaseKind::kFault) ++faults_;
+      if (r.kind == FuzzCaseKind::kRandomPush || r.kind == FuzzCaseKind::kLimitPush || r.kind == FuzzCaseKind::kWristFold) ++pushes_;
+      if (r.verdict.controller_failure()) ++failures_;
+    }
+    const auto now = std::chrono::steady_clock::now();
+    const double elapsed = std::chrono::duration<double>(now - start_).count();
+    if (progress_ == nullptr || (done_ < tasks_.size() && elapsed < next_print_)) return;
+    next_print_ = elapsed + 5.0;
+    *progress_ << "safety-fuzz " << phase_ << ": " << done_ << "/" << tasks_.size() << " runs, " << pushes_ << " pushes, "
+               << faults_ << " faults, " << failures_ << " controller failures, " << format_fixed(elapsed, 0) << " s"
+               << std::endl;
+  }
+
+  std::vector<Task>& tasks_;
+  std::vector<TaskOutput>& outputs_;
+  std::ostream* progress_;
+  const char* phase_;
+  std::vector<std::size_t> order_;
+  std::atomic<std::size_t> next_{0};
+  std::atomic<bool> failed_{false};
+  std::mutex mutex_;
+  std::exception_ptr error_;
+  std::size_t done_ = 0;
+  long pushes_ = 0, faults_ = 0, failures_ = 0;
+  double next_print_ = 5.0;
+  const std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+};
+
+// Keeps the task `id` only (and the reference a fault run needs); ConfigError when none matches.
+void keep_replay(const std::string& id, std::vector<Task>& references, std::vector<Task>& tasks) {
+  auto named = [&](const Task& t) { return t.id == id; };
+  const bool in_tasks = std::any_of(tasks.begin(), tasks.end(), named);
+  const bool in_references = std::any_of(references.begin(), references.end(), named);
+  if (!in_tasks && !in_references) {
+    throw ConfigError("<safety fuzz options>", "replay", "no run '" + id + "' with these options (see report.md for the ids)");
+  }
+  std::erase_if(tasks, [&](const Task& t) { return !named(t); });
+  // A fault run needs the reference of its (mode, loop): "fault/<mode>/<loop>/..." -> "reference/<mode>/<loop>".
+  std::string reference = id;
+  if (id.rfind("fault/", 0) == 0) {
+    const std::size_t mode_end = id.find('/', 6), loop_end = id.find('/', mode_end + 1);
+    reference = "reference/" + id.substr(6, loop_end - 6);
+  }
+  std::erase_if(references, [&](const Task& t) { return t.id != reference; });
+}
+
+void collect(std::vector<TaskOutput>& outputs, SafetyFuzzResult& result) {
+  for (TaskOutput& out : outputs) {
+    result.runs += out.rigs;
+    result.simulated_s += out.simulated_s;
+    for (FuzzRecord& r : out.records) result.records.push_back(std::move(r));
+  }
+}
+
+}  // namespace
+
+long SafetyFuzzResult::controller_failures() const {
+  return std::count_if(records.begin(), records.end(), [](const FuzzRecord& r) { return r.verdict.controller_failure(); });
+}
+
+long SafetyFuzzResult::pushes() const {
+  return std::count_if(records.begin(), records.end(), [](const FuzzRecord& r) {
+    return r.kind == FuzzCaseKind::kRandomPush || r.kind == FuzzCaseKind::kLimitPush || r.kind == FuzzCaseKind::kWristFold;
+  });
+}
+
+long SafetyFuzzResult::faults() const {
+  return std::count_if(records.begin(), records.end(), [](const FuzzRecord& r) { return r.kind == FuzzCaseKind::kFault; });
+}
+
+SafetyFuzzResult run_safety_fuzz(const SafetyFuzzOptions& o, std::ostream* progress) {
+  const auto wall_start = std::chrono::steady_clock::now();
+  const std::unique_ptr<Shared> shared = load_shared(o);
+  if (!o.output_dir.empty()) ensure_output_directory(o.output_dir);
+  std::vector<Task> references, tasks;
+  std::vector<std::unique_ptr<ReferencePath>> paths;
+  add_push_tasks(*shared, tasks);
+  add_targeted_tasks(*shared, tasks);
+  add_fault_tasks(*shared, references, tasks, paths);
+  if (!o.replay.empty()) keep_replay(o.replay, references, tasks);
+  if (progress) {
+    *progress << "safety-fuzz: seed " << o.seed << ", " << references.size() + tasks.size() << " runs (" << shared->faults.size()
+              << " fault cases), " << o.jobs << " jobs" << std::endl;
+  }
+  SafetyFuzzResult result;
+  std::vector<TaskOutput> reference_outputs, outputs;
+  TaskPool(references, reference_outputs, progress, "references").run(o.jobs);
+  TaskPool(tasks, outputs, progress, "runs").run(o.jobs);
+  collect(reference_outputs, result);
+  collect(outputs, result);
+  result.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  if (!o.output_dir.empty()) {
+    result.files = write_output_files(o.output_dir, {{"safety_fuzz.csv", safety_fuzz_csv(result)},
+                                                     {"report.md", safety_fuzz_report(result, o)}});
+  }
+  return result;
+}
+
+}  // namespace phri

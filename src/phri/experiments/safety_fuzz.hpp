@@ -1,0 +1,146 @@
+#pragma once
+// Safety fuzzing on the simulated Gen3 (`phri experiment safety-fuzz`): seeded, reproducible
+// hostile testing of phri::Controller and its safety stage.
+//
+// The arm holds the paper demo's posture [0, 0.58, 3.14, -1.84, 0, 0.85, 1.57] (the plant starts
+// there) with the controller's targets fixed; each run starts in the position loop, switches to the
+// loop under test after position_phase_s and settles for settle_s. Then:
+//
+// 1. Pushes, on every compliance mode (stiff, null_space, full_body, dual) x low-level loop
+//    (position, kinova_torque, kinova_torque_high_velocity, custom) pair: `pushes` random pushes
+//    split over the 16 pairs (0-200 N on a random moving link, random point of its capsule, random
+//    direction into it, step / ramp / half-sine, 0.05-2 s), pushes_per_run per run, the next one
+//    starting when the arm is back and settled; plus, per pair, sustained 60 N pushes driving each
+//    limited joint toward each of its limits (2 s) and a wrist fold toward the base (3 s).
+// 2. Sensor faults (FaultInjectingRobot between the plant and the controller): the catalogue of
+//    safety_fuzz_cases.hpp, each for 1 and for 100 cycles, on every loop and on fault_modes; each
+//    (mode, loop) has a fault-free reference run with the same plant seed whose path the faulted
+//    runs are compared with (the decorator passes the plant's state through bit for bit outside
+//    the fault's window, so both runs are identical until it opens).
+// 3. Every cycle, on the plant's truth: joint limits, |q̇| > 1.05 x its limit, capsule distances,
+//    non-finite commands, refused writes (the harness reports each to the controller; one not
+//    followed by a safe stop is "unhandled"), exceptions and a diverged plant. After each push or
+//    fault: back within 0.05 rad of the reference (the held pose; for dual compliance, which keeps
+//    the pose it is pushed to: at rest) within 3 s, or in a logged safe stop at rest within 1 s.
+//    A window with a violation is operator-possible when its push asked more than the actuators can
+//    resist (safety_fuzz_metrics.hpp), a controller failure otherwise. After a safe stop, a window
+//    without recovery or a crash, the run goes on with a fresh plant and controller.
+//
+// Runs are independent, deterministic functions of (seed, run id, pushes, pushes_per_run): they
+// run on `jobs` threads (each SimRobot has its own mjModel/mjData; MuJoCo's model compiler is
+// serialized) and any one can be replayed alone (`replay`, the ids in the report).
+#include <phri/control/compliance_mode.hpp>
+#include <phri/experiments/safety_fuzz_cases.hpp>
+#include <phri/experiments/safety_fuzz_metrics.hpp>
+#include <phri/robot/low_level_mode.hpp>
+
+#include <cstdint>
+#include <iosfwd>
+#include <string>
+#include <vector>
+
+namespace phri {
+
+struct SafetyFuzzOptions {
+  // ---- files (relative paths are relative to the working directory)
+  std::string plant_config_path = "configs/plant_gen3.yaml";
+  std::string urdf_path = "robots/kinova_gen3/gen3.urdf";
+  std::string actuators_path = "robots/kinova_gen3/actuators.yaml";
+  std::string collision_path = "robots/kinova_gen3/collision.yaml";
+  std::string output_dir = "results/safety_fuzz";  ///< empty: no files
+  std::string figure_script = "tools/report/safety_fuzz_figure.py";  ///< empty: no figure
+
+  // ---- what to run
+  std::uint64_t seed = 1;
+  int pushes = 3000;           ///< random pushes, split over the 16 mode x loop pairs
+  int pushes_per_run = 8;
+  bool targeted_pushes = true; ///< joint-limit pushes and wrist folds on every pair
+  FaultSet faults = FaultSet::kAll;
+  std::vector<ComplianceMode> fault_modes = {ComplianceMode::kNullSpace, ComplianceMode::kFullBody};
+  std::vector<LowLevelMode> loops = {LowLevelMode::kPosition, LowLevelMode::kKinovaTorque,
+                                     LowLevelMode::kKinovaTorqueHighVelocity, LowLevelMode::kCurrent};
+  std::vector<ComplianceMode> modes = {ComplianceMode::kStiff, ComplianceMode::kNullSpace, ComplianceMode::kFullBody,
+                                       ComplianceMode::kDual};
+  std::vector<long> fault_cycles = {1, 100};
+  int jobs = 2;
+  std::string replay;          ///< run only this run (an id of the report); empty: all
+
+  // ---- plant and protocol
+  bool model_mismatch = true;  ///< plant link inertials ±5 % from the controller's URDF
+  std::vector<double> start_q_rad = {0.0, 0.58, 3.14, -1.84, 0.0, 0.85, 1.57};
+  double position_phase_s = 0.4;  ///< position loop before the switch (F/T bias)
+  double settle_s = 0.6;          ///< after the switch, before the first push or fault
+  double min_pause_s = 0.2;       ///< after a push, at least this before the next
+  double fault_observation_s = 1.0;  ///< after a fault, at least this (the arm must stay back)
+  RandomPushRanges push_ranges;
+  double targeted_force_N = 60.0;
+  double limit_push_s = 2.0;
+  double wrist_fold_s = 3.0;
+  SafetyFuzzThresholds thresholds;
+};
+
+enum class FuzzCaseKind : std::uint8_t { kRandomPush = 0, kLimitPush, kWristFold, kFault, kReference, kStartup };
+
+constexpr std::string_view to_string(FuzzCaseKind k) {
+  switch (k) {
+    case FuzzCaseKind::kRandomPush: return "push";
+    case FuzzCaseKind::kLimitPush: return "limit_push";
+    case FuzzCaseKind::kWristFold: return "wrist_fold";
+    case FuzzCaseKind::kFault: return "fault";
+    case FuzzCaseKind::kReference: return "reference";
+    case FuzzCaseKind::kStartup: return "startup";
+  }
+  return "unknown";
+}
+
+/// One push or fault window (or a reference run, or a start-up that failed) and its verdict.
+struct FuzzRecord {
+  std::string run_id;     ///< replay id of the run it belongs to
+  int index = 0;          ///< in the run
+  FuzzCaseKind kind = FuzzCaseKind::kRandomPush;
+  ComplianceMode mode = ComplianceMode::kStiff;
+  LowLevelMode loop = LowLevelMode::kPosition;
+  std::uint64_t plant_seed = 0;
+  double start_s = 0.0;   ///< plant time the push or fault began
+  // push
+  std::string target;     ///< push: link; fault: catalogue name
+  int joint = -1;         ///< fault or limit push: joint (0-based)
+  double force_N = 0.0;
+  std::string profile;
+  double duration_s = 0.0;
+  // fault
+  long fault_cycles = 0;
+  WindowMetrics metrics;
+  FuzzVerdict verdict;
+  std::string safe_stop_reason;
+  std::string error;      ///< crash: what happened
+};
+
+struct SafetyFuzzResult {
+  std::vector<FuzzRecord> records;
+  int runs = 0;           ///< plant + controller constructions
+  double simulated_s = 0.0;
+  double wall_s = 0.0;
+  std::vector<std::string> files;
+
+  long controller_failures() const;
+  long pushes() const;    ///< push windows (random and targeted)
+  long faults() const;
+};
+
+/// Runs everything the options ask for; progress lines on `progress` (may be null). Writes the
+/// CSV (safety_fuzz.csv) and the report (report.md) into options.output_dir when set. Throws
+/// ConfigError on bad options or input files (a replay id that names no run), IoError when an output
+/// cannot be written; a run that throws is recorded (crash), not rethrown.
+SafetyFuzzResult run_safety_fuzz(const SafetyFuzzOptions& options, std::ostream* progress = nullptr);
+
+/// The CSV: one row per record.
+std::string safety_fuzz_csv(const SafetyFuzzResult& result);
+/// The Markdown report: counts per mode x loop, worst margins, controller failures with replay commands.
+std::string safety_fuzz_report(const SafetyFuzzResult& result, const SafetyFuzzOptions& options);
+
+/// `phri experiment safety-fuzz`: run, write the files, draw the figure, print the summary.
+/// Returns 1 when fail_on_violation and there were controller failures, else 0.
+int run_safety_fuzz_command(const SafetyFuzzOptions& options, bool fail_on_violation, std::ostream& out);
+
+}  // namespace phri

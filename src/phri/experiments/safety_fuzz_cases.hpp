@@ -1,0 +1,95 @@
+#pragma once
+// The disturbances of the safety-fuzz experiment (safety_fuzz.hpp): the pushes (random, toward a
+// joint limit, folding the wrist onto the base) and the catalogue of sensor faults, each drawn
+// from the experiment's seed so that any case can be run again alone.
+#include <phri/core/random_generator.hpp>
+#include <phri/experiments/fault_injecting_robot.hpp>
+#include <phri/model/collision_model.hpp>
+#include <phri/model/data.hpp>
+#include <phri/model/model.hpp>
+#include <phri/sim/external_force.hpp>
+
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace phri {
+
+enum class PushKind : std::uint8_t { kRandom = 0, kJointLimit, kWristFold };
+
+constexpr std::string_view to_string(ExternalForce::Profile p) {
+  switch (p) {
+    case ExternalForce::Profile::kStep: return "step";
+    case ExternalForce::Profile::kRamp: return "ramp";
+    case ExternalForce::Profile::kHalfSine: return "half_sine";
+  }
+  return "unknown";
+}
+
+/// One push on the arm: a force at a point of a link, with a time profile (relative start 0).
+struct PushSpec {
+  PushKind kind = PushKind::kRandom;
+  int body = -1;                 ///< the controller model's body the link moves with
+  std::string link;              ///< its name (the plant's MJCF body of the same name)
+  Eigen::Vector3d point_local = Eigen::Vector3d::Zero();  ///< in the body frame [m]
+  Eigen::Vector3d force_N = Eigen::Vector3d::Zero();      ///< full scale, body axes (random) or world axes
+  bool local_frame = true;
+  double magnitude_N = 0.0;
+  ExternalForce::Profile profile = ExternalForce::Profile::kStep;
+  double duration_s = 0.0;
+  double rise_s = 0.0;           ///< kRamp
+  int joint = -1;                ///< kJointLimit: the joint (0-based)
+  int toward = 0;                ///< kJointLimit: +1 its upper limit, -1 its lower one
+
+  /// The plant disturbance, starting at `start_s` (its body name left empty: SimRobot::set_live_disturbance).
+  ExternalForce disturbance(double start_s) const;
+};
+
+/// Ranges of the random pushes (the numbers).
+struct RandomPushRanges {
+  double min_force_N = 0.0, max_force_N = 200.0;
+  double min_duration_s = 0.05, max_duration_s = 2.0;
+};
+
+/// The name of the link a model body stands for (its own frame's name).
+std::string body_link_name(const Model& model, int body);
+
+/// A random push: a capsule of `collision` on a moving link, a uniform point of its surface, a
+/// direction uniform on the half-sphere into the surface (body axes), a uniform magnitude, profile
+/// and duration (a ramp rises over a uniform part of the duration).
+PushSpec draw_random_push(RandomGenerator& rng, const Model& model, const CollisionModel& collision,
+                          const RandomPushRanges& ranges);
+
+/// A sustained push of `force_N` for `duration_s` (50 ms ramp) that drives joint `joint` toward its
+/// upper (toward = +1) or lower limit: at the origin of the body after the joint's child (the far
+/// end of the moving link), along ± that point's Jacobian column of the joint, from `data` (kinematics
+/// of the pose where it starts). kind kJointLimit; body -1 when the column vanishes there.
+PushSpec joint_limit_push(const Model& model, const Data& data, int joint, int toward, double force_N, double duration_s);
+
+/// A push folding the wrist onto the base: at the origin of `link`, toward `target` (world), as
+/// tests/test_sim_control.cpp SelfCollisionDamperKeepsTheWristOffTheBase does. kind kWristFold.
+PushSpec wrist_fold_push(const Model& model, const Data& data, const std::string& link, const Eigen::Vector3d& target,
+                         double force_N, double duration_s);
+
+/// Which sensor faults to inject.
+enum class FaultSet : std::uint8_t { kNone = 0, kSubset, kAll };
+
+/// One entry of the catalogue: its name and the fault (start_cycle and cycles set by the runner).
+struct FaultCase {
+  std::string name;
+  FaultSpec spec;
+};
+
+/// The catalogue (see safety_fuzz.hpp): NaN, inf, ±1e6 spikes on q, q̇, τ_s and current; moderate
+/// spikes (+0.5 rad, +3 rad/s, +50 N.m); offsets; frozen values; a stale frame; sequence and stamp
+/// jumps; frozen stamps; short current vectors; F/T spikes and NaN; refused writes. The joint of
+/// each per-joint fault and the sign of the 1e6 spikes are drawn from `seed`. kSubset: six of them.
+std::vector<FaultCase> fault_catalogue(FaultSet set, int dof, std::uint64_t seed);
+
+/// splitmix64 of (a, b): independent seeds for runs and cases from the experiment's seed.
+std::uint64_t mix_seed(std::uint64_t a, std::uint64_t b);
+
+}  // namespace phri

@@ -1,0 +1,345 @@
+// The safety-fuzz experiment's outputs: the CSV of every window, the Markdown report and the command.
+#include <phri/experiments/safety_fuzz.hpp>
+
+#include <phri/core/format.hpp>
+#include <phri/experiments/experiment_files.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <numbers>
+#include <ostream>
+#include <sstream>
+
+namespace phri {
+namespace {
+
+bool is_push(const FuzzRecord& r) {
+  return r.kind == FuzzCaseKind::kRandomPush || r.kind == FuzzCaseKind::kLimitPush || r.kind == FuzzCaseKind::kWristFold;
+}
+
+std::string violation_list(unsigned bits) {
+  std::string s;
+  for (int i = 0; i < kFuzzViolationCount; ++i) {
+    if ((bits & (1u << i)) == 0) continue;
+    if (!s.empty()) s += '+';
+    s += violation_name(i);
+  }
+  return s;
+}
+
+std::string number(double x, int digits) { return std::isfinite(x) ? format_fixed(x, digits) : (x > 0 ? "inf" : "-inf"); }
+
+// How bad a failing window is, to list the worst first: a crash, a NaN command or an unhandled
+// refusal first, then contact and limits by depth, speed by its ratio, then recovery.
+double severity(const FuzzRecord& r) {
+  const WindowMetrics& m = r.metrics;
+  const unsigned v = r.verdict.violations;
+  double s = 0.0;
+  if (v & (kViolationCrash | kViolationNanCommand | kViolationUnhandledRefusal)) s += 100.0;
+  if (v & kViolationCollision) s += 20.0 + 1e3 * std::max(0.0, -m.min_capsule_distance_m);
+  if (v & kViolationJointLimit) s += 20.0 + 180.0 / std::numbers::pi * std::max(0.0, -m.min_limit_margin_rad);
+  if (v & kViolationOverspeed) s += 10.0 * m.max_speed_ratio;
+  if (v & (kViolationNoRecovery | kViolationSafeStopMoving)) s += 5.0 + std::min(m.max_deviation_rad, 5.0);
+  if (v & kViolationRefusedWrite) s += 3.0;
+  return s;
+}
+
+std::string what(const FuzzRecord& r) {
+  std::ostringstream s;
+  if (is_push(r)) {
+    s << format_fixed(r.force_N, 0) << " N " << r.profile << " " << format_fixed(r.duration_s, 2) << " s on " << r.target;
+    if (r.kind == FuzzCaseKind::kLimitPush) s << " (joint " << r.joint + 1 << ")";
+  } else if (r.kind == FuzzCaseKind::kFault) {
+    s << r.target << " x" << r.fault_cycles;
+    if (r.joint >= 0) s << " (joint " << r.joint + 1 << ")";
+  } else {
+    s << to_string(r.kind);
+  }
+  if (!r.error.empty()) s << ": " << r.error;
+  return s.str();
+}
+
+std::string replay_command(const FuzzRecord& r, const SafetyFuzzOptions& o) {
+  std::string c = "phri experiment safety-fuzz --seed " + std::to_string(o.seed) + " --pushes " + std::to_string(o.pushes);
+  if (o.pushes_per_run != SafetyFuzzOptions{}.pushes_per_run) c += " --pushes-per-run " + std::to_string(o.pushes_per_run);
+  return c + " --replay " + r.run_id;
+}
+
+// Counts of one mode x loop pair.
+struct PairCounts {
+  long pushes = 0, push_violations = 0, operator_possible = 0, push_failures = 0, push_safe_stops = 0, no_recovery = 0;
+  long faults = 0, fault_failures = 0, fault_safe_stops = 0, other_failures = 0;
+
+  void add(const FuzzRecord& r) {
+    const bool failure = r.verdict.controller_failure();
+    if (is_push(r)) {
+      ++pushes;
+      push_violations += r.verdict.violations != 0;
+      operator_possible += r.verdict.violations != 0 && r.verdict.operator_possible;
+      push_failures += failure;
+      push_safe_stops += r.metrics.safe_stop;
+      no_recovery += (r.verdict.violations & kViolationNoRecovery) != 0;
+    } else if (r.kind == FuzzCaseKind::kFault) {
+      ++faults;
+      fault_failures += failure;
+      fault_safe_stops += r.metrics.safe_stop;
+    } else {
+      other_failures += failure;
+    }
+  }
+};
+
+void pair_table(const SafetyFuzzResult& result, std::ostream& s) {
+  std::map<std::pair<int, int>, PairCounts> pairs;
+  for (const FuzzRecord& r : result.records) pairs[{static_cast<int>(r.mode), static_cast<int>(r.loop)}].add(r);
+  s << "## Per compliance mode x low-level loop\n\n"
+       "| mode | loop | pushes | with violations | operator-possible | controller failures | safe stops | not recovered | "
+       "faults | fault failures | fault safe stops | start-up/reference failures |\n"
+       "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+  for (const auto& [key, c] : pairs) {
+    s << "| " << to_string(static_cast<ComplianceMode>(key.first)) << " | " << to_string(static_cast<LowLevelMode>(key.second))
+      << " | " << c.pushes << " | " << c.push_violations << " | " << c.operator_possible << " | " << c.push_failures << " | "
+      << c.push_safe_stops << " | " << c.no_recovery << " | " << c.faults << " | " << c.fault_failures << " | "
+      << c.fault_safe_stops << " | " << c.other_failures << " |\n";
+  }
+  s << "\n";
+}
+
+void category_table(const SafetyFuzzResult& result, std::ostream& s) {
+  const FuzzCaseKind kinds[] = {FuzzCaseKind::kRandomPush, FuzzCaseKind::kLimitPush, FuzzCaseKind::kWristFold,
+                                FuzzCaseKind::kFault, FuzzCaseKind::kReference, FuzzCaseKind::kStartup};
+  s << "## Controller failures by category\n\nA window counts once in each category it violates "
+       "(operator-possible windows excluded).\n\n| category |";
+  for (FuzzCaseKind k : kinds) s << " " << to_string(k) << " |";
+  s << " total |\n|---|---|---|---|---|---|---|---|\n";
+  for (int i = 0; i < kFuzzViolationCount; ++i) {
+    long counts[6] = {0, 0, 0, 0, 0, 0}, total = 0;
+    for (const FuzzRecord& r : result.records) {
+      if (!r.verdict.controller_failure() || (r.verdict.violations & (1u << i)) == 0) continue;
+      ++counts[static_cast<int>(r.kind)];
+      ++total;
+    }
+    s << "| " << violation_name(i) << " |";
+    for (FuzzCaseKind k : kinds) s << " " << counts[static_cast<int>(k)] << " |";
+    s << " " << total << " |\n";
+  }
+  s << "\n";
+}
+
+void fault_table(const SafetyFuzzResult& result, std::ostream& s) {
+  struct Row {
+    long runs = 0, failures = 0, safe_stops = 0;
+    unsigned categories = 0;
+    std::string where;
+  };
+  std::map<std::pair<std::string, long>, Row> rows;
+  for (const FuzzRecord& r : result.records) {
+    if (r.kind != FuzzCaseKind::kFault) continue;
+    Row& row = rows[{r.target, r.fault_cycles}];
+    ++row.runs;
+    row.safe_stops += r.metrics.safe_stop;
+    if (!r.verdict.controller_failure()) continue;
+    ++row.failures;
+    row.categories |= r.verdict.violations;
+    row.where += (row.where.empty() ? "" : ", ") + std::string(to_string(r.mode)) + "/" + std::string(to_string(r.loop));
+  }
+  if (rows.empty()) return;
+  s << "## Sensor faults\n\n| fault | cycles | runs | safe stops | controller failures | categories | where |\n"
+       "|---|---|---|---|---|---|---|\n";
+  for (const auto& [key, row] : rows) {
+    s << "| " << key.first << " | " << key.second << " | " << row.runs << " | " << row.safe_stops << " | " << row.failures
+      << " | " << violation_list(row.categories) << " | " << row.where << " |\n";
+  }
+  s << "\n";
+}
+
+// The windows that did not come back: where the arm ended (deviation from its reference when the
+// window closed, the joint furthest off) and whether it had come to rest there.
+void no_recovery_table(const SafetyFuzzResult& result, std::ostream& s) {
+  std::map<std::pair<int, int>, std::vector<const FuzzRecord*>> pairs;
+  for (const FuzzRecord& r : result.records) {
+    if (r.verdict.controller_failure() && (r.verdict.violations & kViolationNoRecovery)) {
+      pairs[{static_cast<int>(r.mode), static_cast<int>(r.loop)}].push_back(&r);
+    }
+  }
+  if (pairs.empty()) return;
+  s << "## Not recovered: where the arm ended\n\nFinal deviation from the reference when the window closed (3 s after "
+       "the push or fault), the joints furthest off (count), and how many had come to rest (max abs(qd) < 0.01 rad/s).\n\n"
+       "| mode | loop | windows | final deviation median / p90 / max rad | joints furthest off | at rest |\n"
+       "|---|---|---|---|---|---|\n";
+  for (const auto& [key, list] : pairs) {
+    std::vector<double> d;
+    std::map<int, int> joints;
+    long at_rest = 0;
+    for (const FuzzRecord* r : list) {
+      d.push_back(r->metrics.final_deviation_rad);
+      ++joints[r->metrics.final_deviation_joint + 1];
+      at_rest += r->metrics.final_speed_rad_s < 0.01;
+    }
+    std::sort(d.begin(), d.end());
+    auto at = [&](double f) { return d[static_cast<std::size_t>(std::lround(f * static_cast<double>(d.size() - 1)))]; };
+    s << "| " << to_string(static_cast<ComplianceMode>(key.first)) << " | " << to_string(static_cast<LowLevelMode>(key.second))
+      << " | " << list.size() << " | " << number(at(0.5), 3) << " / " << number(at(0.9), 3) << " / " << number(d.back(), 3)
+      << " |";
+    for (const auto& [joint, n] : joints) {
+      if (joint > 0) s << " j" << joint << ": " << n;  // 0: dual compliance, judged at rest only
+    }
+    s << " | " << at_rest << " |\n";
+  }
+  s << "\n";
+}
+
+template <typename Better>
+const FuzzRecord* worst(const SafetyFuzzResult& result, bool failures_only, Better better) {
+  const FuzzRecord* w = nullptr;
+  for (const FuzzRecord& r : result.records) {
+    if (failures_only && r.verdict.operator_possible) continue;
+    if (w == nullptr || better(r, *w)) w = &r;
+  }
+  return w;
+}
+
+void margins(const SafetyFuzzResult& result, std::ostream& s) {
+  s << "## Worst margins\n\n| margin | all windows | windows not operator-possible |\n|---|---|---|\n";
+  auto cell = [](const FuzzRecord* r, double value, int digits, const char* unit) {
+    if (r == nullptr) return std::string("-");
+    return number(value, digits) + " " + unit + " (`" + r->run_id + "` #" + std::to_string(r->index) + ", " + what(*r) + ")";
+  };
+  const auto speed = [](const FuzzRecord& a, const FuzzRecord& b) { return a.metrics.max_speed_ratio > b.metrics.max_speed_ratio; };
+  const auto limit = [](const FuzzRecord& a, const FuzzRecord& b) { return a.metrics.min_limit_margin_rad < b.metrics.min_limit_margin_rad; };
+  const auto capsule = [](const FuzzRecord& a, const FuzzRecord& b) {
+    return a.metrics.min_capsule_distance_m < b.metrics.min_capsule_distance_m;
+  };
+  const FuzzRecord* rows[3][2] = {{worst(result, false, speed), worst(result, true, speed)},
+                                  {worst(result, false, limit), worst(result, true, limit)},
+                                  {worst(result, false, capsule), worst(result, true, capsule)}};
+  const char* names[3] = {"max abs(qd) / velocity limit", "joint-limit margin (< 0: penetration)", "smallest capsule distance"};
+  for (int k = 0; k < 3; ++k) {
+    s << "| " << names[k] << " |";
+    for (int j = 0; j < 2; ++j) {
+      const FuzzRecord* r = rows[k][j];
+      const double v = r == nullptr ? 0.0
+                       : k == 0     ? r->metrics.max_speed_ratio
+                       : k == 1     ? r->metrics.min_limit_margin_rad * 180.0 / std::numbers::pi
+                                    : 1e3 * r->metrics.min_capsule_distance_m;
+      s << " " << cell(r, v, k == 0 ? 3 : 2, k == 0 ? "" : k == 1 ? "deg" : "mm") << " |";
+    }
+    s << "\n";
+  }
+  s << "\n";
+}
+
+std::vector<const FuzzRecord*> failures_worst_first(const SafetyFuzzResult& result) {
+  std::vector<const FuzzRecord*> f;
+  for (const FuzzRecord& r : result.records) {
+    if (r.verdict.controller_failure()) f.push_back(&r);
+  }
+  std::stable_sort(f.begin(), f.end(), [](const FuzzRecord* a, const FuzzRecord* b) { return severity(*a) > severity(*b); });
+  return f;
+}
+
+void failure_list(const SafetyFuzzResult& result, const SafetyFuzzOptions& o, std::ostream& s) {
+  const std::vector<const FuzzRecord*> f = failures_worst_first(result);
+  constexpr std::size_t kMaxRows = 200;
+  s << "## Controller failures, worst first\n\n";
+  if (f.empty()) {
+    s << "None.\n";
+    return;
+  }
+  if (f.size() > kMaxRows) s << "The " << kMaxRows << " worst of " << f.size() << " (all in safety_fuzz.csv).\n\n";
+  s << "| # | run | window | mode | loop | what | violations | max qd/limit | limit margin deg | capsule mm | deviation max / final rad | "
+       "safe stop | replay |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+  for (std::size_t i = 0; i < std::min(f.size(), kMaxRows); ++i) {
+    const FuzzRecord& r = *f[i];
+    const WindowMetrics& m = r.metrics;
+    s << "| " << i + 1 << " | `" << r.run_id << "` | " << r.index << " | " << to_string(r.mode) << " | " << to_string(r.loop)
+      << " | " << what(r) << " | " << violation_list(r.verdict.violations) << " | " << number(m.max_speed_ratio, 3) << " | "
+      << number(m.min_limit_margin_rad * 180.0 / std::numbers::pi, 2) << " | " << number(1e3 * m.min_capsule_distance_m, 1)
+      << " | " << number(m.max_deviation_rad, 3)  << " / " << number(m.final_deviation_rad, 3)
+      << (m.final_deviation_joint >= 0 ? " (j" + std::to_string(m.final_deviation_joint + 1) + ")" : std::string()) << " | " << (m.safe_stop ? r.safe_stop_reason : "-") << " | `"
+      << replay_command(r, o) << "` |\n";
+  }
+}
+
+}  // namespace
+
+std::string safety_fuzz_csv(const SafetyFuzzResult& result) {
+  std::ostringstream s;
+  s << "run_id,index,kind,mode,loop,plant_seed,start_s,target,joint,force_N,profile,duration_s,fault_cycles,"
+       "max_speed_ratio,min_limit_margin_rad,min_capsule_distance_mm,required_torque_ratio,max_deviation_rad,final_deviation_rad,final_deviation_joint,final_speed_rad_s,"
+       "recovery_time_s,safe_stop,safe_stop_reason,safe_stop_rest_time_s,refused_writes,unhandled_refusals,nan_command,"
+       "crashed,violations,operator_possible,controller_failure,error\n";
+  for (const FuzzRecord& r : result.records) {
+    const WindowMetrics& m = r.metrics;
+    std::string error = r.error;
+    std::replace(error.begin(), error.end(), ',', ';');
+    s << r.run_id << ',' << r.index << ',' << to_string(r.kind) << ',' << to_string(r.mode) << ',' << to_string(r.loop) << ','
+      << r.plant_seed << ',' << format_fixed(r.start_s, 3) << ',' << r.target << ',' << (r.joint >= 0 ? r.joint + 1 : 0) << ','
+      << format_fixed(r.force_N, 2) << ',' << r.profile << ',' << format_fixed(r.duration_s, 3) << ',' << r.fault_cycles << ','
+      << number(m.max_speed_ratio, 4) << ',' << number(m.min_limit_margin_rad, 5) << ','
+      << number(1e3 * m.min_capsule_distance_m, 2) << ',' << number(m.max_required_torque_ratio, 3) << ','
+      << number(m.max_deviation_rad, 4) << ',' << number(m.final_deviation_rad, 4) << ','
+      << m.final_deviation_joint + 1 << ',' << number(m.final_speed_rad_s, 4) << ',' << number(m.recovery_time_s, 3) << ',' << (m.safe_stop ? 1 : 0) << ','
+      << r.safe_stop_reason << ',' << number(m.safe_stop_rest_time_s, 3) << ',' << m.refused_writes << ','
+      << m.unhandled_refusals << ',' << (m.nan_command ? 1 : 0) << ',' << (m.crashed ? 1 : 0) << ','
+      << violation_list(r.verdict.violations) << ',' << (r.verdict.operator_possible ? 1 : 0) << ','
+      << (r.verdict.controller_failure() ? 1 : 0) << ',' << error << '\n';
+  }
+  return s.str();
+}
+
+std::string safety_fuzz_report(const SafetyFuzzResult& result, const SafetyFuzzOptions& o) {
+  std::ostringstream s;
+  long kinds[6] = {0, 0, 0, 0, 0, 0};
+  for (const FuzzRecord& r : result.records) ++kinds[static_cast<int>(r.kind)];
+  const SafetyFuzzThresholds& t = o.thresholds;
+  s << "# Safety fuzz, seed " << o.seed << "\n\n"
+    << result.pushes() << " pushes (" << kinds[0] << " random, " << kinds[1] << " toward joint limits, " << kinds[2]
+    << " wrist folds) and " << result.faults() << " sensor faults (" << kinds[4] << " fault-free references) on "
+    << result.runs << " plant + controller constructions; " << format_fixed(result.simulated_s, 0) << " s simulated in "
+    << format_fixed(result.wall_s, 1) << " s of wall time with " << o.jobs << " jobs. **" << result.controller_failures()
+    << " controller failures.**" << (o.replay.empty() ? "" : " Replay of `" + o.replay + "` only.") << "\n\n"
+    << "Violations, on the plant's true state: a joint beyond its URDF limit; |qd| above " << t.speed_factor
+    << " x its velocity limit; a self-collision capsule pair below " << format_fixed(1e3 * t.collision_distance_m, 0)
+    << " mm; a non-finite command; a crash or a diverged plant; a refused write (unhandled: no safe stop the next cycle); "
+       "not back within "
+    << t.recovery_tolerance_rad << " rad of the reference (held pose; fault-free path; dual compliance: at rest) within "
+    << t.recovery_time_s << " s, and not in a safe stop; a safe stop still moving (max abs(qd) >= " << t.rest_speed_rad_s
+    << " rad/s) " << t.safe_stop_rest_time_s
+    << " s after it began. Operator-possible: the push needed more than a joint's torque limit to hold the arm "
+       "(|g(q) - J_p^T F|_i > tau_limit_i, controller model, true q).\n\n";
+  pair_table(result, s);
+  category_table(result, s);
+  fault_table(result, s);
+  no_recovery_table(result, s);
+  margins(result, s);
+  failure_list(result, o, s);
+  return s.str();
+}
+
+int run_safety_fuzz_command(const SafetyFuzzOptions& options, bool fail_on_violation, std::ostream& out) {
+  out << "safety fuzz: plant " << options.plant_config_path << ", seed " << options.seed << ", " << options.pushes
+      << " random pushes" << std::endl;
+  const SafetyFuzzResult r = run_safety_fuzz(options, &out);
+  std::ostringstream summary;
+  summary << r.pushes() << " pushes, " << r.faults() << " faults, " << r.runs << " runs: " << format_fixed(r.simulated_s, 0)
+          << " s simulated in " << format_fixed(r.wall_s, 1) << " s of wall time\n";
+  summary << "controller failures: " << r.controller_failures();
+  for (int i = 0; i < kFuzzViolationCount; ++i) {
+    const long n = std::count_if(r.records.begin(), r.records.end(), [i](const FuzzRecord& x) {
+      return x.verdict.controller_failure() && (x.verdict.violations & (1u << i)) != 0;
+    });
+    if (n > 0) summary << ", " << violation_name(i) << " " << n;
+  }
+  summary << "\n";
+  const std::vector<const FuzzRecord*> f = failures_worst_first(r);
+  for (std::size_t i = 0; i < std::min<std::size_t>(f.size(), 5); ++i) {
+    summary << "  " << violation_list(f[i]->verdict.violations) << ": " << what(*f[i]) << " -> " << replay_command(*f[i], options)
+            << "\n";
+  }
+  report_experiment({summary.str(), r.files, options.output_dir, options.figure_script, "safety_fuzz.png"}, out);
+  return fail_on_violation && r.controller_failures() > 0 ? 1 : 0;
+}
+
+}  // namespace phri
