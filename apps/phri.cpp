@@ -275,6 +275,8 @@ CLI::App* add_safety_fuzz_command(CLI::App& experiment, SafetyFuzzArguments& arg
       ->capture_default_str();
   fuzz->add_flag("--no-targeted", args.no_targeted, "leave out the pushes toward the joint limits and the wrist folds");
   fuzz->add_option("--replay", o.replay, "run only this run (an id from report.md)");
+  fuzz->add_option("--trace", o.trace_path, "with --replay: the run's every cycle as CSV (plant truth, command, push)")
+      ->needs("--replay");
   fuzz->add_option("--plant", o.plant_config_path, "plant configuration")->check(CLI::ExistingFile);
   fuzz->add_flag("--fail-on-violation", args.fail_on_violation, "exit with status 1 when a controller failure was found");
   return fuzz;

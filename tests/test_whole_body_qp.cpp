@@ -229,3 +229,39 @@ TEST(ComplianceControllerTest, ReleaseThresholdAboveTheTouchThresholdIsAConfigEr
 }
 
 }  // namespace
+
+// The posture's stiction term (posture_task.hpp) against its closed form: at rest with a constant
+// error e it grows at K_I e per second up to its clamp; it bleeds off (time constant 0.1 s) while
+// the joint moves faster than 0.1 rad/s; it restarts from zero when the joint crosses its target;
+// it never acts outside its zone or with zero stiffness.
+TEST(PostureTaskTest, StictionTermIntegratesAtRestClampsBleedsAndResets) {
+  const phri::Model model = phri::Model::from_urdf_file(kGen3 + "gen3.urdf");
+  phri::PostureTask posture(model);
+  posture.reset_gains(20.0, 9.0, 1.0, 0.0);
+  const double gain = 200.0, limit = 40.0, zone = 0.3, dt = 1e-3;
+  posture.set_integral(gain, limit, zone);
+  Eigen::VectorXd target(7);
+  target << 0, 0.58, 3.14, -1.84, 0, 0.85, 1.57;
+  posture.set_target(target);
+  Eigen::VectorXd q = target, qd = Eigen::VectorXd::Zero(7);
+  const Eigen::VectorXd none = Eigen::VectorXd::Zero(7);
+  q[1] -= 0.05;  // joint 2 stuck 0.05 rad short
+  q[3] += 0.5;   // joint 4 outside the zone
+  for (int k = 0; k < 100; ++k) posture.update(q, qd, none, dt);
+  EXPECT_NEAR(posture.integral_term()[1], gain * 0.05 * 0.1, 1e-9);  // 0.1 s of K_I e
+  EXPECT_EQ(posture.integral_term()[3], 0.0);
+  EXPECT_NEAR(posture.reference()[1], 20.0 * 0.05 + gain * 0.05 * 0.1, 1e-9);
+  for (int k = 0; k < 5000; ++k) posture.update(q, qd, none, dt);
+  EXPECT_DOUBLE_EQ(posture.integral_term()[1], limit);
+  qd[1] = 0.5;  // moving: bleeds with time constant 0.1 s
+  for (int k = 0; k < 100; ++k) posture.update(q, qd, none, dt);
+  EXPECT_NEAR(posture.integral_term()[1], limit * std::exp(-1.0), 1e-6);
+  qd[1] = 0.0;
+  q[1] = target[1] + 0.01;  // crossed the target: restarts from zero, on the other side
+  posture.update(q, qd, none, dt);
+  EXPECT_NEAR(posture.integral_term()[1], -gain * 0.01 * dt, 1e-12);
+  posture.reset_gains(0.0, 9.0, 1.0, 0.0);  // no spring: no stiction term either
+  posture.set_integral(gain, limit, zone);
+  for (int k = 0; k < 100; ++k) posture.update(q, qd, none, dt);
+  EXPECT_EQ(posture.integral_term()[1], 0.0);
+}

@@ -14,7 +14,8 @@ ComplianceController::ComplianceController(const ComplianceSettings& settings) :
   }
   for (double v : {settings.ee_position_stiffness, settings.ee_orientation_stiffness, settings.ee_weight,
                    settings.full_body_ee_stiffness, settings.posture_stiffness, settings.posture_damping,
-                   settings.posture_weight, settings.touched_ee_damping, settings.touched_posture_damping}) {
+                   settings.posture_weight, settings.touched_ee_damping, settings.touched_posture_damping,
+                   settings.posture_integral_gain, settings.posture_integral_limit, settings.posture_integral_zone}) {
     if (!(v >= 0) || !std::isfinite(v)) fail("gains", "stiffness, damping and weights must be finite and >= 0");
   }
   if (!(settings.posture_weight > 0)) fail("posture_weight", "must be > 0 (it keeps the QP strictly convex)");
@@ -59,6 +60,8 @@ void ComplianceController::initialise(ComplianceMode mode, WholeBodyQp& qp, cons
                  Vector6d::Constant(mode == ComplianceMode::kFullBody ? 1.0 : 0.0));
   qp.posture().reset_gains(settings_.posture_stiffness, settings_.posture_damping, settings_.posture_weight,
                            mode == ComplianceMode::kStiff ? 0.0 : 1.0);
+  qp.posture().set_integral(settings_.posture_integral_gain, settings_.posture_integral_limit,
+                            settings_.posture_integral_zone);
   ee.hold_current_pose(data);
 }
 

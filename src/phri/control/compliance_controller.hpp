@@ -25,6 +25,11 @@ struct ComplianceSettings {
   double posture_stiffness = 20.0;
   double posture_damping = 9.0;
   double posture_weight = 1.0;
+  /// Posture stiction term (posture_task.hpp; not in the paper): K_I [1/s^3], its clamp [rad/s^2]
+  /// and the zone around the target where it acts [rad]. 0 turns it off (the paper's behaviour).
+  double posture_integral_gain = 200.0;
+  double posture_integral_limit = 40.0;
+  double posture_integral_zone = 0.3;
   // Dual compliance (paper: 8 up, 4 down on the 6-D wrench norm; touched EE damping 15,
   // posture damping 2).
   double touch_threshold = 8.0;

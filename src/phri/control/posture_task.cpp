@@ -16,12 +16,19 @@ PostureTask::PostureTask(const Model& model, double smoothing_time_constant)
       target_qd_(Eigen::VectorXd::Zero(model.nv())),
       target_qdd_(Eigen::VectorXd::Zero(model.nv())),
       error_(Eigen::VectorXd::Zero(model.nv())),
-      reference_(Eigen::VectorXd::Zero(model.nv())) {
+      reference_(Eigen::VectorXd::Zero(model.nv())),
+      integral_term_(Eigen::VectorXd::Zero(model.nv())) {
   for (const Joint& j : model.joints()) continuous_.push_back(j.type == JointType::kContinuous);
 }
 
 void PostureTask::set_stiffness(const Eigen::VectorXd& stiffness) { stiffness_.set_target(stiffness); }
 void PostureTask::set_damping(const Eigen::VectorXd& damping) { damping_.set_target(damping); }
+void PostureTask::set_integral(double gain, double limit, double zone) {
+  integral_gain_ = std::max(gain, 0.0);
+  integral_limit_ = std::max(limit, 0.0);
+  integral_zone_ = std::max(zone, 0.0);
+  integral_term_.setZero();
+}
 void PostureTask::set_weight(double weight) { weight_.set_target_constant(weight); }
 void PostureTask::set_gamma(double gamma) { gamma_.set_target_constant(std::clamp(gamma, 0.0, 1.0)); }
 void PostureTask::reset_gains(double stiffness, double damping, double weight, double gamma) {
@@ -32,14 +39,28 @@ void PostureTask::reset_gains(double stiffness, double damping, double weight, d
 }
 
 void PostureTask::set_target(const Eigen::VectorXd& q, const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd) {
+  if (target_q_ != q) integral_term_.setZero();
   target_q_ = q;
   target_qd_ = qd;
   target_qdd_ = qdd;
 }
 void PostureTask::set_target(const Eigen::VectorXd& q) {
+  if (target_q_ != q) integral_term_.setZero();
   target_q_ = q;
   target_qd_.setZero();
   target_qdd_.setZero();
+}
+
+void PostureTask::update_integral(const Eigen::VectorXd& qd, double dt) {
+  if (integral_gain_ <= 0.0) return;
+  const double bleed = std::exp(-dt / kIntegralBleed_s);
+  for (int i = 0; i < nv_; ++i) {
+    double& term = integral_term_[i];
+    const double e = error_[i];
+    if (term * e < 0.0) term = 0.0;  // crossed the target: start again from the other side
+    const bool creeping = std::abs(qd[i]) < kCreepSpeed_rad_s && std::abs(e) < integral_zone_ && stiffness_.value()[i] > 0.0;
+    term = creeping ? std::clamp(term + integral_gain_ * e * dt, -integral_limit_, integral_limit_) : term * bleed;
+  }
 }
 
 void PostureTask::update(const Eigen::VectorXd& q, const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd_external,
@@ -53,8 +74,9 @@ void PostureTask::update(const Eigen::VectorXd& q, const Eigen::VectorXd& qd, co
     if (continuous_[static_cast<std::size_t>(i)]) e = std::remainder(e, 2.0 * std::numbers::pi);
     error_[i] = e;
   }
+  update_integral(qd, dt);
   reference_ = target_qdd_ + stiffness_.value().cwiseProduct(error_) + damping_.value().cwiseProduct(target_qd_ - qd) +
-               gamma_.value()[0] * qdd_external;
+               integral_term_ + gamma_.value()[0] * qdd_external;
 }
 
 }  // namespace phri

@@ -5,6 +5,14 @@
 //
 // The error of a continuous joint is wrapped to (-pi, pi] so the posture never asks for a full
 // turn. Gains, weight and gamma are smoothed like the end-effector task's.
+//
+// Stiction term (not in the paper): a weak spring at rest near its target cannot beat the drive's
+// static friction (2.15 N.m on the Gen3's large actuators), so a pushed elbow would stop a few
+// hundredths of a radian short for good. While a joint is stuck or creeping (|qd| < 0.1 rad/s)
+// within integral_zone of its target, K_I times the integrated error is added to qdd*, clamped to
+// integral_limit; when the joint moves faster or leaves the zone the term bleeds off (time
+// constant 0.1 s), and it restarts from zero when the joint crosses its target, so it neither
+// winds up during a push or a motion nor drives an overshoot.
 #include <phri/core/smoothed_vector.hpp>
 #include <phri/model/model.hpp>
 
@@ -19,6 +27,9 @@ public:
   void set_damping(const Eigen::VectorXd& damping);
   void set_damping(double damping) { damping_.set_target_constant(damping); }
   void set_weight(double weight);
+  /// Stiction term: K_I [1/s^3] (0: off); clamp [rad/s^2]; zone [rad]. Resets the integral.
+  void set_integral(double gain, double limit, double zone);
+  const Eigen::VectorXd& integral_term() const { return integral_term_; }
   void set_gamma(double gamma);
   void reset_gains(double stiffness, double damping, double weight, double gamma);
   double weight() const { return weight_.value()[0]; }
@@ -36,6 +47,11 @@ public:
   const Eigen::VectorXd& error() const { return error_; }
 
 private:
+  void update_integral(const Eigen::VectorXd& qd, double dt);
+  /// Below: the joint is stuck or creeping against friction (the paper's friction velocity threshold).
+  static constexpr double kCreepSpeed_rad_s = 0.1;
+  static constexpr double kIntegralBleed_s = 0.1;
+
   int nv_;
   std::vector<bool> continuous_;
   SmoothedVector stiffness_;
@@ -45,6 +61,8 @@ private:
   Eigen::VectorXd target_q_, target_qd_, target_qdd_;
   Eigen::VectorXd error_;
   Eigen::VectorXd reference_;
+  double integral_gain_ = 0.0, integral_limit_ = 0.0, integral_zone_ = 0.0;
+  Eigen::VectorXd integral_term_;  ///< K_I * integral of the error [rad/s^2]
 };
 
 }  // namespace phri

@@ -13,6 +13,7 @@
 #include <chrono>
 #include <cmath>
 #include <exception>
+#include <fstream>
 #include <functional>
 #include <memory>
 #include <mutex>
@@ -144,6 +145,7 @@ public:
     if (refusal_pending_ && status != CycleStatus::kSafeStop) ++m.unhandled_refusals;
     refusal_pending_ = false;
     if (!setpoint_finite(command_)) m.nan_command = true;
+    if (trace_.is_open()) write_trace_row(status);
     if (io_.write(command_) != WriteStatus::kOk) {
       const bool injected = io_.fault_active() && io_.fault().kind == FaultKind::kWriteRefused;
       if (!injected) ++m.refused_writes;
@@ -169,6 +171,20 @@ public:
     return classify(m, s_.o.thresholds).violations == 0 && !m.safe_stop;
   }
 
+  // Every later cycle as one CSV row (a replay's --trace); appends when `append`.
+  void trace_to(const std::string& path, bool append) {
+    trace_.open(path, append ? std::ios::app : std::ios::trunc);
+    if (!trace_) throw ConfigError(path, "trace", "cannot write the trace file");
+    if (append) return;
+    trace_ << "t_s,status,safety_state";
+    const int n = robot_->dof();
+    for (const char* name : {"q", "qd", "command", "tau_ext_hat", "tau_sensor_true", "tau_friction", "posture_integral",
+                             "qdd_desired", "tau_desired"}) {
+      for (int i = 0; i < n; ++i) trace_ << ',' << name << i + 1;
+    }
+    trace_ << '\n';
+  }
+
   double time() const { return robot_->state().time_s; }
   long cycles() const { return io_.cycles(); }
   double speed() const { return speed_; }
@@ -187,6 +203,21 @@ public:
   SafetyMonitor& monitor() { return monitor_; }
 
 private:
+  void write_trace_row(CycleStatus status) {
+    const SimRobot::Truth& truth = robot_->truth();
+    const Eigen::VectorXd& cmd = command_.mode == LowLevelMode::kPosition ? command_.q_rad
+                                 : command_.mode == LowLevelMode::kCurrent ? command_.current_A
+                                                                           : command_.tau_Nm;
+    trace_ << robot_->state().time_s << ',' << to_string(status) << ',' << to_string(cycle_.supervisor().state());
+    for (const Eigen::VectorXd* v : {&truth.q_rad, &truth.qd_rad_s, &cmd, &cycle_.external_torque(),
+                                     &truth.tau_transmitted_Nm, &truth.tau_friction_Nm,
+                                     &cycle_.qp().posture().integral_term(),
+                                     &cycle_.qp().desired_acceleration(), &cycle_.qp().desired_torque()}) {
+      for (Eigen::Index i = 0; i < v->size(); ++i) trace_ << ',' << (*v)[i];
+    }
+    trace_ << '\n';
+  }
+
   const Shared& s_;
   LowLevelMode loop_;
   std::unique_ptr<SimRobot> robot_;
@@ -195,6 +226,7 @@ private:
   RobotCommand command_;
   ControllerTargets targets_;
   SafetyMonitor monitor_;
+  std::ofstream trace_;
   bool refusal_pending_ = false;
   double speed_ = 0.0;
 };
@@ -281,6 +313,7 @@ void push_run(const Shared& s, const std::string& id, ComplianceMode mode, LowLe
     try {
       Rig rig(s, mode, loop, seed, FaultSpec{});
       ++out.rigs;
+      if (!s.o.trace_path.empty()) rig.trace_to(s.o.trace_path, rebuild > 0);
       if (!rig.warm_up(r.metrics)) {
         r.verdict = classify(r.metrics, s.o.thresholds);
         r.safe_stop_reason = rig.safe_stop_reason();
@@ -381,6 +414,7 @@ void fault_run(const Shared& s, const std::string& id, ComplianceMode mode, LowL
   try {
     Rig rig(s, mode, loop, seed, spec);
     ++out.rigs;
+    if (!s.o.trace_path.empty()) rig.trace_to(s.o.trace_path, false);
     WindowMetrics warm;
     rig.warm_up(warm);  // identical to the reference's start-up (its record judges it)
     WindowMetrics& m = r.metrics;

@@ -64,6 +64,7 @@ struct SafetyFuzzOptions {
   std::vector<long> fault_cycles = {1, 100};
   int jobs = 2;
   std::string replay;          ///< run only this run (an id of the report); empty: all
+  std::string trace_path;      ///< with replay: every cycle of the replayed run as CSV; empty: none
 
   // ---- plant and protocol
   bool model_mismatch = true;  ///< plant link inertials ±5 % from the controller's URDF
