@@ -341,6 +341,24 @@ TEST(Safety, FrozenValuesAndStaleStampsAreDetected) {
   }
 }
 
+// A q̇ offset that stays within range (3 rad/s on joint 4 for 100 ms, below the 2.5x bound) made
+// the controller brake against a phantom motion: the true joint reached 1.34x its velocity limit.
+// q̇ must agree with the rate of q: the offset is caught at its first sample, the arm never moves
+// faster than 0.2x its limit and ends in a safe stop near the fault-free run's pose, in every loop.
+TEST(Safety, AVelocityOffsetWithinRangeIsCaughtByTheRateOfQ) {
+  for (phri::LowLevelMode loop : {phri::LowLevelMode::kPosition, phri::LowLevelMode::kKinovaTorque,
+                                  phri::LowLevelMode::kKinovaTorqueHighVelocity, phri::LowLevelMode::kCurrent}) {
+    SCOPED_TRACE(std::string(phri::to_string(loop)));
+    Rig clean(phri::ComplianceMode::kNullSpace, loop), faulty(phri::ComplianceMode::kNullSpace, loop);
+    clean.run(1.5);
+    faulty.run(1.5, [](long k, phri::RobotState& s) { if (k >= 500 && k < 600) s.qd_rad_s[3] += 3.0; });
+    EXPECT_EQ(faulty.cycle_.supervisor().safe_stop_transition().reason, phri::SafetyFault::kVelocityMismatch);
+    EXPECT_EQ(faulty.cycle_.status(), phri::CycleStatus::kSafeStop);
+    EXPECT_LT(faulty.speed_ratio_, 0.2);
+    EXPECT_LT(distance(faulty.q(), clean.q()), 0.01);
+  }
+}
+
 // A single-sample F/T spike (300 N) is not a dual-compliance touch.
 TEST(Safety, ASingleSampleForceSpikeIsNotATouch) {
   Rig rig(phri::ComplianceMode::kDual, phri::LowLevelMode::kCurrent);

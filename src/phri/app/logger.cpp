@@ -93,7 +93,7 @@ std::string Logger::legend_yaml() {
                                      CycleStatus::kStaleState, CycleStatus::kTargetsRejected, CycleStatus::kSafeStop});
   legend_entry(out, "safety_state", {SupervisorState::kNormal, SupervisorState::kDegraded, SupervisorState::kSafeStop});
   out += "safety_fault:\n";
-  for (int f = 0; f <= static_cast<int>(SafetyFault::kFollowingError); ++f) {
+  for (int f = 0; f <= static_cast<int>(SafetyFault::kLast); ++f) {
     out += "  " + std::to_string(f) + ": " + std::string(to_string(static_cast<SafetyFault>(f))) + "\n";
   }
   legend_entry(out, "controller_status", {WholeBodyQpStatus::kOk, WholeBodyQpStatus::kQpInfeasible,

@@ -58,7 +58,7 @@ void PostureTask::update_integral(const Eigen::VectorXd& qd, double dt) {
     double& term = integral_term_[i];
     const double e = error_[i];
     if (term * e < 0.0) term = 0.0;  // crossed the target: start again from the other side
-    const bool creeping = std::abs(qd[i]) < kCreepSpeed_rad_s && std::abs(e) < integral_zone_ && stiffness_.value()[i] > 0.0;
+    const bool creeping = integral_enabled_ && std::abs(qd[i]) < kCreepSpeed_rad_s && std::abs(e) < integral_zone_ && stiffness_.value()[i] > 0.0;
     term = creeping ? std::clamp(term + integral_gain_ * e * dt, -integral_limit_, integral_limit_) : term * bleed;
   }
 }

@@ -12,7 +12,8 @@
 // within integral_zone of its target, K_I times the integrated error is added to qdd*, clamped to
 // integral_limit; when the joint moves faster or leaves the zone the term bleeds off (time
 // constant 0.1 s), and it restarts from zero when the joint crosses its target, so it neither
-// winds up during a push or a motion nor drives an overshoot.
+// winds up during a push or a motion nor drives an overshoot. The controller enables it in the
+// custom loop only (see enable_integral).
 #include <phri/core/smoothed_vector.hpp>
 #include <phri/model/model.hpp>
 
@@ -30,6 +31,9 @@ public:
   /// Stiction term: K_I [1/s^3] (0: off); clamp [rad/s^2]; zone [rad]. Resets the integral.
   void set_integral(double gain, double limit, double zone);
   const Eigen::VectorXd& integral_term() const { return integral_term_; }
+  /// Off: the term bleeds off (the controller keeps it for the custom loop, whose friction
+  /// pre-compensation turns its acceleration into torque at rest).
+  void enable_integral(bool on) { integral_enabled_ = on; }
   void set_gamma(double gamma);
   void reset_gains(double stiffness, double damping, double weight, double gamma);
   double weight() const { return weight_.value()[0]; }
@@ -62,6 +66,7 @@ private:
   Eigen::VectorXd error_;
   Eigen::VectorXd reference_;
   double integral_gain_ = 0.0, integral_limit_ = 0.0, integral_zone_ = 0.0;
+  bool integral_enabled_ = true;
   Eigen::VectorXd integral_term_;  ///< K_I * integral of the error [rad/s^2]
 };
 

@@ -39,7 +39,7 @@ void check_settings(const SensorRanges& r, const SupervisorSettings& s) {
     throw ConfigError(kWhere, "ranges", "limits must be > 0 and lower < upper");
   }
   if (!(s.period_s > 0) || !(s.position_margin_rad >= 0) || !(s.velocity_bound_factor >= 1) ||
-      !(s.position_step_factor >= 1) || !(s.position_step_slack_rad >= 0) || !(s.torque_range_factor >= 1) ||
+      !(s.position_step_factor >= 1) || !(s.position_step_slack_rad >= 0) || !(s.velocity_consistency_rad_s > 0) || !(s.encoder_quantum_rad >= 0) || !(s.torque_range_factor >= 1) ||
       !(s.current_range_factor >= 1) || !(s.max_degraded_s >= s.period_s) || !(s.recovery_samples >= 1) ||
       !(s.max_fault_budget >= 1) || !(s.fault_budget_decay_per_good >= 0) || !(s.frozen_s >= 0)) {
     throw ConfigError(kWhere, "settings", "a bound is out of range (factors >= 1, times >= the period)");
@@ -93,6 +93,13 @@ SafetyFault StateSupervisor::check_ranges(const RobotState& s, int& joint) const
       const double dt = std::max(s.joints.stamp_s - last_good_.joints.stamp_s, c.period_s);
       const double step = std::abs(q - last_good_.q_rad[i]);
       if (step > c.position_step_factor * v_limit * dt + c.position_step_slack_rad) return SafetyFault::kPositionJump;
+      // q̇ must agree with the position's own rate: over the gap since the last good sample the mean
+      // velocity is (q̇ + q̇_last) / 2 at constant acceleration. A q̇ offset or spike within range
+      // would otherwise make the controller brake against a phantom motion.
+      const double mean_qd = 0.5 * (s.qd_rad_s[i] + last_good_.qd_rad_s[i]);
+      if (std::abs(mean_qd - (q - last_good_.q_rad[i]) / dt) > c.velocity_consistency_rad_s + 2.0 * c.encoder_quantum_rad / dt) {
+        return SafetyFault::kVelocityMismatch;
+      }
     }
   }
   if ((joint = first_beyond(s.tau_sensor_Nm, ranges_.torque_range, c.torque_range_factor)) >= 0) {

@@ -50,6 +50,8 @@ enum class SafetyFault : std::uint8_t {
   kWriteRefused,    ///< the robot refused a command
   kQpFailure,       ///< the QP kept failing (brake fallback for longer than allowed)
   kFollowingError,  ///< the position loop could not follow its reference (re-synced too often)
+  kVelocityMismatch,///< q̇ disagrees with the rate of q between consecutive samples
+  kLast = kVelocityMismatch,
 };
 
 constexpr std::string_view to_string(SupervisorState s) {
@@ -73,6 +75,7 @@ constexpr std::string_view to_string(SafetyFault f) {
     case SafetyFault::kPositionRange: return "position_out_of_range";
     case SafetyFault::kPositionJump: return "position_jump";
     case SafetyFault::kVelocityRange: return "velocity_out_of_range";
+    case SafetyFault::kVelocityMismatch: return "velocity_mismatch";
     case SafetyFault::kTorqueRange: return "torque_out_of_range";
     case SafetyFault::kCurrentRange: return "current_out_of_range";
     case SafetyFault::kFrozenValues: return "frozen_values";
@@ -106,6 +109,11 @@ struct SupervisorSettings {
   /// position_step_slack_rad for encoder quanta and jitter) is a jump, not a motion.
   double position_step_factor = 3.0;
   double position_step_slack_rad = 1e-3;
+  /// [rad/s] |mean q̇ - Δq/Δt| allowed between the sample and the last good one, besides two
+  /// encoder quanta over Δt: a 3 rad/s offset on q̇ is caught at its first sample.
+  double velocity_consistency_rad_s = 0.5;
+  /// [rad] the joint encoders' quantum or noise (Gen3: far below 2 pi / 2^16 = 9.6e-5).
+  double encoder_quantum_rad = 1e-4;
   /// |τ_s| above factor x the drive's peak motor torque (and |i| above factor x its current
   /// limit) is not a reading: the link side can briefly see more than the motor gives (a hard
   /// stop, an impact), but not several times more.
