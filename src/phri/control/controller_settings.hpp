@@ -42,7 +42,7 @@ struct SafetySettings {
   /// Velocity guard of the torque loops, the last line behind the QP's velocity constraint: above
   /// guard_fraction x the drive's velocity limit, damping rate x (M_ii + I_r) x the excess.
   double velocity_guard_fraction = 0.9;
-  double velocity_guard_rate = 400.0;  ///< [1/s]
+  double velocity_guard_rate = 200.0;  ///< [1/s]
   /// Limit guard: beyond the damper's safety distance d_s, an outward torque of the joint's static
   /// friction plus stiffness x the depth, so that a joint leaves the band against its stiction.
   double limit_guard_stiffness_Nm_per_rad = 200.0;
