@@ -385,9 +385,12 @@ CycleStatus Controller::step(const RobotState& state, const ControllerTargets& t
   select_external_torque();
   bound_external_torque();
   if (low_level_.requested() == LowLevelMode::kPosition) tau_ext_.setZero();
-  // The posture's stiction term only where friction pre-compensation turns it into torque at rest
-  // (in the vendor's torque loops 40 rad/s^2 along the elbow's low-inertia self-motion makes < 1 N.m).
-  qp_.posture().enable_integral(low_level_.requested() == LowLevelMode::kCurrent);
+  // The posture's stiction term in the torque loops, where friction pre-compensation (custom loop)
+  // or the breakaway feed-forward (vendor loops) turns its acceleration into torque at rest.
+  // Not in dual compliance: the hand places the end effector anywhere, the posture target is then
+  // off the new self-motion manifold and the term would only make the arm creep.
+  qp_.posture().enable_integral(low_level_.requested() != LowLevelMode::kPosition &&
+                                compliance_.mode() != ComplianceMode::kDual);
   const WholeBodyQpStatus qp_status = qp_.update(model_, data_, q_, qd_, tau_ext_, settings_.period_s);
   check_qp(qp_status, state.time_s);
   if (supervisor_.safe_stop()) {

@@ -20,10 +20,12 @@ LowLevelController::LowLevelController(const ActuatorTable& actuators, const Cus
       torque_per_amp_(Eigen::VectorXd::Zero(actuators.size())),
       current_limit_(Eigen::VectorXd::Zero(actuators.size())),
       entry_current_(Eigen::VectorXd::Zero(actuators.size())),
+      breakaway_(Eigen::VectorXd::Zero(actuators.size())),
       offset_decay_(std::exp(-custom.period_s / kTorqueBlendTime)) {
   for (int i = 0; i < actuators.size(); ++i) {
     torque_per_amp_[i] = actuators[i].torque_per_amp();
     current_limit_[i] = actuators[i].current_limit_A;
+    friction_.push_back(actuators[i].friction);
   }
 }
 
@@ -98,7 +100,13 @@ void LowLevelController::update(const RobotState& state, const Eigen::VectorXd& 
           torque_offset_ = state.tau_sensor_Nm - tau_desired;
         }
       }
-      command.tau_Nm = tau_desired + torque_offset_;
+      for (Eigen::Index i = 0; i < breakaway_.size(); ++i) {
+        const FrictionParameters& f = friction_[static_cast<std::size_t>(i)];
+        const bool stuck = std::abs(state.qd_rad_s[i]) < f.velocity_threshold_rad_s &&
+                           std::abs(qdd_desired[i]) >= f.acceleration_threshold_rad_s2;
+        breakaway_[i] = stuck ? std::copysign(kVendorBreakawayShare * f.static_Nm, qdd_desired[i]) : 0.0;
+      }
+      command.tau_Nm = tau_desired + torque_offset_ + breakaway_;
       torque_offset_ *= offset_decay_;
       break;
     case LowLevelMode::kCurrent:

@@ -52,6 +52,12 @@ public:
 
   /// Position-loop reference clamps so far (joint-cycles where the servo could not follow).
   long resync_count() const { return resyncs_; }
+  /// Vendor torque loops: the share of static friction added to tau_d at breakaway (stuck joint,
+  /// desired acceleration beyond the friction model's threshold). Kinova's torque loop rejects only
+  /// part of the gear friction through its torque-sensor feedback; without this a soft spring
+  /// (posture, full-body end effector) stops short. 0: off (the paper's Kinova modes).
+  static constexpr double kVendorBreakawayShare = 0.5;
+  const Eigen::VectorXd& breakaway() const { return breakaway_; }
   const CustomTorqueController& custom() const { return custom_; }
   const Eigen::VectorXd& position_reference() const { return q_ref_; }
 
@@ -68,7 +74,9 @@ private:
   Eigen::VectorXd torque_offset_;  // motor minus desired torque at a torque-loop entry, fading
   Eigen::VectorXd torque_per_amp_; // nominal K_T G_r per joint
   Eigen::VectorXd current_limit_;  // A
+  std::vector<FrictionParameters> friction_;  // per joint, for the breakaway feed-forward
   Eigen::VectorXd entry_current_;  // the current the custom loop starts from
+  Eigen::VectorXd breakaway_;      // the vendor loops' breakaway feed-forward of this cycle [N.m]
   double offset_decay_ = 0.0;
 };
 
