@@ -171,3 +171,33 @@ TEST_F(CustomLoop, RejectsBadSettingsNamingTheKey) {
 }
 
 }  // namespace
+
+namespace {
+
+// The vendor loops' breakaway feed-forward (low_level_controller.hpp): a stuck joint asked to
+// accelerate beyond the friction model's threshold gets half its static friction added to tau_d in
+// the direction asked; a moving joint, or one asked for less, gets nothing.
+TEST(VendorLoops, BreakawayFeedForwardOnlyForAStuckJointAskedToMove) {
+  const phri::ActuatorTable table = phri::ActuatorTable::from_yaml_file(kActuators);
+  phri::LowLevelController low(table, phri::CustomTorqueSettings{}, phri::LowLevelMode::kKinovaTorque);
+  phri::RobotState state(7);
+  state.q_rad.setZero();
+  state.qd_rad_s.setZero();
+  state.qd_rad_s[2] = 0.5;  // joint 3 slides
+  state.tau_sensor_Nm.setZero();
+  state.current.valid = false;
+  Eigen::VectorXd tau_d = Eigen::VectorXd::Zero(7), qdd = Eigen::VectorXd::Zero(7);
+  qdd[0] = 5.0;   // stuck, asked to move: + half its static friction
+  qdd[1] = -5.0;  // the other way
+  qdd[2] = 5.0;   // moving: nothing
+  qdd[3] = 0.5;   // below the 1 rad/s^2 threshold: nothing
+  phri::RobotCommand command(7);
+  for (int k = 0; k < 400; ++k) low.update(state, tau_d, qdd, command);  // the entry offset fades (50 ms)
+  const double half = phri::LowLevelController::kVendorBreakawayShare;
+  EXPECT_NEAR(command.tau_Nm[0], half * table[0].friction.static_Nm, 1e-6);
+  EXPECT_NEAR(command.tau_Nm[1], -half * table[1].friction.static_Nm, 1e-6);
+  EXPECT_NEAR(command.tau_Nm[2], 0.0, 1e-6);
+  EXPECT_NEAR(command.tau_Nm[3], 0.0, 1e-6);
+}
+
+}  // namespace
