@@ -1,5 +1,7 @@
 #include <phri/lowlevel/low_level_controller.hpp>
 
+#include <phri/lowlevel/friction_compensation.hpp>
+
 #include <cmath>
 
 namespace phri {
@@ -101,10 +103,10 @@ void LowLevelController::update(const RobotState& state, const Eigen::VectorXd& 
         }
       }
       for (Eigen::Index i = 0; i < breakaway_.size(); ++i) {
-        const FrictionParameters& f = friction_[static_cast<std::size_t>(i)];
-        const bool stuck = std::abs(state.qd_rad_s[i]) < f.velocity_threshold_rad_s &&
-                           std::abs(qdd_desired[i]) >= f.acceleration_threshold_rad_s2;
-        breakaway_[i] = stuck ? std::copysign(kVendorBreakawayShare * f.static_Nm, qdd_desired[i]) : 0.0;
+        // The paper's friction model's breakaway case (stuck, asked to move), a share of it.
+        FrictionCase which = FrictionCase::kNone;
+        const double tau_f = friction_compensation(friction_[static_cast<std::size_t>(i)], state.qd_rad_s[i], qdd_desired[i], &which);
+        breakaway_[i] = which == FrictionCase::kStatic ? kVendorBreakawayShare * tau_f : 0.0;
       }
       command.tau_Nm = tau_desired + torque_offset_ + breakaway_;
       torque_offset_ *= offset_decay_;
