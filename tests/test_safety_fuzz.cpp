@@ -114,13 +114,13 @@ TEST(SafetyFuzzClassify, RecoveryTrackerDecisions) {
     EXPECT_FALSE(m.safe_stop);
     EXPECT_EQ(phri::classify(m, t).violations, 0u);
   }
-  {  // never back: decided 3 s after the end
+  {  // never back: decided 3 s after the end plus the walk back from 0.2 rad (0.2 / 0.5 rad/s)
     phri::RecoveryTracker r(t, 1.0, 0.2);
     double now = 0.0;
     for (; now < 10.0 && !r.done(); now += 1e-3) r.sample(now, 0.2, 0.0, -1.0);
     phri::WindowMetrics m;
     r.finish(m);
-    EXPECT_NEAR(now, 4.0, 2e-3);
+    EXPECT_NEAR(now, 1.0 + 3.0 + 0.2 / t.return_speed_rad_s, 2e-3);
     EXPECT_EQ(phri::classify(m, t).violations, phri::kViolationNoRecovery);
   }
   {  // a safe stop at 0.5 s, at rest 0.3 s later: fine

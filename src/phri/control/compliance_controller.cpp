@@ -15,7 +15,9 @@ ComplianceController::ComplianceController(const ComplianceSettings& settings) :
   for (double v : {settings.ee_position_stiffness, settings.ee_orientation_stiffness, settings.ee_weight,
                    settings.full_body_ee_stiffness, settings.posture_stiffness, settings.posture_damping,
                    settings.posture_weight, settings.touched_ee_damping, settings.touched_posture_damping,
-                   settings.posture_integral_gain, settings.posture_integral_limit, settings.posture_integral_zone}) {
+                   settings.posture_integral_gain, settings.posture_integral_limit, settings.posture_integral_zone,
+                   settings.ee_integral.gain, settings.ee_integral.linear_limit, settings.ee_integral.angular_limit,
+                   settings.ee_integral.linear_zone, settings.ee_integral.angular_zone}) {
     if (!(v >= 0) || !std::isfinite(v)) fail("gains", "stiffness, damping and weights must be finite and >= 0");
   }
   if (!(settings.posture_weight > 0)) fail("posture_weight", "must be > 0 (it keeps the QP strictly convex)");
@@ -62,6 +64,7 @@ void ComplianceController::initialise(ComplianceMode mode, WholeBodyQp& qp, cons
                            mode == ComplianceMode::kStiff ? 0.0 : 1.0);
   qp.posture().set_integral(settings_.posture_integral_gain, settings_.posture_integral_limit,
                             settings_.posture_integral_zone);
+  ee.set_integral(settings_.ee_integral);
   ee.hold_current_pose(data);
 }
 

@@ -8,6 +8,7 @@
 // steps; a touch shorter than a few time constants releases onto a spring not yet fully faded,
 // which is the bounded step of K(t) times the distance dragged.
 #include <phri/control/compliance_mode.hpp>
+#include <phri/control/return_leash.hpp>
 #include <phri/control/whole_body_qp.hpp>
 
 #include <algorithm>
@@ -30,6 +31,11 @@ struct ComplianceSettings {
   double posture_integral_gain = 200.0;
   double posture_integral_limit = 40.0;
   double posture_integral_zone = 0.3;
+  /// End-effector stiction term (end_effector_task.hpp; not in the paper). Gain 0 turns it off.
+  TaskIntegralSettings ee_integral{.gain = 200.0, .linear_limit = 10.0, .angular_limit = 40.0,
+                                   .linear_zone = 0.05, .angular_zone = 0.3};
+  /// The way back after a hand carried the arm in full-body compliance (return_leash.hpp).
+  ReturnLeashSettings return_leash;
   // Dual compliance (paper: 8 up, 4 down on the 6-D wrench norm; touched EE damping 15,
   // posture damping 2).
   double touch_threshold = 8.0;

@@ -133,6 +133,7 @@ Controller::Controller(LoadedRobot robot, const ControllerSettings& settings)
       collision_(std::move(robot.collision)),
       qp_(model_, collision_ ? &*collision_ : nullptr, qp_settings(settings, actuators_)),
       compliance_(settings.compliance),
+      leash_(model_, model_.frame_id(settings.end_effector_frame), settings.compliance.return_leash),
       observer_(model_, settings.observer_gain),
       wrench_(settings.wrench),
       low_level_(actuators_, custom_torque_settings(settings), settings.initial_loop),
@@ -370,6 +371,7 @@ CycleStatus Controller::step(const RobotState& state, const ControllerTargets& t
     started_ = true;
     qp_.posture().set_target(q_);
     compliance_.initialise(settings_.initial_compliance, qp_, data_);
+    leash_.reset();
   }
   if (pending_mode_) {
     compliance_.set_mode(*pending_mode_, qp_, data_);
@@ -379,6 +381,11 @@ CycleStatus Controller::step(const RobotState& state, const ControllerTargets& t
   // single-sample spikes of the F/T signal (tool inertia during stick-slip jolts, noise) must not
   // free the end effector for a few milliseconds.
   compliance_.update(trigger_filter_.update(wrench_.calibrated() ? wrench_.norm() : 0.0), qp_, data_);
+  // The way back after a hand carried the arm (return_leash.hpp): dragged in full-body compliance.
+  leash_.update(model_, q_, qd_, qp_.posture().target(), qp_.posture().target_velocity(),
+                compliance_.mode() == ComplianceMode::kFullBody, settings_.period_s);
+  qp_.posture().set_target_offset(leash_.offset());
+  qp_.end_effector().set_target_offset(leash_.pose_offset());
 
   // ---- QP and inverse dynamics. Under the robot's position loop the external torque is not fed
   // back: the stiff servo rejects it and the observer would only see servo effort.
@@ -389,8 +396,10 @@ CycleStatus Controller::step(const RobotState& state, const ControllerTargets& t
   // or the breakaway feed-forward (vendor loops) turns its acceleration into torque at rest.
   // Not in dual compliance: the hand places the end effector anywhere, the posture target is then
   // off the new self-motion manifold and the term would only make the arm creep.
-  qp_.posture().enable_integral(low_level_.requested() != LowLevelMode::kPosition &&
-                                compliance_.mode() != ComplianceMode::kDual);
+  const bool stiction_terms =
+      low_level_.requested() != LowLevelMode::kPosition && compliance_.mode() != ComplianceMode::kDual;
+  qp_.posture().enable_integral(stiction_terms);
+  qp_.end_effector().enable_integral(stiction_terms);
   const WholeBodyQpStatus qp_status = qp_.update(model_, data_, q_, qd_, tau_ext_, settings_.period_s);
   check_qp(qp_status, state.time_s);
   if (supervisor_.safe_stop()) {

@@ -23,6 +23,7 @@
 #include <phri/control/controller_settings.hpp>
 #include <phri/control/controller_targets.hpp>
 #include <phri/control/compliance_controller.hpp>
+#include <phri/control/return_leash.hpp>
 #include <phri/control/momentum_observer.hpp>
 #include <phri/control/whole_body_qp.hpp>
 #include <phri/control/wrench_estimator.hpp>
@@ -131,6 +132,7 @@ private:
   std::optional<CollisionModel> collision_;
   WholeBodyQp qp_;
   ComplianceController compliance_;
+  ReturnLeash leash_;
   MomentumObserver observer_;
   WrenchEstimator wrench_;
   LowLevelController low_level_;

@@ -53,7 +53,13 @@ void EndEffectorTask::reset_gains(const Vector6d& stiffness, const Vector6d& dam
   gamma_.reset(gamma.cwiseMax(0.0).cwiseMin(1.0));
 }
 
+void EndEffectorTask::set_integral(const TaskIntegralSettings& settings) {
+  integral_ = settings;
+  integral_term_.setZero();
+}
+
 void EndEffectorTask::set_target(const Eigen::Isometry3d& pose, const Vector6d& velocity, const Vector6d& acceleration) {
+  if (pose.matrix() != commanded_pose_.matrix()) integral_term_.setZero();
   commanded_pose_ = pose;
   commanded_velocity_ = velocity;
   commanded_acceleration_ = acceleration;
@@ -61,6 +67,7 @@ void EndEffectorTask::set_target(const Eigen::Isometry3d& pose, const Vector6d& 
 
 void EndEffectorTask::hold_current_pose(const Data& data) {
   commanded_pose_ = data.frame_placements[static_cast<std::size_t>(frame_id_)];
+  integral_term_.setZero();
   commanded_velocity_.setZero();
   commanded_acceleration_.setZero();
   target_pose_ = commanded_pose_;
@@ -68,6 +75,27 @@ void EndEffectorTask::hold_current_pose(const Data& data) {
   target_acceleration_.setZero();
   tracking_position_ = tracking_rotation_ = true;
   governor_linear_speed_ = governor_angular_speed_ = 0.0;
+}
+
+void EndEffectorTask::set_target_offset(const Eigen::Isometry3d& offset) {
+  target_offset_ = offset;
+  offset_on_ = offset.matrix() != Eigen::Matrix4d::Identity();
+}
+
+// The tracked target: the governed one carried by the offset (its velocity and acceleration rotated).
+void EndEffectorTask::apply_target_offset() {
+  if (!offset_on_) {
+    tracked_pose_ = target_pose_;
+    tracked_velocity_ = target_velocity_;
+    tracked_acceleration_ = target_acceleration_;
+    return;
+  }
+  const Eigen::Matrix3d& r = target_offset_.linear();
+  tracked_pose_ = target_offset_ * target_pose_;
+  tracked_velocity_.head<3>() = r * target_velocity_.head<3>();
+  tracked_velocity_.tail<3>() = r * target_velocity_.tail<3>();
+  tracked_acceleration_.head<3>() = r * target_acceleration_.head<3>();
+  tracked_acceleration_.tail<3>() = r * target_acceleration_.tail<3>();
 }
 
 bool EndEffectorTask::target_reached() const {
@@ -144,21 +172,40 @@ void EndEffectorTask::govern_target(double dt) {
   set_governed_motion(angular, 3);
 }
 
+void EndEffectorTask::update_integral(double dt) {
+  if (integral_.gain <= 0.0) return;
+  const double bleed = std::exp(-dt / kIntegralBleed_s);
+  const bool creeping = integral_enabled_ && !offset_on_ && commanded_velocity_.isZero(0.0) && target_reached() &&
+                        velocity_.head<3>().norm() < kCreepLinear_m_s && velocity_.tail<3>().norm() < kCreepAngular_rad_s;
+  for (Eigen::Index i = 0; i < 6; ++i) {
+    const bool linear = i < 3;
+    double& term = integral_term_[i];
+    const double e = error_[i];
+    if (term * e < 0.0) term = 0.0;  // crossed the target: start again from the other side
+    const double zone = linear ? integral_.linear_zone : integral_.angular_zone;
+    const double limit = linear ? integral_.linear_limit : integral_.angular_limit;
+    const bool active = creeping && std::abs(e) < zone && stiffness_.value()[i] > 0.0;
+    term = active ? std::clamp(term + integral_.gain * e * dt, -limit, limit) : term * bleed;
+  }
+}
+
 void EndEffectorTask::update(const Model& model, const Data& data, const Eigen::VectorXd& qdd_external, double dt) {
   stiffness_.step(dt);
   damping_.step(dt);
   weight_.step(dt);
   gamma_.step(dt);
   govern_target(dt);
+  apply_target_offset();
   pose_ = data.frame_placements[static_cast<std::size_t>(frame_id_)];
   frame_jacobian(model, data, frame_id_, ReferenceFrame::kLocalWorldAligned, jacobian_);
   velocity_ = frame_velocity(model, data, frame_id_, ReferenceFrame::kLocalWorldAligned);
-  error_.head<3>() = target_pose_.translation() - pose_.translation();
-  error_.tail<3>() = rotation_log(target_pose_.linear() * pose_.linear().transpose());
+  error_.head<3>() = tracked_pose_.translation() - pose_.translation();
+  error_.tail<3>() = rotation_log(tracked_pose_.linear() * pose_.linear().transpose());
+  update_integral(dt);
   const Vector6d bias = frame_jdot_qdot(model, data, frame_id_, ReferenceFrame::kLocalWorldAligned);
   // ë* (paper's task reference) minus the drift J̇ qd, plus the compliant part gamma J M^-1 tau_ext.
-  reference_ = target_acceleration_ + stiffness_.value().cwiseProduct(error_) +
-               damping_.value().cwiseProduct(target_velocity_ - velocity_) - bias;
+  reference_ = tracked_acceleration_ + stiffness_.value().cwiseProduct(error_) +
+               damping_.value().cwiseProduct(tracked_velocity_ - velocity_) + integral_term_ - bias;
   external_task_acceleration_.noalias() = jacobian_ * qdd_external;
   reference_ += gamma_.value().cwiseProduct(external_task_acceleration_);
 }

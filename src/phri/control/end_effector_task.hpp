@@ -17,6 +17,15 @@
 
 namespace phri {
 
+/// Stiction term of the task (not in the paper; see EndEffectorTask::set_integral). Gain 0: off.
+struct TaskIntegralSettings {
+  double gain = 0.0;            ///< K_I [1/s^3]
+  double linear_limit = 0.0;    ///< clamp of the linear term [m/s^2]
+  double angular_limit = 0.0;   ///< clamp of the angular term [rad/s^2]
+  double linear_zone = 0.0;     ///< acts while |e_i| is below [m]
+  double angular_zone = 0.0;    ///< [rad]
+};
+
 /// Bounds of the reference governor that moves the task's target toward a target that jumped.
 struct TargetLimits {
   double linear_speed = 0.25;          ///< m/s
@@ -46,6 +55,18 @@ public:
   Vector6d gamma() const { return gamma_.value(); }
   Vector6d stiffness_target() const { return stiffness_.target(); }
 
+  /// Stiction term, the end effector's counterpart of PostureTask's: with a soft spring (full-body
+  /// compliance, K 30) the pose error left when the joints stick (a few centimetres) is a few
+  /// tenths of a m/s^2 of demand, below what the drives' static friction lets through. While the
+  /// target is held (no commanded velocity, the governor arrived), the end effector creeps (below
+  /// 0.02 m/s and 0.1 rad/s) and an axis's error is within its zone, K_I times the integrated error
+  /// is added to ë*, clamped; otherwise it bleeds off (0.1 s). It restarts from zero when an axis
+  /// crosses its target and when a new target is set. Resets the term.
+  void set_integral(const TaskIntegralSettings& settings);
+  /// Off: the term bleeds off (the controller turns it on in the torque loops, off in dual compliance).
+  void enable_integral(bool on) { integral_enabled_ = on; }
+  const Vector6d& integral_term() const { return integral_term_; }
+
   // ---- targets
   /// A trajectory point: pose, twist (linear; angular, world axes) and acceleration feed-forward.
   void set_target(const Eigen::Isometry3d& pose, const Vector6d& velocity = Vector6d::Zero(),
@@ -60,6 +81,11 @@ public:
   const Vector6d& target_velocity() const { return target_velocity_; }
   /// True when the tracked target is the one last set (the governor has arrived).
   bool target_reached() const;
+  /// An offset applied on the left of the governed target, T_offset T* (ReturnLeash's way back;
+  /// its velocity is not fed forward). Identity: none. The stiction term waits while it is on.
+  void set_target_offset(const Eigen::Isometry3d& offset);
+  /// What the task tracks: T_offset T* (T* itself without an offset).
+  const Eigen::Isometry3d& tracked_pose() const { return tracked_pose_; }
 
   // ---- per cycle
   /// data after compute_all_terms; qdd_external = M^-1 tau_ext; advances the gain filters by dt.
@@ -79,6 +105,11 @@ private:
                                      bool& tracking, double& speed_state);
   void govern_target(double dt);
   void set_governed_motion(const GovernorMove& move, Eigen::Index offset);
+  void update_integral(double dt);
+  void apply_target_offset();
+  static constexpr double kCreepLinear_m_s = 0.02;
+  static constexpr double kCreepAngular_rad_s = 0.1;
+  static constexpr double kIntegralBleed_s = 0.1;
 
   int frame_id_;
   TargetLimits limits_;
@@ -98,6 +129,14 @@ private:
   Vector6d target_acceleration_ = Vector6d::Zero();
   Eigen::MatrixXd jacobian_;
   Vector6d reference_ = Vector6d::Zero();
+  Eigen::Isometry3d target_offset_ = Eigen::Isometry3d::Identity();
+  bool offset_on_ = false;
+  Eigen::Isometry3d tracked_pose_ = Eigen::Isometry3d::Identity();
+  Vector6d tracked_velocity_ = Vector6d::Zero();
+  Vector6d tracked_acceleration_ = Vector6d::Zero();
+  TaskIntegralSettings integral_;
+  bool integral_enabled_ = true;
+  Vector6d integral_term_ = Vector6d::Zero();
   Vector6d external_task_acceleration_ = Vector6d::Zero();  // J M^-1 tau_ext
   Vector6d error_ = Vector6d::Zero();
   Vector6d velocity_ = Vector6d::Zero();

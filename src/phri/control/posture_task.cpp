@@ -15,6 +15,7 @@ PostureTask::PostureTask(const Model& model, double smoothing_time_constant)
       target_q_(Eigen::VectorXd::Zero(model.nv())),
       target_qd_(Eigen::VectorXd::Zero(model.nv())),
       target_qdd_(Eigen::VectorXd::Zero(model.nv())),
+      offset_q_(Eigen::VectorXd::Zero(model.nv())),
       error_(Eigen::VectorXd::Zero(model.nv())),
       reference_(Eigen::VectorXd::Zero(model.nv())),
       integral_term_(Eigen::VectorXd::Zero(model.nv())) {
@@ -51,6 +52,11 @@ void PostureTask::set_target(const Eigen::VectorXd& q) {
   target_qdd_.setZero();
 }
 
+void PostureTask::set_target_offset(const Eigen::VectorXd& offset) {
+  offset_q_ = offset;
+  offset_on_ = !offset.isZero(0.0);
+}
+
 void PostureTask::update_integral(const Eigen::VectorXd& qd, double dt) {
   if (integral_gain_ <= 0.0) return;
   const double bleed = std::exp(-dt / kIntegralBleed_s);
@@ -58,7 +64,7 @@ void PostureTask::update_integral(const Eigen::VectorXd& qd, double dt) {
     double& term = integral_term_[i];
     const double e = error_[i];
     if (term * e < 0.0) term = 0.0;  // crossed the target: start again from the other side
-    const bool creeping = integral_enabled_ && std::abs(qd[i]) < kCreepSpeed_rad_s && std::abs(e) < integral_zone_ && stiffness_.value()[i] > 0.0;
+    const bool creeping = integral_enabled_ && !offset_on_ && std::abs(qd[i]) < kCreepSpeed_rad_s && std::abs(e) < integral_zone_ && stiffness_.value()[i] > 0.0;
     term = creeping ? std::clamp(term + integral_gain_ * e * dt, -integral_limit_, integral_limit_) : term * bleed;
   }
 }
@@ -70,7 +76,7 @@ void PostureTask::update(const Eigen::VectorXd& q, const Eigen::VectorXd& qd, co
   weight_.step(dt);
   gamma_.step(dt);
   for (int i = 0; i < nv_; ++i) {
-    double e = target_q_[i] - q[i];
+    double e = target_q_[i] + offset_q_[i] - q[i];
     if (continuous_[static_cast<std::size_t>(i)]) e = std::remainder(e, 2.0 * std::numbers::pi);
     error_[i] = e;
   }

@@ -13,7 +13,7 @@
 // integral_limit; when the joint moves faster or leaves the zone the term bleeds off (time
 // constant 0.1 s), and it restarts from zero when the joint crosses its target, so it neither
 // winds up during a push or a motion nor drives an overshoot. The controller enables it in the
-// custom loop only (see enable_integral).
+// torque loops, not in dual compliance (see enable_integral); EndEffectorTask has the same term.
 #include <phri/core/smoothed_vector.hpp>
 #include <phri/model/model.hpp>
 
@@ -44,6 +44,10 @@ public:
   void set_target(const Eigen::VectorXd& q, const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd);
   void set_target(const Eigen::VectorXd& q);
   const Eigen::VectorXd& target() const { return target_q_; }
+  const Eigen::VectorXd& target_velocity() const { return target_qd_; }
+  /// Added to the target (ReturnLeash's way back; its velocity is not fed forward); zero: none.
+  /// The stiction term waits while an offset is on.
+  void set_target_offset(const Eigen::VectorXd& offset);
 
   void update(const Eigen::VectorXd& q, const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd_external, double dt);
   /// What qdd should equal: qdd* + gamma_0 M^-1 tau_ext.
@@ -63,6 +67,8 @@ private:
   SmoothedVector weight_;
   SmoothedVector gamma_;
   Eigen::VectorXd target_q_, target_qd_, target_qdd_;
+  Eigen::VectorXd offset_q_;
+  bool offset_on_ = false;
   Eigen::VectorXd error_;
   Eigen::VectorXd reference_;
   double integral_gain_ = 0.0, integral_limit_ = 0.0, integral_zone_ = 0.0;

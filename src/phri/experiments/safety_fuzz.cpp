@@ -9,6 +9,7 @@
 #include <phri/sim/sim_robot.hpp>
 
 #include <algorithm>
+#include <numbers>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -182,6 +183,7 @@ public:
                              "qdd_desired", "tau_desired"}) {
       for (int i = 0; i < n; ++i) trace_ << ',' << name << i + 1;
     }
+    for (int i = 0; i < 6; ++i) trace_ << ",ee_error" << i + 1;
     trace_ << '\n';
   }
 
@@ -215,6 +217,8 @@ private:
                                      &cycle_.qp().desired_acceleration(), &cycle_.qp().desired_torque()}) {
       for (Eigen::Index i = 0; i < v->size(); ++i) trace_ << ',' << (*v)[i];
     }
+    const Vector6d& ee_error = cycle_.qp().end_effector().error();
+    for (Eigen::Index i = 0; i < 6; ++i) trace_ << ',' << ee_error[i];
     trace_ << '\n';
   }
 
@@ -274,7 +278,10 @@ bool run_push(Rig& rig, const Shared& s, const PushSpec& p, const Eigen::VectorX
   if (plant_body < 0) throw ConfigError(s.o.plant_config_path, "bodies", "the plant has no body '" + p.link + "' to push");
   rig.robot().set_live_disturbance(plant_body, force);
   RecoveryTracker tracker(th, start + p.duration_s, s.o.min_pause_s);
-  const long max_cycles = std::lround((p.duration_s + th.recovery_time_s + th.safe_stop_rest_time_s + 0.5) / s.dt);
+  // Room for the longest walk back (half a turn beyond any joint's range is not possible: 2 pi).
+  const double walk_back_s = 2.0 * std::numbers::pi / th.return_speed_rad_s;
+  const long max_cycles =
+      std::lround((p.duration_s + th.recovery_time_s + walk_back_s + th.safe_stop_rest_time_s + 0.5) / s.dt);
   for (long k = 0; k < max_cycles && !tracker.done() && !m.crashed; ++k) {
     rig.step(m);
     const double t = rig.time();

@@ -128,8 +128,9 @@ void RecoveryTracker::sample(double t, double deviation, double speed, double sa
   } else {
     recovered_at_ = -1.0;  // left the tolerance again: not back yet
   }
+  if (std::isfinite(deviation)) allowed_s_ = std::max(allowed_s_, t_.recovery_time_s + deviation / t_.return_speed_rad_s);
   const bool settled = speed < t_.settle_speed_rad_s;
-  done_ = (recovered_at_ >= 0.0 && settled && since >= min_observation_) || since >= t_.recovery_time_s;
+  done_ = (recovered_at_ >= 0.0 && settled && since >= min_observation_) || since >= std::max(allowed_s_, t_.recovery_time_s);
 }
 
 void RecoveryTracker::finish(WindowMetrics& m) const {

@@ -16,6 +16,7 @@
 // * classify(): the violation categories of a window, and whether they are operator-possible (the
 //   push asked more than the actuators can resist: required torque ratio > 1 on some joint) or a
 //   controller failure (anything else; every violation under an injected sensor fault).
+#include <phri/control/return_leash.hpp>
 #include <phri/model/collision_model.hpp>
 #include <phri/model/data.hpp>
 #include <phri/model/model.hpp>
@@ -48,7 +49,10 @@ struct SafetyFuzzThresholds {
   double speed_factor = 1.05;            ///< |q̇| / velocity limit above this: overspeed
   double collision_distance_m = 0.0;     ///< capsule distance below this: collision
   double recovery_tolerance_rad = 0.05;  ///< max_i |q_i - reference_i| to count as back
-  double recovery_time_s = 3.0;          ///< after the end of the push or fault
+  double recovery_time_s = 3.0;          ///< after the end of the push or fault, plus the walk back:
+  /// a carried arm walks back at the controller's ReturnLeash speed, so a window that ended d rad
+  /// away (the largest deviation seen after the end) gets d / return_speed_rad_s more.
+  double return_speed_rad_s = ReturnLeashSettings{}.return_speed_rad_s;
   double rest_speed_rad_s = 0.01;        ///< max |q̇| at rest (safe stop)
   double safe_stop_rest_time_s = 1.0;    ///< from the safe stop's transition
   double settle_speed_rad_s = 0.05;      ///< max |q̇| for the next push to start
@@ -144,6 +148,7 @@ private:
   SafetyFuzzThresholds t_;
   double end_, min_observation_;
   double recovered_at_ = -1.0;  // since the end
+  double allowed_s_ = 0.0;      // recovery_time_s plus the walk back
   double safe_stop_time_ = -1.0, rest_after_ = -1.0;
   bool done_ = false;
 };
