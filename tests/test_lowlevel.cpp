@@ -192,12 +192,43 @@ TEST(VendorLoops, BreakawayFeedForwardOnlyForAStuckJointAskedToMove) {
   qdd[2] = 5.0;   // moving: nothing
   qdd[3] = 0.5;   // below the 1 rad/s^2 threshold: nothing
   phri::RobotCommand command(7);
+  low.enable_breakaway_ramp(false);  // the base share (the ramp has its own test)
   for (int k = 0; k < 400; ++k) low.update(state, tau_d, qdd, command);  // the entry offset fades (50 ms)
   const double half = phri::LowLevelController::kVendorBreakawayShare;
   EXPECT_NEAR(command.tau_Nm[0], half * table[0].friction.static_Nm, 1e-6);
   EXPECT_NEAR(command.tau_Nm[1], -half * table[1].friction.static_Nm, 1e-6);
   EXPECT_NEAR(command.tau_Nm[2], 0.0, 1e-6);
   EXPECT_NEAR(command.tau_Nm[3], 0.0, 1e-6);
+}
+
+TEST(VendorLoops, BreakawayShareGrowsWhileAJointStaysStuckAndStartsAgainWhenItMoves) {
+  const phri::ActuatorTable table = phri::ActuatorTable::from_yaml_file(kActuators);
+  phri::LowLevelController low(table, phri::CustomTorqueSettings{}, phri::LowLevelMode::kKinovaTorque);
+  phri::RobotState state(7);
+  state.q_rad.setZero();
+  state.qd_rad_s.setZero();
+  state.tau_sensor_Nm.setZero();
+  state.current.valid = false;
+  Eigen::VectorXd tau_d = Eigen::VectorXd::Zero(7), qdd = Eigen::VectorXd::Zero(7);
+  qdd[4] = 5.0;  // joint 5 stuck, asked to move
+  phri::RobotCommand command(7);
+  const double base = phri::LowLevelController::kVendorBreakawayShare;
+  const double rate = phri::LowLevelController::kBreakawayShareRate_per_s;
+  const double fs = table[4].friction.static_Nm;
+  for (int k = 0; k < 300; ++k) low.update(state, tau_d, qdd, command);
+  // First cycle at the base share, then + rate * dt per cycle: 299 cycles of growth.
+  EXPECT_NEAR(low.breakaway()[4], std::min(base + rate * 0.299, 1.0) * fs, 1e-9);
+  for (int k = 0; k < 2000; ++k) low.update(state, tau_d, qdd, command);
+  EXPECT_NEAR(low.breakaway()[4], fs, 1e-12);  // never beyond the whole static friction
+  state.qd_rad_s[4] = 0.5;  // it breaks free: nothing while it slides
+  low.update(state, tau_d, qdd, command);
+  EXPECT_EQ(low.breakaway()[4], 0.0);
+  state.qd_rad_s[4] = 0.0;  // stuck again: from the base share
+  low.update(state, tau_d, qdd, command);
+  EXPECT_NEAR(low.breakaway()[4], base * fs, 1e-12);
+  qdd[4] = -5.0;  // asked the other way: from the base share, the other sign
+  low.update(state, tau_d, qdd, command);
+  EXPECT_NEAR(low.breakaway()[4], -base * fs, 1e-12);
 }
 
 }  // namespace

@@ -400,6 +400,7 @@ CycleStatus Controller::step(const RobotState& state, const ControllerTargets& t
       low_level_.requested() != LowLevelMode::kPosition && compliance_.mode() != ComplianceMode::kDual;
   qp_.posture().enable_integral(stiction_terms);
   qp_.end_effector().enable_integral(stiction_terms);
+  low_level_.enable_breakaway_ramp(stiction_terms);
   const WholeBodyQpStatus qp_status = qp_.update(model_, data_, q_, qd_, tau_ext_, settings_.period_s);
   check_qp(qp_status, state.time_s);
   if (supervisor_.safe_stop()) {

@@ -23,6 +23,7 @@ LowLevelController::LowLevelController(const ActuatorTable& actuators, const Cus
       current_limit_(Eigen::VectorXd::Zero(actuators.size())),
       entry_current_(Eigen::VectorXd::Zero(actuators.size())),
       breakaway_(Eigen::VectorXd::Zero(actuators.size())),
+      breakaway_share_(Eigen::VectorXd::Constant(actuators.size(), kVendorBreakawayShare)),
       offset_decay_(std::exp(-custom.period_s / kTorqueBlendTime)) {
   for (int i = 0; i < actuators.size(); ++i) {
     torque_per_amp_[i] = actuators[i].torque_per_amp();
@@ -106,7 +107,12 @@ void LowLevelController::update(const RobotState& state, const Eigen::VectorXd& 
         // The paper's friction model's breakaway case (stuck, asked to move), a share of it.
         FrictionCase which = FrictionCase::kNone;
         const double tau_f = friction_compensation(friction_[static_cast<std::size_t>(i)], state.qd_rad_s[i], qdd_desired[i], &which);
-        breakaway_[i] = which == FrictionCase::kStatic ? kVendorBreakawayShare * tau_f : 0.0;
+        // A joint that stays stuck while asked the same way gets a growing share (a hand pushing
+        // harder), up to the whole static friction; it starts again at the base share otherwise.
+        const bool same_push = breakaway_ramp_ && which == FrictionCase::kStatic && tau_f * breakaway_[i] > 0.0;
+        breakaway_share_[i] = same_push ? std::min(breakaway_share_[i] + kBreakawayShareRate_per_s * period_s_, 1.0)
+                                        : kVendorBreakawayShare;
+        breakaway_[i] = which == FrictionCase::kStatic ? breakaway_share_[i] * tau_f : 0.0;
       }
       command.tau_Nm = tau_desired + torque_offset_ + breakaway_;
       torque_offset_ *= offset_decay_;

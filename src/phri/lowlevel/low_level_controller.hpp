@@ -57,6 +57,12 @@ public:
   /// part of the gear friction through its torque-sensor feedback; without this a soft spring
   /// (posture, full-body end effector) stops short. 0: off (the paper's Kinova modes).
   static constexpr double kVendorBreakawayShare = 0.5;
+  /// While the same joint stays stuck and asked the same way, its share grows by this per second,
+  /// up to 1 (the whole modelled static friction).
+  static constexpr double kBreakawayShareRate_per_s = 1.0;
+  /// Off: the share stays at kVendorBreakawayShare (the controller turns the ramp off in dual
+  /// compliance, where a joint held by friction off the posture target is meant to stay put).
+  void enable_breakaway_ramp(bool on) { breakaway_ramp_ = on; }
   const Eigen::VectorXd& breakaway() const { return breakaway_; }
   const CustomTorqueController& custom() const { return custom_; }
   const Eigen::VectorXd& position_reference() const { return q_ref_; }
@@ -77,6 +83,8 @@ private:
   std::vector<FrictionParameters> friction_;  // per joint, for the breakaway feed-forward
   Eigen::VectorXd entry_current_;  // the current the custom loop starts from
   Eigen::VectorXd breakaway_;      // the vendor loops' breakaway feed-forward of this cycle [N.m]
+  Eigen::VectorXd breakaway_share_;  // its share of the static friction, per joint
+  bool breakaway_ramp_ = true;
   double offset_decay_ = 0.0;
 };
 
