@@ -147,6 +147,43 @@ TEST(SimControl, FullBodyComplianceYieldsAndReturns) {
   EXPECT_LT(back, 0.05 * moved);
 }
 
+TEST(SimControl, FullBodyComplianceCarriedFarWalksBackInJointSpace) {
+  // A hand (40 N on the bracelet for 1 s) carries the arm about 2 rad away. With the return leash:
+  // back within 0.05 rad of the held posture within 3 s plus the walk back (the largest deviation
+  // / 0.5 rad/s), on the plant's true joints. (A harder carry that flips the elbow, 80 N for 1.5 s,
+  // still ends in the flipped branch: the leash walks back without the arm; see the README.)
+  Rig rig(phri::ComplianceMode::kFullBody,
+          {push("bracelet_link", Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(0, 40, 0), 1.0, 1.0)});
+  rig.run(0.9);
+  const Eigen::VectorXd held = rig.robot_.truth().q_rad;
+  auto deviation = [&]() {
+    Eigen::VectorXd d = rig.robot_.truth().q_rad - held;
+    for (int i : {0, 2, 4, 6}) d[i] = std::remainder(d[i], 2.0 * M_PI);  // continuous joints
+    return d.cwiseAbs().maxCoeff();
+  };
+  double largest = 0.0;
+  bool out = false;
+  rig.run(1.7, [&]() {
+    largest = std::max(largest, deviation());
+    out |= rig.cycle_.leash().out();
+  });
+  double back_at = -1.0, t = 0.0;
+  const double allowed = 3.0 + largest / 0.5;
+  rig.run(allowed, [&]() {
+    t += 1e-3;
+    largest = std::max(largest, back_at < 0.0 ? deviation() : largest);
+    if (back_at < 0.0 && deviation() < 0.05) back_at = t;
+  });
+  std::printf("full-body carry (plant): largest joint deviation %.2f rad, back within 0.05 rad after %.2f s (allowed %.2f s), "
+              "%.3f rad off at the end\n", largest, back_at, allowed, deviation());
+  EXPECT_GT(largest, 0.8);
+  EXPECT_TRUE(out);
+  EXPECT_GE(back_at, 0.0);
+  EXPECT_LT(deviation(), 0.05);
+  EXPECT_FALSE(rig.cycle_.leash().out());
+  EXPECT_TRUE(rig.torque_ok_);
+}
+
 TEST(SimControl, DualComplianceKeepsTheNewPoseAndIgnoresLightTouches) {
   Rig rig(phri::ComplianceMode::kDual, {push("tool", Eigen::Vector3d(0, 0, 0.05), Eigen::Vector3d(0, 3, 0), 1.0, 1.0),
                                          push("tool", Eigen::Vector3d(0, 0, 0.05), Eigen::Vector3d(0, 15, 0), 2.5, 1.0)});

@@ -381,17 +381,20 @@ CycleStatus Controller::step(const RobotState& state, const ControllerTargets& t
   // single-sample spikes of the F/T signal (tool inertia during stick-slip jolts, noise) must not
   // free the end effector for a few milliseconds.
   compliance_.update(trigger_filter_.update(wrench_.calibrated() ? wrench_.norm() : 0.0), qp_, data_);
-  // The way back after a hand carried the arm (return_leash.hpp): dragged in full-body compliance.
-  leash_.update(model_, q_, qd_, qp_.posture().target(), qp_.posture().target_velocity(),
-                compliance_.mode() == ComplianceMode::kFullBody, settings_.period_s);
-  qp_.posture().set_target_offset(leash_.offset());
-  qp_.end_effector().set_target_offset(leash_.pose_offset());
 
   // ---- QP and inverse dynamics. Under the robot's position loop the external torque is not fed
   // back: the stiff servo rejects it and the observer would only see servo effort.
   select_external_torque();
   bound_external_torque();
   if (low_level_.requested() == LowLevelMode::kPosition) tau_ext_.setZero();
+  // The way back after a hand carried the arm (return_leash.hpp): dragged in full-body compliance
+  // while a hand is on the arm (tau_ext beyond the compliance dead band on some joint), never by
+  // the arm's own motion, which would otherwise pull the leash along with it.
+  const bool carried = (tau_ext_.cwiseAbs().array() > qp_.compliance_deadband().array()).any();
+  leash_.update(model_, q_, qd_, qp_.posture().target(), qp_.posture().target_velocity(),
+                compliance_.mode() == ComplianceMode::kFullBody && carried, settings_.period_s);
+  qp_.posture().set_target_offset(leash_.offset());
+  qp_.end_effector().set_target_offset(leash_.pose_offset());
   // The posture's stiction term in the torque loops, where friction pre-compensation (custom loop)
   // or the breakaway feed-forward (vendor loops) turns its acceleration into torque at rest.
   // Not in dual compliance: the hand places the end effector anywhere, the posture target is then

@@ -86,6 +86,7 @@ public:
   const Data& data() const { return data_; }
   const WholeBodyQp& qp() const { return qp_; }
   const ComplianceController& compliance() const { return compliance_; }
+  const ReturnLeash& leash() const { return leash_; }
   const MomentumObserver& observer() const { return observer_; }
   /// The external joint torque the QP used in the last step (see ExternalTorqueSource).
   const Eigen::VectorXd& external_torque() const { return tau_ext_; }

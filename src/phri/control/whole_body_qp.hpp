@@ -96,6 +96,8 @@ public:
                           const Eigen::VectorXd& tau_ext, double dt);
 
   const Eigen::VectorXd& desired_acceleration() const { return qdd_desired_; }
+  /// The soft dead band of tau_ext in the compliant terms, per joint [N.m].
+  const Eigen::VectorXd& compliance_deadband() const { return deadband_; }
   const Eigen::VectorXd& desired_torque() const { return tau_desired_; }
   const Eigen::VectorXd& external_acceleration() const { return qdd_external_; }
   WholeBodyQpStatus status() const { return status_; }

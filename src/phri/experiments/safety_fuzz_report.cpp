@@ -165,7 +165,7 @@ void no_recovery_table(const SafetyFuzzResult& result, std::ostream& s) {
   }
   if (pairs.empty()) return;
   s << "## Not recovered: where the arm ended\n\nFinal deviation from the reference when the window closed (3 s after "
-       "the push or fault), the joints furthest off (count), and how many had come to rest (max abs(qd) < 0.01 rad/s).\n\n"
+       "the push or fault, plus the walk back), the joints furthest off (count), and how many had come to rest (max abs(qd) < 0.01 rad/s).\n\n"
        "| mode | loop | windows | final deviation median / p90 / max rad | joints furthest off | at rest |\n"
        "|---|---|---|---|---|---|\n";
   for (const auto& [key, list] : pairs) {
@@ -305,7 +305,8 @@ std::string safety_fuzz_report(const SafetyFuzzResult& result, const SafetyFuzzO
     << " mm; a non-finite command; a crash or a diverged plant; a refused write (unhandled: no safe stop the next cycle); "
        "not back within "
     << t.recovery_tolerance_rad << " rad of the reference (held pose; fault-free path; dual compliance: at rest) within "
-    << t.recovery_time_s << " s, and not in a safe stop; a safe stop still moving (max abs(qd) >= " << t.rest_speed_rad_s
+    << t.recovery_time_s << " s plus the walk back (the largest deviation after the end / " << t.return_speed_rad_s
+    << " rad/s, the controller's return leash), and not in a safe stop; a safe stop still moving (max abs(qd) >= " << t.rest_speed_rad_s
     << " rad/s) " << t.safe_stop_rest_time_s
     << " s after it began. Operator-possible: the push needed more than a joint's torque limit to hold the arm "
        "(|g(q) - J_p^T F|_i > tau_limit_i, controller model, true q).\n\n";
