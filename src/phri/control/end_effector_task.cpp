@@ -1,5 +1,6 @@
 #include <phri/control/end_effector_task.hpp>
 
+#include <phri/control/stiction_term.hpp>
 #include <phri/model/algorithms.hpp>
 
 #include <algorithm>
@@ -179,13 +180,11 @@ void EndEffectorTask::update_integral(double dt) {
                         velocity_.head<3>().norm() < kCreepLinear_m_s && velocity_.tail<3>().norm() < kCreepAngular_rad_s;
   for (Eigen::Index i = 0; i < 6; ++i) {
     const bool linear = i < 3;
-    double& term = integral_term_[i];
     const double e = error_[i];
-    if (term * e < 0.0) term = 0.0;  // crossed the target: start again from the other side
     const double zone = linear ? integral_.linear_zone : integral_.angular_zone;
     const double limit = linear ? integral_.linear_limit : integral_.angular_limit;
     const bool active = creeping && std::abs(e) < zone && stiffness_.value()[i] > 0.0;
-    term = active ? std::clamp(term + integral_.gain * e * dt, -limit, limit) : term * bleed;
+    integral_term_[i] = stiction_step(integral_term_[i], e, active, integral_.gain, limit, dt, bleed);
   }
 }
 

@@ -1,5 +1,7 @@
 #include <phri/control/posture_task.hpp>
 
+#include <phri/control/stiction_term.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <numbers>
@@ -61,11 +63,10 @@ void PostureTask::update_integral(const Eigen::VectorXd& qd, double dt) {
   if (integral_gain_ <= 0.0) return;
   const double bleed = std::exp(-dt / kIntegralBleed_s);
   for (int i = 0; i < nv_; ++i) {
-    double& term = integral_term_[i];
     const double e = error_[i];
-    if (term * e < 0.0) term = 0.0;  // crossed the target: start again from the other side
-    const bool creeping = integral_enabled_ && !offset_on_ && std::abs(qd[i]) < kCreepSpeed_rad_s && std::abs(e) < integral_zone_ && stiffness_.value()[i] > 0.0;
-    term = creeping ? std::clamp(term + integral_gain_ * e * dt, -integral_limit_, integral_limit_) : term * bleed;
+    const bool creeping = integral_enabled_ && !offset_on_ && std::abs(qd[i]) < kCreepSpeed_rad_s &&
+                          std::abs(e) < integral_zone_ && stiffness_.value()[i] > 0.0;
+    integral_term_[i] = stiction_step(integral_term_[i], e, creeping, integral_gain_, integral_limit_, dt, bleed);
   }
 }
 

@@ -368,6 +368,16 @@ std::uint64_t fault_seed(const Shared& s, ComplianceMode mode, LowLevelMode loop
   return mix_seed(mix_seed(s.o.seed, 0xFA17), static_cast<std::uint64_t>(static_cast<int>(mode) * 8 + static_cast<int>(loop))) >> 2;
 }
 
+// A run that threw (not a configuration error): a crash, with the exception's message.
+void record_crash(FuzzRecord& r, const std::exception& e) {
+  r.metrics.crashed = true;
+  r.error = e.what();
+}
+
+void finish_record(const Shared& s, FuzzRecord& r, TaskOutput& out) {
+  r.verdict = classify(r.metrics, s.o.thresholds);
+  out.records.push_back(r);
+}
 
 // The fault-free run of a (mode, loop) with the faulted runs' plant seed: its path, and its own
 // checks (a record of kind kReference).
@@ -398,11 +408,9 @@ void reference_run(const Shared& s, const std::string& id, ComplianceMode mode, 
   } catch (const ConfigError&) {
     throw;
   } catch (const std::exception& e) {
-    r.metrics.crashed = true;
-    r.error = e.what();
+    record_crash(r, e);
   }
-  r.verdict = classify(r.metrics, s.o.thresholds);
-  out.records.push_back(r);
+  finish_record(s, r, out);
 }
 
 // One fault case for `fault_cycles` cycles right after the warm-up, compared with the reference path.
@@ -445,11 +453,9 @@ void fault_run(const Shared& s, const std::string& id, ComplianceMode mode, LowL
   } catch (const ConfigError&) {
     throw;
   } catch (const std::exception& e) {
-    r.metrics.crashed = true;
-    r.error = e.what();
+    record_crash(r, e);
   }
-  r.verdict = classify(r.metrics, s.o.thresholds);
-  out.records.push_back(r);
+  finish_record(s, r, out);
 }
 
 // ---- the task list: one task per run, each a deterministic function of the options
