@@ -231,4 +231,44 @@ TEST(VendorLoops, BreakawayShareGrowsWhileAJointStaysStuckAndStartsAgainWhenItMo
   EXPECT_NEAR(low.breakaway()[4], -base * fs, 1e-12);
 }
 
+// A joint the vendor loop leaves crawling (its velocity feedback, friction it does not compensate)
+// keeps the assist while it slides slowly the way the task still accelerates it: a share of the
+// Coulomb friction along the motion, growing like the breakaway share; nothing when the task
+// brakes it, above kSlowSlideFactor times the velocity threshold, or with the ramp off.
+TEST(VendorLoops, FrictionAssistFollowsASlowSlideTheTaskStillAccelerates) {
+  const phri::ActuatorTable table = phri::ActuatorTable::from_yaml_file(kActuators);
+  phri::LowLevelController low(table, phri::CustomTorqueSettings{}, phri::LowLevelMode::kKinovaTorque);
+  phri::RobotState state(7);
+  state.q_rad.setZero();
+  state.qd_rad_s.setZero();
+  state.tau_sensor_Nm.setZero();
+  state.current.valid = false;
+  Eigen::VectorXd tau_d = Eigen::VectorXd::Zero(7), qdd = Eigen::VectorXd::Zero(7);
+  phri::RobotCommand command(7);
+  const phri::FrictionParameters& f = table[5].friction;
+  const double base = phri::LowLevelController::kVendorBreakawayShare;
+  const double rate = phri::LowLevelController::kBreakawayShareRate_per_s;
+  const double slow = 0.5 * (1.0 + phri::LowLevelController::kSlowSlideFactor) * f.velocity_threshold_rad_s;
+  qdd[5] = -5.0;
+  low.update(state, tau_d, qdd, command);  // stuck, asked negative: breakaway at the base share
+  EXPECT_NEAR(low.breakaway()[5], -base * f.static_Nm, 1e-12);
+  state.qd_rad_s[5] = -slow;  // sliding slowly the same way: the share goes on growing, on Coulomb
+  low.update(state, tau_d, qdd, command);
+  EXPECT_NEAR(low.breakaway()[5], -(base + rate * 1e-3) * f.coulomb_Nm, 1e-12);
+  EXPECT_NEAR(command.tau_Nm[5], low.breakaway()[5], 1e-12);  // tau_d = 0, entry offset tau_s - tau_d = 0
+  qdd[5] = 5.0;  // the task brakes the slide: nothing
+  low.update(state, tau_d, qdd, command);
+  EXPECT_EQ(low.breakaway()[5], 0.0);
+  qdd[5] = -5.0;
+  state.qd_rad_s[5] = -1.01 * phri::LowLevelController::kSlowSlideFactor * f.velocity_threshold_rad_s;  // fast
+  low.update(state, tau_d, qdd, command);
+  EXPECT_EQ(low.breakaway()[5], 0.0);
+  state.qd_rad_s[5] = -slow;  // slow again, from the base share
+  low.update(state, tau_d, qdd, command);
+  EXPECT_NEAR(low.breakaway()[5], -base * f.coulomb_Nm, 1e-12);
+  low.enable_breakaway_ramp(false);  // dual compliance, placed by hand: the breakaway case only
+  low.update(state, tau_d, qdd, command);
+  EXPECT_EQ(low.breakaway()[5], 0.0);
+}
+
 }  // namespace

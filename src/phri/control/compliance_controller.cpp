@@ -54,7 +54,7 @@ void ComplianceController::apply(WholeBodyQp& qp) {
 
 void ComplianceController::initialise(ComplianceMode mode, WholeBodyQp& qp, const Data& data) {
   mode_ = mode;
-  touched_ = false;
+  touched_ = released_ = false;
   apply(qp);
   // Start at the set values rather than filtering from zero.
   EndEffectorTask& ee = qp.end_effector();
@@ -92,6 +92,7 @@ void ComplianceController::update(double wrench_norm, WholeBodyQp& qp, const Dat
   } else if (touched_ && wrench_norm < settings_.release_threshold) {
     // The pose at release is the new target; the spring, faded by now, grows back from zero.
     touched_ = false;
+    released_ = true;
     qp.end_effector().hold_current_pose(data);
     apply(qp);
   }

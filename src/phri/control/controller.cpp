@@ -188,6 +188,7 @@ bool Controller::apply(const ControllerTargets& targets) {
     compliance_.set_stiffness_scale(*targets.stiffness_scale, qp_);
   }
   if (targets.has_posture && accept(usable(targets.posture, model_.nv()))) {
+    if (targets.posture.q != qp_.posture().target()) compliance_.posture_target_set();
     qp_.posture().set_target(targets.posture.q, targets.posture.qd, targets.posture.qdd);
   }
   if (targets.has_pose && accept(usable(targets.pose))) {
@@ -390,17 +391,20 @@ CycleStatus Controller::step(const RobotState& state, const ControllerTargets& t
   // The way back after a hand carried the arm (return_leash.hpp): dragged in full-body compliance
   // while a hand is on the arm (tau_ext beyond the compliance dead band on some joint), never by
   // the arm's own motion, which would otherwise pull the leash along with it.
-  const bool carried = (tau_ext_.cwiseAbs().array() > qp_.compliance_deadband().array()).any();
-  leash_.update(model_, q_, qd_, qp_.posture().target(), qp_.posture().target_velocity(),
-                compliance_.mode() == ComplianceMode::kFullBody && carried, settings_.period_s);
+  const bool carried = compliance_.mode() == ComplianceMode::kFullBody &&
+                       (tau_ext_.cwiseAbs().array() > qp_.compliance_deadband().array()).any();
+  leash_.update(model_, q_, qd_, qp_.posture().target(), qp_.posture().target_velocity(), carried, settings_.period_s);
   qp_.posture().set_target_offset(leash_.offset());
   qp_.end_effector().set_target_offset(leash_.pose_offset());
-  // The posture's stiction term in the torque loops, where friction pre-compensation (custom loop)
-  // or the breakaway feed-forward (vendor loops) turns its acceleration into torque at rest.
-  // Not in dual compliance: the hand places the end effector anywhere, the posture target is then
-  // off the new self-motion manifold and the term would only make the arm creep.
+  // The tasks' stiction terms and the vendor loops' friction assist in the torque loops, where
+  // friction pre-compensation (custom loop) or the assist (vendor loops) turns their acceleration
+  // into torque at rest. Off while a hand carries the arm in full-body compliance (they would wind
+  // up against it; the leash follows the hand instead), and in
+  // dual compliance once the hand has placed the end effector: the posture target is then off the
+  // new pose's self-motion manifold, and the terms would only make the arm creep toward it.
   const bool stiction_terms =
-      low_level_.requested() != LowLevelMode::kPosition && compliance_.mode() != ComplianceMode::kDual;
+      low_level_.requested() != LowLevelMode::kPosition && !carried &&
+      !(compliance_.mode() == ComplianceMode::kDual && (compliance_.touched() || compliance_.placed_by_hand()));
   qp_.posture().enable_integral(stiction_terms);
   qp_.end_effector().enable_integral(stiction_terms);
   low_level_.enable_breakaway_ramp(stiction_terms);

@@ -176,7 +176,7 @@ void EndEffectorTask::govern_target(double dt) {
 void EndEffectorTask::update_integral(double dt) {
   if (integral_.gain <= 0.0) return;
   const double bleed = std::exp(-dt / kIntegralBleed_s);
-  const bool creeping = integral_enabled_ && !offset_on_ && commanded_velocity_.isZero(0.0) && target_reached() &&
+  const bool creeping = integral_enabled_ && commanded_velocity_.isZero(0.0) && target_reached() &&
                         velocity_.head<3>().norm() < kCreepLinear_m_s && velocity_.tail<3>().norm() < kCreepAngular_rad_s;
   for (Eigen::Index i = 0; i < 6; ++i) {
     const bool linear = i < 3;

@@ -82,7 +82,7 @@ public:
   /// True when the tracked target is the one last set (the governor has arrived).
   bool target_reached() const;
   /// An offset applied on the left of the governed target, T_offset T* (ReturnLeash's way back;
-  /// its velocity is not fed forward). Identity: none. The stiction term waits while it is on.
+  /// its velocity is not fed forward). Identity: none. The stiction term acts on the error to T_offset T*.
   void set_target_offset(const Eigen::Isometry3d& offset);
   /// What the task tracks: T_offset T* (T* itself without an offset).
   const Eigen::Isometry3d& tracked_pose() const { return tracked_pose_; }

@@ -56,7 +56,6 @@ void PostureTask::set_target(const Eigen::VectorXd& q) {
 
 void PostureTask::set_target_offset(const Eigen::VectorXd& offset) {
   offset_q_ = offset;
-  offset_on_ = !offset.isZero(0.0);
 }
 
 void PostureTask::update_integral(const Eigen::VectorXd& qd, double dt) {
@@ -64,7 +63,7 @@ void PostureTask::update_integral(const Eigen::VectorXd& qd, double dt) {
   const double bleed = std::exp(-dt / kIntegralBleed_s);
   for (int i = 0; i < nv_; ++i) {
     const double e = error_[i];
-    const bool creeping = integral_enabled_ && !offset_on_ && std::abs(qd[i]) < kCreepSpeed_rad_s &&
+    const bool creeping = integral_enabled_ && std::abs(qd[i]) < kCreepSpeed_rad_s &&
                           std::abs(e) < integral_zone_ && stiffness_.value()[i] > 0.0;
     integral_term_[i] = stiction_step(integral_term_[i], e, creeping, integral_gain_, integral_limit_, dt, bleed);
   }

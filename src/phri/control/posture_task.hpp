@@ -46,7 +46,8 @@ public:
   const Eigen::VectorXd& target() const { return target_q_; }
   const Eigen::VectorXd& target_velocity() const { return target_qd_; }
   /// Added to the target (ReturnLeash's way back; its velocity is not fed forward); zero: none.
-  /// The stiction term waits while an offset is on.
+  /// The stiction term acts on the error to the offset target (it helps the arm follow the walk
+  /// back; the controller turns it off while a hand carries the arm).
   void set_target_offset(const Eigen::VectorXd& offset);
 
   void update(const Eigen::VectorXd& q, const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd_external, double dt);
@@ -68,7 +69,6 @@ private:
   SmoothedVector gamma_;
   Eigen::VectorXd target_q_, target_qd_, target_qdd_;
   Eigen::VectorXd offset_q_;
-  bool offset_on_ = false;
   Eigen::VectorXd error_;
   Eigen::VectorXd reference_;
   double integral_gain_ = 0.0, integral_limit_ = 0.0, integral_zone_ = 0.0;

@@ -25,7 +25,9 @@ namespace phri {
 
 struct ReturnLeashSettings {
   double length_rad = 0.2;          ///< how far q_l may trail the arm (per joint)
-  double return_speed_rad_s = 0.5;  ///< walking speed of q_l back to q* (largest joint)
+  /// Walking speed of q_l back to q* (largest joint). Slow enough for Kinova's damped torque loops
+  /// to follow with the wrist against friction: at 0.5 rad/s the arm fell behind the walk.
+  double return_speed_rad_s = 0.15;
 };
 
 class ReturnLeash {

@@ -183,7 +183,10 @@ public:
                              "qdd_desired", "tau_desired"}) {
       for (int i = 0; i < n; ++i) trace_ << ',' << name << i + 1;
     }
-    for (int i = 0; i < 6; ++i) trace_ << ",ee_error" << i + 1;
+    for (int i = 0; i < n; ++i) trace_ << ",leash_offset" << i + 1;
+    for (const char* name : {"ee_error", "ee_integral"}) {
+      for (int i = 0; i < 6; ++i) trace_ << ',' << name << i + 1;
+    }
     trace_ << '\n';
   }
 
@@ -214,11 +217,13 @@ private:
     for (const Eigen::VectorXd* v : {&truth.q_rad, &truth.qd_rad_s, &cmd, &cycle_.external_torque(),
                                      &truth.tau_transmitted_Nm, &truth.tau_friction_Nm,
                                      &cycle_.qp().posture().integral_term(),
-                                     &cycle_.qp().desired_acceleration(), &cycle_.qp().desired_torque()}) {
+                                     &cycle_.qp().desired_acceleration(), &cycle_.qp().desired_torque(),
+                                     &cycle_.leash().offset()}) {
       for (Eigen::Index i = 0; i < v->size(); ++i) trace_ << ',' << (*v)[i];
     }
-    const Vector6d& ee_error = cycle_.qp().end_effector().error();
-    for (Eigen::Index i = 0; i < 6; ++i) trace_ << ',' << ee_error[i];
+    for (const Vector6d* v : {&cycle_.qp().end_effector().error(), &cycle_.qp().end_effector().integral_term()}) {
+      for (Eigen::Index i = 0; i < 6; ++i) trace_ << ',' << (*v)[i];
+    }
     trace_ << '\n';
   }
 

@@ -21,7 +21,7 @@
 //    non-finite commands, refused writes (the harness reports each to the controller; one not
 //    followed by a safe stop is "unhandled"), exceptions and a diverged plant. After each push or
 //    fault: back within 0.05 rad of the reference (the held pose; for dual compliance, which keeps
-//    the pose it is pushed to: at rest) within 3 s plus the walk back (d / 0.5 rad/s after a window
+//    the pose it is pushed to: at rest) within 3 s plus the walk back (d / 0.15 rad/s after a window
 //    that took the arm d rad away: ReturnLeash's speed), or in a logged safe stop at rest within 1 s.
 //    A window with a violation is operator-possible when its push asked more than the actuators can
 //    resist (safety_fuzz_metrics.hpp), a controller failure otherwise. After a safe stop, a window

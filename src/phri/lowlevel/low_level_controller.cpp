@@ -103,17 +103,7 @@ void LowLevelController::update(const RobotState& state, const Eigen::VectorXd& 
           torque_offset_ = state.tau_sensor_Nm - tau_desired;
         }
       }
-      for (Eigen::Index i = 0; i < breakaway_.size(); ++i) {
-        // The paper's friction model's breakaway case (stuck, asked to move), a share of it.
-        FrictionCase which = FrictionCase::kNone;
-        const double tau_f = friction_compensation(friction_[static_cast<std::size_t>(i)], state.qd_rad_s[i], qdd_desired[i], &which);
-        // A joint that stays stuck while asked the same way gets a growing share (a hand pushing
-        // harder), up to the whole static friction; it starts again at the base share otherwise.
-        const bool same_push = breakaway_ramp_ && which == FrictionCase::kStatic && tau_f * breakaway_[i] > 0.0;
-        breakaway_share_[i] = same_push ? std::min(breakaway_share_[i] + kBreakawayShareRate_per_s * period_s_, 1.0)
-                                        : kVendorBreakawayShare;
-        breakaway_[i] = which == FrictionCase::kStatic ? breakaway_share_[i] * tau_f : 0.0;
-      }
+      update_friction_assist(state.qd_rad_s, qdd_desired);
       command.tau_Nm = tau_desired + torque_offset_ + breakaway_;
       torque_offset_ *= offset_decay_;
       break;
@@ -133,6 +123,37 @@ void LowLevelController::update(const RobotState& state, const Eigen::VectorXd& 
       command.mode = LowLevelMode::kCurrent;
       command.current_A = custom_.current();
       break;
+  }
+}
+
+// The vendor loops' friction assist (not in the paper, whose custom loop pre-compensates all of
+// friction): a share of the paper's friction model where the vendor loop, with its velocity
+// feedback and no friction compensation, leaves a joint stuck or crawling although the task asks
+// it to move. Stuck (the model's breakaway case): share * static friction in the direction asked.
+// Sliding slowly (below 3 x the model's velocity threshold) in the direction the task still
+// accelerates: share * Coulomb friction along the motion; without it the joint crawls at the
+// threshold, the assist switching on and off as it crosses. The share grows (a hand pushing
+// harder) while the joint stays slow and asked the same way, up to the whole friction; it starts
+// again at the base share otherwise. Off (the ramp disabled: dual compliance, where the hand
+// leaves the arm anywhere): the breakaway case alone at the base share.
+void LowLevelController::update_friction_assist(const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd_desired) {
+  for (Eigen::Index i = 0; i < breakaway_.size(); ++i) {
+    const FrictionParameters& friction = friction_[static_cast<std::size_t>(i)];
+    FrictionCase which = FrictionCase::kNone;
+    const double tau_f = friction_compensation(friction, qd[i], qdd_desired[i], &which);
+    double direction = 0.0, full = 0.0;
+    if (which == FrictionCase::kStatic) {
+      direction = tau_f;
+      full = friction.static_Nm;
+    } else if (breakaway_ramp_ && which == FrictionCase::kSliding &&
+               std::abs(qd[i]) < kSlowSlideFactor * friction.velocity_threshold_rad_s && qd[i] * qdd_desired[i] > 0.0) {
+      direction = qd[i];
+      full = friction.coulomb_Nm;
+    }
+    const bool same_push = breakaway_ramp_ && direction * breakaway_[i] > 0.0;
+    breakaway_share_[i] = same_push ? std::min(breakaway_share_[i] + kBreakawayShareRate_per_s * period_s_, 1.0)
+                                    : kVendorBreakawayShare;
+    breakaway_[i] = direction == 0.0 ? 0.0 : std::copysign(breakaway_share_[i] * full, direction);
   }
 }
 

@@ -60,6 +60,9 @@ public:
   /// While the same joint stays stuck and asked the same way, its share grows by this per second,
   /// up to 1 (the whole modelled static friction).
   static constexpr double kBreakawayShareRate_per_s = 1.0;
+  /// The assist goes on while a joint slides slower than this many times the friction model's
+  /// velocity threshold (see update_friction_assist).
+  static constexpr double kSlowSlideFactor = 3.0;
   /// Off: the share stays at kVendorBreakawayShare (the controller turns the ramp off in dual
   /// compliance, where a joint held by friction off the posture target is meant to stay put).
   void enable_breakaway_ramp(bool on) { breakaway_ramp_ = on; }
@@ -68,6 +71,7 @@ public:
   const Eigen::VectorXd& position_reference() const { return q_ref_; }
 
 private:
+  void update_friction_assist(const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd_desired);
   CustomTorqueController custom_;
   double period_s_;
   LowLevelMode loop_;
