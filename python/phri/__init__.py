@@ -78,3 +78,7 @@ def run(config: Union[str, _os.PathLike], duration_s: Optional[float] = None, ou
     if logger is not None:
         logger.close()
     return RunResult(summary, config.logging.path if logger is not None else "")
+
+
+# Only phri's names: the helpers of the annotations above are not part of the API.
+del annotations, Optional, Union

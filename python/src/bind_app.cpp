@@ -68,8 +68,8 @@ void bind_logger(py::module_& m) {
   py::class_<Logger>(m, "Logger", "One CSV row per cycle, written off the control thread (load it with phri.load_log).")
       .def(py::init<const LoggerSettings&>(), py::arg("settings"), "Opens the file; ConfigError when it cannot be created.")
       .def("close", &Logger::close, py::call_guard<py::gil_scoped_release>(), "Drains the ring, closes the file.")
-      .def("stats", &Logger::stats)
-      .def("summary", &Logger::summary)
+      .def("stats", &Logger::stats, "Counters so far.")
+      .def("summary", &Logger::summary, "One line: rows written, dropped, queue depth, throughput.")
       .def_property_readonly("path", &Logger::path)
       .def_property_readonly("legend_path", &Logger::legend_path)
       .def_static("header", &Logger::header, py::arg("dof"), "The CSV header line for `dof` joints.")
@@ -80,7 +80,7 @@ void bind_config(py::module_& m) {
   py::enum_<LoopClock::Pacing>(m, "Pacing", "lockstep: as fast as possible; real_time: one period per cycle.")
       .value("lockstep", LoopClock::Pacing::kLockstep)
       .value("real_time", LoopClock::Pacing::kRealTime);
-  py::class_<RunSettings>(m, "RunSettings")
+  py::class_<RunSettings>(m, "RunSettings", "The `run:` section: duration and pacing.")
       .def(py::init<>())
       .def_readwrite("duration_s", &RunSettings::duration_s)
       .def_readwrite("pacing", &RunSettings::pacing);
@@ -102,13 +102,13 @@ void bind_run_session(py::module_& m) {
            py::arg("name"))
       .def_readwrite("start_s", &PhaseMark::start_s)
       .def_readwrite("name", &PhaseMark::name);
-  py::class_<RunOptions>(m, "RunOptions")
+  py::class_<RunOptions>(m, "RunOptions", "What run_session runs: duration, pacing, status line, named phases.")
       .def(py::init<>())
       .def_readwrite("duration_s", &RunOptions::duration_s)
       .def_readwrite("real_time", &RunOptions::real_time)
       .def_readwrite("status_line", &RunOptions::status_line)
       .def_readwrite("phases", &RunOptions::phases);
-  py::class_<PhaseSummary>(m, "PhaseSummary")
+  py::class_<PhaseSummary>(m, "PhaseSummary", "One row of the end-of-run table.")
       .def_readonly("name", &PhaseSummary::name)
       .def_readonly("start_s", &PhaseSummary::start_s)
       .def_readonly("end_s", &PhaseSummary::end_s)

@@ -54,14 +54,15 @@ void bind_friction(py::module_& m) {
       .def_readonly("residual_rms_Nm", &JointFrictionEstimate::residual_rms_Nm)
       .def_readonly("levels_used", &JointFrictionEstimate::levels_used)
       .def("coulomb_error", &JointFrictionEstimate::coulomb_error, "Relative error of the identified Coulomb level.")
-      .def("viscous_error", &JointFrictionEstimate::viscous_error)
-      .def("static_error", &JointFrictionEstimate::static_error);
-  py::class_<FrictionIdentificationResult>(m, "FrictionIdentificationResult")
+      .def("viscous_error", &JointFrictionEstimate::viscous_error, "Relative error of the identified viscous coefficient.")
+      .def("static_error", &JointFrictionEstimate::static_error, "Relative error of the identified static level.");
+  py::class_<FrictionIdentificationResult>(m, "FrictionIdentificationResult", "Per-joint estimates and the files written.")
       .def_readonly("joints", &FrictionIdentificationResult::joints)
       .def_readonly("simulated_s", &FrictionIdentificationResult::simulated_s)
       .def_readonly("wall_s", &FrictionIdentificationResult::wall_s)
       .def_readonly("files", &FrictionIdentificationResult::files)
-      .def("worst_relative_error", &FrictionIdentificationResult::worst_relative_error);
+      .def("worst_relative_error", &FrictionIdentificationResult::worst_relative_error,
+           "Largest |relative error| over the identified Coulomb, viscous and static values.");
   m.def("identify_friction", [](const O& o, bool progress) {
         return run_released<FrictionIdentificationResult>(o, progress, [](const O& x, std::ostream* s) { return identify_friction(x, s); });
       }, py::arg("options"), py::arg("progress") = true, "Runs the friction identification (GIL released).");
@@ -91,7 +92,7 @@ void bind_tracking_types(py::module_& m) {
       .def_readonly("samples", &R::samples)
       .def_readonly("qp_fallbacks", &R::qp_fallbacks)
       .def_readonly("csv_path", &R::csv_path);
-  py::class_<TorqueTrackingResult>(m, "TorqueTrackingResult")
+  py::class_<TorqueTrackingResult>(m, "TorqueTrackingResult", "Every scenario x loop run and the files written.")
       .def_readonly("runs", &TorqueTrackingResult::runs)
       .def_readonly("simulated_s", &TorqueTrackingResult::simulated_s)
       .def_readonly("wall_s", &TorqueTrackingResult::wall_s)
@@ -173,15 +174,15 @@ void bind_safety_fuzz(py::module_& m) {
       .def_readwrite("loops", &O::loops)
       .def_readwrite("jobs", &O::jobs)
       .def_readwrite("replay", &O::replay);
-  py::class_<SafetyFuzzResult>(m, "SafetyFuzzResult")
+  py::class_<SafetyFuzzResult>(m, "SafetyFuzzResult", "Windows judged, runs, times and the files written.")
       .def_readonly("runs", &SafetyFuzzResult::runs)
       .def_readonly("simulated_s", &SafetyFuzzResult::simulated_s)
       .def_readonly("wall_s", &SafetyFuzzResult::wall_s)
       .def_readonly("files", &SafetyFuzzResult::files)
       .def_property_readonly("records", [](const SafetyFuzzResult& r) { return r.records.size(); }, "Number of windows judged.")
-      .def("controller_failures", &SafetyFuzzResult::controller_failures)
-      .def("pushes", &SafetyFuzzResult::pushes)
-      .def("faults", &SafetyFuzzResult::faults);
+      .def("controller_failures", &SafetyFuzzResult::controller_failures, "Windows failed by the controller (not the operator).")
+      .def("pushes", &SafetyFuzzResult::pushes, "Push windows (random and targeted).")
+      .def("faults", &SafetyFuzzResult::faults, "Sensor-fault windows.");
   m.def("run_safety_fuzz", [](const O& o, bool progress) {
         return run_released<SafetyFuzzResult>(o, progress, [](const O& x, std::ostream* s) { return run_safety_fuzz(x, s); });
       }, py::arg("options"), py::arg("progress") = true, "Runs the fuzz (GIL released; `jobs` threads).");

@@ -98,7 +98,7 @@ void bind_model_class(py::module_& m) {
       .def_property_readonly("joints", &Model::joints, "The joints (copies).")
       .def_property_readonly("frames", &Model::frames, "The frames (copies), indexed by frame id.")
       .def("frame_id", &Model::frame_id, py::arg("name"), "Frame index by name; ConfigError when unknown.")
-      .def("has_frame", &Model::has_frame, py::arg("name"))
+      .def("has_frame", &Model::has_frame, py::arg("name"), "Whether the model has a frame of that name.")
       .def("joint_id", &Model::joint_id, py::arg("name"), "Joint index by name; ConfigError when unknown.")
       .def("body_inertia", &Model::body_inertia, py::arg("body"), "Body i's inertia in its frame (a copy).")
       .def_property_readonly("base_link", &Model::base_link)
@@ -204,8 +204,10 @@ void bind_kinematics(py::module_& m) {
         },
         py::arg("model"), py::arg("data"), py::arg("body"), py::arg("point"),
         "3 x nv linear Jacobian of the point of `body` now at world position `point`.");
-  m.def("body_point_velocity", &body_point_velocity, py::arg("model"), py::arg("data"), py::arg("body"), py::arg("point"));
-  m.def("body_point_jdot_qdot", &body_point_jdot_qdot, py::arg("model"), py::arg("data"), py::arg("body"), py::arg("point"));
+  m.def("body_point_velocity", &body_point_velocity, py::arg("model"), py::arg("data"), py::arg("body"), py::arg("point"),
+        "World velocity of the point of `body` now at `point` (after forward_kinematics with qd).");
+  m.def("body_point_jdot_qdot", &body_point_jdot_qdot, py::arg("model"), py::arg("data"), py::arg("body"), py::arg("point"),
+        "That point's classical acceleration; with qdd = 0 (after compute_all_terms) its J̇ q̇.");
 }
 
 void bind_dynamics(py::module_& m) {
