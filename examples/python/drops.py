@@ -12,8 +12,10 @@ there itself); once installed (cmake --install), nothing to set.
 import argparse
 import pathlib
 import sys
+from typing import Dict
 
 import numpy as np
+import numpy.typing as npt
 
 try:
     import phri
@@ -31,7 +33,10 @@ DROPS = [
 ]
 
 
-def drop(mode, loop_mode, seconds, release_s):
+Series = Dict[str, npt.NDArray[np.float64]]
+
+
+def drop(mode: phri.ComplianceMode, loop_mode: phri.LowLevelMode, seconds: float, release_s: float) -> Series:
     """One drop; returns per-cycle arrays: time, tool height change, cable force, end-effector error."""
     config = phri.SimRobotConfig.from_yaml_file(phri.locate("configs/plant_gen3.yaml"))
     config.initial_q_rad = POSTURE
@@ -56,7 +61,7 @@ def drop(mode, loop_mode, seconds, release_s):
     return {"t": t, "dz_mm": dz, "cable_N": cable, "ee_error_mm": error}
 
 
-def plot(results, release_s, out, show):
+def plot(results: Dict[str, Series], release_s: float, out: str, show: bool) -> None:
     import matplotlib
     if not show:
         matplotlib.use("Agg")
@@ -80,7 +85,7 @@ def plot(results, release_s, out, show):
         plt.show()
 
 
-def main():
+def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--out", default="drops.png", help="figure file (default: drops.png)")
     parser.add_argument("--seconds", type=float, default=3.0, help="simulated time of each drop (default: 3)")

@@ -49,12 +49,13 @@ class RunResult:
     summary: RunSummary
     log_path: str
 
-    def log(self):
+    def log(self) -> numpy.typing.NDArray[Any]:
         """The run's log as a numpy structured array (phri.load_log)."""
         return load_log(self.log_path)
 
 
-def run(config: Union[str, _os.PathLike], duration_s: Optional[float] = None, out_dir: Union[str, _os.PathLike] = "out",
+def run(config: Union[str, _os.PathLike[str]], duration_s: Optional[float] = None,
+        out_dir: Union[str, _os.PathLike[str]] = "out",
         real_time: bool = False, status_line: bool = False) -> RunResult:
     """Runs a session as `phri run --config CONFIG` does (simulated arm, FSM and its timeline, log), without the
     figure: lockstep unless real_time, for duration_s (default: the configuration's), the log written into out_dir.

@@ -47,7 +47,7 @@ def test_stubs_describe_every_public_name_and_parse():
     undeclared = [n for n in public_names() if n not in declared and not inspect.ismodule(getattr(phri, n))]
     assert not undeclared, f"not in the stubs: {undeclared}"
     text = stub.read_text()
-    assert "def crba(model: Model, data: Data, q: numpy.typing.NDArray[numpy.float64]) -> numpy.ndarray" in text
+    assert "def crba(model: Model, data: Data, q: numpy.typing.NDArray[numpy.float64]) -> numpy.typing.NDArray[Any]" in text
     signatures = [line for line in text.splitlines() if line.lstrip().startswith("def ")]
     assert len(signatures) > 200 and not [line for line in signatures if "::" in line]  # no C++ type left
 
@@ -72,3 +72,41 @@ def test_cmake_install_puts_a_working_package_where_debian_python_finds_it(tmp_p
     default = pathlib.Path("/usr/local") / os.environ["PHRI_PYTHON_INSTALL_DIR"]
     assert str(default) in subprocess.run(["/usr/bin/python3", "-c", "import sys; print(sys.path)"],
                                           capture_output=True, text=True, check=True).stdout
+
+
+TYPED_USE = """
+import numpy as np
+import numpy.typing as npt
+import phri
+
+model = phri.Model.from_urdf_file(phri.locate("robots/kinova_gen3/gen3.urdf"))
+data = phri.Data(model)
+M: npt.NDArray[np.float64] = phri.crba(model, data, np.zeros(model.nq))
+config = phri.SimRobotConfig.from_yaml_file(phri.locate("configs/plant_gen3.yaml"))
+config.drop_test.enabled = True
+robot = phri.SimRobot(config)
+loop = phri.ClosedLoop(robot, phri.Controller(phri.ControllerSettings()))
+targets = phri.ControllerTargets(7)
+targets.compliance_mode = phri.ComplianceMode.dual
+targets.set_posture(np.zeros(7))
+status: phri.CycleStatus = loop.step(targets)
+ran: int = loop.run(5)
+rows = loop.record(10)
+result: phri.RunResult = phri.run("configs/demo.yaml", duration_s=1.0)
+try:
+    phri.Model.from_urdf_file("missing.urdf")
+except phri.ConfigError as error:
+    where: str = error.file
+"""
+
+
+def test_stubs_type_check_a_script_and_the_example_with_mypy(tmp_path):
+    pytest.importorskip("mypy", reason="python3-mypy is not installed (scripts/setup installs it)")
+    script = tmp_path / "typed_use.py"
+    script.write_text(TYPED_USE)
+    example = pathlib.Path(os.environ.get("PHRI_SOURCE_DIR", PACKAGE_DIR.parents[2])) / "examples/python/drops.py"
+    done = subprocess.run([sys.executable, "-m", "mypy", "--strict", "--no-incremental", "--ignore-missing-imports",
+                           "--cache-dir", str(tmp_path / "mypy_cache"), str(script), str(example)],
+                          env={**os.environ, "MYPYPATH": str(PACKAGE_DIR.parent)}, capture_output=True, text=True,
+                          cwd=tmp_path)
+    assert done.returncode == 0, done.stdout + done.stderr

@@ -52,7 +52,11 @@ def python_type(text):
         else:
             out.append(text[i])
             i += 1
-    result = "".join(out).replace("phri._phri.", "").replace("numpy.dtype[void]", "numpy.dtype")
+    result = "".join(out).replace("phri._phri.", "")
+    # Bare Python types pybind11 names (py::array, py::dtype, py::list, py::object) with their parameters.
+    result = re.sub(r"\bnumpy\.ndarray\b(?!\[)", "numpy.typing.NDArray[Any]", result)
+    result = re.sub(r"(?<!\.)\bdtype\b", "numpy.dtype[Any]", result)
+    result = re.sub(r"\blist\b", "List[Any]", result)
     result = re.sub(r"\bobject\b", "Any", result)
     if "::" in result or "<" in result:
         raise SystemExit(f"make_stubs: a signature names a C++ type (missing binding?): {text}")
