@@ -84,26 +84,26 @@ void make_read_only(py::array& a) {
   py::detail::array_proxy(a.ptr())->flags &= ~py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
 }
 
-py::array matrix_view(const Eigen::MatrixXd& matrix, py::handle owner, bool writeable) {
+py::array_t<double> matrix_view(const Eigen::MatrixXd& matrix, py::handle owner, bool writeable) {
   const auto size = static_cast<py::ssize_t>(sizeof(double));
-  py::array a(py::dtype::of<double>(), {matrix.rows(), matrix.cols()}, {size, size * matrix.rows()}, matrix.data(), owner);
+  py::array_t<double> a({matrix.rows(), matrix.cols()}, {size, size * matrix.rows()}, matrix.data(), owner);
   if (!writeable) make_read_only(a);
   return a;
 }
 
-py::array vector_view(const double* data, long size, py::handle owner, bool writeable) {
-  py::array a(py::dtype::of<double>(), {size}, {static_cast<py::ssize_t>(sizeof(double))}, data, owner);
+py::array_t<double> vector_view(const double* data, long size, py::handle owner, bool writeable) {
+  py::array_t<double> a({size}, {static_cast<py::ssize_t>(sizeof(double))}, data, owner);
   if (!writeable) make_read_only(a);
   return a;
 }
 
-py::array vector_view(const Eigen::VectorXd& vector, py::handle owner, bool writeable) {
+py::array_t<double> vector_view(const Eigen::VectorXd& vector, py::handle owner, bool writeable) {
   return vector_view(vector.data(), static_cast<long>(vector.size()), owner, writeable);
 }
 
-py::array isometry_view(const Eigen::Isometry3d& pose, py::handle owner) {
+py::array_t<double> isometry_view(const Eigen::Isometry3d& pose, py::handle owner) {
   const auto size = static_cast<py::ssize_t>(sizeof(double));
-  py::array a(py::dtype::of<double>(), {4, 4}, {size, 4 * size}, pose.matrix().data(), owner);
+  py::array_t<double> a({4, 4}, {size, 4 * size}, pose.matrix().data(), owner);
   make_read_only(a);
   return a;
 }

@@ -18,7 +18,7 @@ using Vector = Eigen::VectorXd;
 py::object owner_of(const Data& data) { return py::cast(&data, py::return_value_policy::reference); }
 
 // A read-only view of one of Data's vectors, owned by the Data.
-py::array data_vector(const Data& data, const Eigen::VectorXd& vector) { return vector_view(vector, owner_of(data)); }
+py::array_t<double> data_vector(const Data& data, const Eigen::VectorXd& vector) { return vector_view(vector, owner_of(data)); }
 
 void bind_model_types(py::module_& m) {
   py::enum_<JointType>(m, "JointType", "Joint kinds a URDF chain may have.")
@@ -151,7 +151,7 @@ void bind_data(py::module_& m) {
 }
 
 // frame_jacobian into `out` (checked: the C++ function writes through an Eigen map of its memory) or a new array.
-py::array jacobian_into(const Model& model, const Data& data, int frame_id, ReferenceFrame rf, std::optional<py::array> out) {
+py::array_t<double> jacobian_into(const Model& model, const Data& data, int frame_id, ReferenceFrame rf, std::optional<py::array> out) {
   check_index("frame_jacobian", frame_id, model.num_frames());
   const auto size = static_cast<py::ssize_t>(sizeof(double));
   py::array target = out ? *out : py::array(py::dtype::of<double>(), {6, model.nv()}, {size, 6 * size});
@@ -164,7 +164,7 @@ py::array jacobian_into(const Model& model, const Data& data, int frame_id, Refe
   }
   Eigen::Map<Eigen::MatrixXd> jacobian(static_cast<double*>(target.mutable_data()), 6, model.nv());
   frame_jacobian(model, data, frame_id, rf, jacobian);
-  return target;
+  return py::reinterpret_borrow<py::array_t<double>>(target);
 }
 
 void bind_kinematics(py::module_& m) {

@@ -39,11 +39,11 @@ std::string locate(const std::string& relative);
 void make_read_only(py::array& a);
 /// A numpy view of a column-major matrix or vector owned by `owner` (which the view keeps alive).
 /// Read-only unless `writeable`; it sees every later change of the C++ buffer.
-py::array matrix_view(const Eigen::MatrixXd& matrix, py::handle owner, bool writeable = false);
-py::array vector_view(const Eigen::VectorXd& vector, py::handle owner, bool writeable = false);
-py::array vector_view(const double* data, long size, py::handle owner, bool writeable = false);
+py::array_t<double> matrix_view(const Eigen::MatrixXd& matrix, py::handle owner, bool writeable = false);
+py::array_t<double> vector_view(const Eigen::VectorXd& vector, py::handle owner, bool writeable = false);
+py::array_t<double> vector_view(const double* data, long size, py::handle owner, bool writeable = false);
 /// A 4 x 4 homogeneous view of an isometry (Eigen stores it as a column-major 4 x 4 matrix).
-py::array isometry_view(const Eigen::Isometry3d& pose, py::handle owner);
+py::array_t<double> isometry_view(const Eigen::Isometry3d& pose, py::handle owner);
 
 /// Copies `values` into `target` without resizing it; ArgumentError naming `what` on a size mismatch.
 void assign_same_size(Eigen::VectorXd& target, const Eigen::Ref<const Eigen::VectorXd>& values, const char* what);

@@ -47,7 +47,7 @@ def test_stubs_describe_every_public_name_and_parse():
     undeclared = [n for n in public_names() if n not in declared and not inspect.ismodule(getattr(phri, n))]
     assert not undeclared, f"not in the stubs: {undeclared}"
     text = stub.read_text()
-    assert "def crba(model: Model, data: Data, q: numpy.typing.NDArray[numpy.float64]) -> numpy.typing.NDArray[Any]" in text
+    assert "def crba(model: Model, data: Data, q: numpy.typing.NDArray[numpy.float64]) -> numpy.typing.NDArray[numpy.float64]" in text
     signatures = [line for line in text.splitlines() if line.lstrip().startswith("def ")]
     assert len(signatures) > 200 and not [line for line in signatures if "::" in line]  # no C++ type left
 
