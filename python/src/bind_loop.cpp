@@ -27,15 +27,16 @@ py::array records_array(const std::vector<LogColumn>& columns, long rows) {
   return py::array(dtype, {rows}, {dtype.itemsize()});
 }
 
-// Runs `cycles` periods in slices, the GIL released during each; rows (if any) get the log rows.
-long run_released(ClosedLoop& loop, long cycles, const ControllerTargets* targets, LogRow* rows) {
+// Runs `cycles` periods in slices, the GIL released during each; records (if any) get the log rows.
+long run_released(ClosedLoop& loop, long cycles, const ControllerTargets* targets, unsigned char* records,
+                  std::size_t record_size) {
   long done = 0;
   while (done < cycles && !loop.finished()) {
     const long slice = std::min(kCyclesBetweenSignalChecks, cycles - done);
     long ran = 0;
     {
       const py::gil_scoped_release release;
-      ran = loop.run(slice, done == 0 ? targets : nullptr, rows != nullptr ? rows + done : nullptr);
+      ran = loop.run(slice, done == 0 ? targets : nullptr, records != nullptr ? records + record_size * done : nullptr);
     }
     done += ran;
     if (PyErr_CheckSignals() != 0) throw py::error_already_set();
@@ -45,14 +46,11 @@ long run_released(ClosedLoop& loop, long cycles, const ControllerTargets* target
 
 py::array record(ClosedLoop& loop, long cycles, const ControllerTargets* targets) {
   if (cycles < 0) throw ArgumentError("ClosedLoop.record: cycles must be >= 0, got " + std::to_string(cycles));
-  const int dof = loop.dof();
-  std::vector<LogRow> rows(static_cast<std::size_t>(cycles));
-  const long done = run_released(loop, cycles, targets, rows.data());
-  const std::vector<LogColumn> columns = log_columns(dof);
-  py::array table = records_array(columns, done);
-  auto* out = static_cast<unsigned char*>(table.mutable_data());
-  for (long k = 0; k < done; ++k) write_log_record(rows[static_cast<std::size_t>(k)], dof, out + 8 * columns.size() * k);
-  return table;
+  const std::vector<LogColumn> columns = log_columns(loop.dof());
+  py::array table = records_array(columns, cycles);  // the rows go straight into it, no other copy
+  const long done = run_released(loop, cycles, targets, static_cast<unsigned char*>(table.mutable_data()),
+                                 8 * columns.size());
+  return done == cycles ? table : py::array(table[py::slice(0, done, 1)]);
 }
 
 void bind_closed_loop_class(py::module_& m) {
@@ -67,7 +65,7 @@ void bind_closed_loop_class(py::module_& m) {
       .def("step", &ClosedLoop::step, py::arg("targets") = nullptr,
            "One period; `targets` (None: no change) act in this period. Returns the controller's CycleStatus.")
       .def("run", [](ClosedLoop& loop, long cycles, const ControllerTargets* targets) {
-             return run_released(loop, cycles, targets, nullptr);
+             return run_released(loop, cycles, targets, nullptr, 0);
            },
            py::arg("cycles"), py::arg("targets") = nullptr,
            "`cycles` periods in C++, GIL released (targets, if given, in the first); stops early when the FSM has "

@@ -1,5 +1,7 @@
 #include "closed_loop.hpp"
 
+#include "log_table.hpp"
+
 #include <phri/core/error.hpp>
 
 namespace phri::python {
@@ -43,14 +45,16 @@ CycleStatus ClosedLoop::step(const ControllerTargets* targets) {
   return status_;
 }
 
-long ClosedLoop::run(long cycles, const ControllerTargets* targets, LogRow* rows) {
+long ClosedLoop::run(long cycles, const ControllerTargets* targets, unsigned char* records) {
   if (targets != nullptr && fsm_ != nullptr) {
     throw ArgumentError("ClosedLoop.run: targets given to a loop driven by an FSM (post events to the FSM instead)");
   }
+  const int dof = robot_.dof();
+  const std::size_t record_size = records != nullptr ? 8 * log_columns(dof).size() : 0;
   long k = 0;
   for (; k < cycles && !finished(); ++k) {
-    cycle(k == 0 && targets != nullptr ? *targets : no_targets_, rows != nullptr);
-    if (rows != nullptr) rows[k] = row_;
+    cycle(k == 0 && targets != nullptr ? *targets : no_targets_, records != nullptr);
+    if (records != nullptr) write_log_record(row_, dof, records + record_size * static_cast<std::size_t>(k));
   }
   return k;
 }

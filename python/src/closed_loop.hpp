@@ -26,9 +26,9 @@ public:
   /// an FSM takes the FSM's instead (ArgumentError when both are given).
   CycleStatus step(const ControllerTargets* targets = nullptr);
   /// `cycles` periods (the targets, if any, in the first one); stops early once the FSM has
-  /// finished. When `rows` is not null, row k of the log (LogRow) goes to rows[k]. Returns the
-  /// number of periods run.
-  long run(long cycles, const ControllerTargets* targets = nullptr, LogRow* rows = nullptr);
+  /// finished. When `records` is not null, period k's log row goes to record k there, as
+  /// write_log_record (log_table.hpp) writes it. Returns the number of periods run.
+  long run(long cycles, const ControllerTargets* targets = nullptr, unsigned char* records = nullptr);
 
   /// The latest state read (null before the first step).
   const RobotState* state() const { return state_; }
