@@ -3,8 +3,11 @@
 
 1. Layering: a file of module M includes <phri/N/...> only for N == M or a module below M
    (MODULE_DEPENDENCIES, the same graph as the top-level CMakeLists.txt).
-2. Function length: no function in src/ or apps/ longer than MAX_FUNCTION_LINES, counted from the
-   first line of its declaration (template and initializer list included) to its closing brace.
+2. Function length: no function in src/, apps/ or python/ (the bindings) longer than
+   MAX_FUNCTION_LINES, counted from the first line of its declaration (template and initializer
+   list included) to its closing brace.
+3. The library knows nothing of Python: no file of src/phri includes pybind11 or Python.h (the
+   bindings live in python/, above every module).
 
     tools/check_structure.py [--layering-only] [ROOT]   (default ROOT: the folder above tools/)
 
@@ -33,6 +36,7 @@ MODULE_DEPENDENCIES = {
 }
 
 INCLUDE = re.compile(r'^\s*#\s*include\s*[<"]phri/([A-Za-z0-9_]+)/', re.M)
+PYTHON_INCLUDE = re.compile(r'^\s*#\s*include\s*[<"](pybind11/|Python\.h)', re.M)
 SCOPE_KEYWORD = re.compile(r"\b(namespace|class|struct|enum|union)\b|^\s*extern\s*\"C\"")
 FUNCTION_TAIL = re.compile(r"(\)|\}|\bconst|\bnoexcept|\boverride|\bfinal|\bmutable|->\s*[\w:<>,\s*&]+)\s*$")
 
@@ -58,6 +62,9 @@ def layering_findings(src):
             continue
         allowed = reachable(module) | {module}
         text = path.read_text()
+        for match in PYTHON_INCLUDE.finditer(text):
+            line = text.count("\n", 0, match.start()) + 1
+            findings.append(f"{path}:{line}: module '{module}' includes {match.group(1)}: Python belongs in python/")
         for match in INCLUDE.finditer(text):
             target = match.group(1)
             if target not in allowed:
@@ -215,11 +222,12 @@ def main(argv):
         findings += cmake_graph_findings(root / "CMakeLists.txt")
     if not layering_only:
         findings += length_findings(src)
-        if (root / "apps").is_dir():
-            findings += length_findings(root / "apps")
+        for folder in ("apps", "python"):
+            if (root / folder).is_dir():
+                findings += length_findings(root / folder)
     for finding in findings:
         print(finding)
-    scope = "layering of " + str(src) if layering_only else f"{src} and {root / 'apps'}"
+    scope = "layering of " + str(src) if layering_only else f"{src}, {root / 'apps'} and {root / 'python'}"
     print(f"check_structure: {len(findings)} finding(s) ({scope})")
     return 1 if findings else 0
 

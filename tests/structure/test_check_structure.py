@@ -62,4 +62,13 @@ expect(len(found) == 1 and "85 lines" in found[0], "lambdas and local classes co
 short = tree({"app/e.cpp": "namespace phri {\nint f() {\n" + body(77) + "  return 0;\n}\n}\n"})
 expect(check.length_findings(short / "src") == [], "a function of exactly 80 lines passes")
 
+python_in_library = tree({"sim/p.cpp": "#include <pybind11/pybind11.h>\nint p() { return 0; }\n"})
+findings = check.layering_findings(python_in_library / "src")
+expect(len(findings) == 1 and "pybind11/" in findings[0], "a library module including pybind11 is found")
+
+long_binding = tree({"core/a.hpp": "#pragma once\n"})
+(long_binding / "python" / "src").mkdir(parents=True)
+(long_binding / "python" / "src" / "bind.cpp").write_text("void bind() {\n" + body(80) + "}\n")
+expect(check.main(["x", str(long_binding)]) == 1, "a function over the limit in python/ fails the check")
+
 sys.exit(1 if failures else 0)

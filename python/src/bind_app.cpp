@@ -1,0 +1,155 @@
+// phri/app for Python: the run configuration (Config, one YAML per run), events and the FSM that
+// turns them into ControllerTargets, the CSV logger, and run_session (the `phri run` loop, with its
+// summary), which runs with the GIL released and prints through Python's sys.stdout.
+#include "bindings.hpp"
+#include "python_stream.hpp"
+
+#include <phri/app/config.hpp>
+#include <phri/app/run_session.hpp>
+
+#include <sstream>
+
+namespace phri::python {
+namespace {
+
+void bind_fsm(py::module_& m) {
+  bind_enum<Event, kEventCount>(m, "Event", "What an operator or a timeline asks of the FSM (names as in the YAML timeline).");
+  bind_enum<FsmState, 4>(m, "FsmState", "startup, static, dynamic, stopped.");
+  py::enum_<Scenario>(m, "Scenario", "The demo's scenarios.")
+      .value("static", Scenario::kStatic)
+      .value("dynamic", Scenario::kDynamic);
+  py::class_<TimedEvent>(m, "TimedEvent", "An event of a scripted timeline at `time_s` of robot time.")
+      .def(py::init([](double t, Event e) { return TimedEvent{t, e}; }), py::arg("time_s"), py::arg("event"))
+      .def_readwrite("time_s", &TimedEvent::time_s)
+      .def_readwrite("event", &TimedEvent::event);
+  py::class_<StartupSettings>(m, "StartupSettings", "The FSM's start-up move to the home posture.")
+      .def(py::init<>())
+      .def_readwrite("enabled", &StartupSettings::enabled)
+      .def_readwrite("home_q_rad", &StartupSettings::home_q_rad)
+      .def_readwrite("max_joint_speed_rad_s", &StartupSettings::max_joint_speed_rad_s)
+      .def_readwrite("tolerance_rad", &StartupSettings::tolerance_rad)
+      .def_readwrite("timeout_s", &StartupSettings::timeout_s);
+  py::class_<FsmSettings>(m, "FsmSettings", "The demo FSM (configs/demo.yaml `fsm:` and `events:`).")
+      .def(py::init<>())
+      .def_readwrite("startup", &FsmSettings::startup)
+      .def_readwrite("first_scenario", &FsmSettings::first_scenario)
+      .def_readwrite("torque_loop", &FsmSettings::torque_loop, "Start-up hands over to it; toggle_loop's torque side.")
+      .def_readwrite("stiffness_step", &FsmSettings::stiffness_step)
+      .def_readwrite("rest_speed_rad_s", &FsmSettings::rest_speed_rad_s)
+      .def_readwrite("timeline", &FsmSettings::timeline, "Scripted events (a list: assign a new one).");
+  py::class_<Fsm>(m, "Fsm", "The demo's state machine: events in, ControllerTargets out, once per period.")
+      .def(py::init<const FsmSettings&, const Controller&>(), py::arg("settings"), py::arg("controller"),
+           py::keep_alive<1, 3>(), "`controller`: the one this FSM drives (kept alive with it).")
+      .def("post", &Fsm::post, py::arg("event"), "Queues an event for the next update (False when the queue is full).")
+      .def("update", &Fsm::update, py::arg("time_s"), py::arg("state"), py::arg("controller"),
+           py::return_value_policy::reference_internal, "This period's targets (before controller.step).")
+      .def_property_readonly("targets", &Fsm::targets, py::return_value_policy::reference_internal)
+      .def_property_readonly("state", &Fsm::state)
+      .def_property_readonly("braking", &Fsm::braking)
+      .def_property_readonly("finished", &Fsm::finished, "`stop` was handled and the arm is at rest.")
+      .def_property_readonly("startup_complete", &Fsm::startup_complete)
+      .def_property_readonly("last_event_code", &Fsm::last_event_code)
+      .def_property_readonly("events_handled", &Fsm::events_handled)
+      .def_property_readonly("static_pose", &Fsm::static_pose, "The static scenario's end-effector pose (4 x 4).");
+}
+
+void bind_logger(py::module_& m) {
+  py::class_<LoggerSettings>(m, "LoggerSettings", "The CSV log of a run.")
+      .def(py::init<>())
+      .def_readwrite("path", &LoggerSettings::path)
+      .def_readwrite("dof", &LoggerSettings::dof)
+      .def_readwrite("capacity_rows", &LoggerSettings::capacity_rows)
+      .def_readwrite("write_legend", &LoggerSettings::write_legend);
+  py::class_<LoggerStats>(m, "LoggerStats", "What the logger wrote and dropped.")
+      .def_readonly("pushed", &LoggerStats::pushed)
+      .def_readonly("dropped", &LoggerStats::dropped)
+      .def_readonly("written", &LoggerStats::written)
+      .def_readonly("write_error", &LoggerStats::write_error);
+  py::class_<Logger>(m, "Logger", "One CSV row per cycle, written off the control thread (load it with phri.load_log).")
+      .def(py::init<const LoggerSettings&>(), py::arg("settings"), "Opens the file; ConfigError when it cannot be created.")
+      .def("close", &Logger::close, py::call_guard<py::gil_scoped_release>(), "Drains the ring, closes the file.")
+      .def("stats", &Logger::stats, "Counters so far.")
+      .def("summary", &Logger::summary, "One line: rows written, dropped, queue depth, throughput.")
+      .def_property_readonly("path", &Logger::path)
+      .def_property_readonly("legend_path", &Logger::legend_path)
+      .def_static("header", &Logger::header, py::arg("dof"), "The CSV header line for `dof` joints.")
+      .def_static("legend_yaml", &Logger::legend_yaml, "The legend of the integer columns, as YAML.");
+}
+
+void bind_config(py::module_& m) {
+  py::enum_<LoopClock::Pacing>(m, "Pacing", "lockstep: as fast as possible; real_time: one period per cycle.")
+      .value("lockstep", LoopClock::Pacing::kLockstep)
+      .value("real_time", LoopClock::Pacing::kRealTime);
+  py::class_<RunSettings>(m, "RunSettings", "The `run:` section: duration and pacing.")
+      .def(py::init<>())
+      .def_readwrite("duration_s", &RunSettings::duration_s)
+      .def_readwrite("pacing", &RunSettings::pacing);
+  py::class_<Config>(m, "Config", "ONE YAML per run (configs/demo.yaml documents every key), as the settings of each piece.")
+      .def_static("from_yaml_file", &Config::from_yaml_file, py::arg("path"), "ConfigError naming the file and the key path.")
+      .def_static("from_yaml_string", &Config::from_yaml_string, py::arg("yaml"), py::arg("source_name"), py::arg("base_dir"))
+      .def_readwrite("source", &Config::source)
+      .def_readwrite("controller", &Config::controller)
+      .def_readwrite("plant", &Config::plant)
+      .def_readwrite("fsm", &Config::fsm)
+      .def_readwrite("logging_enabled", &Config::logging_enabled)
+      .def_readwrite("logging", &Config::logging)
+      .def_readwrite("run", &Config::run);
+}
+
+void bind_run_session(py::module_& m) {
+  py::class_<PhaseMark>(m, "PhaseMark", "A named span of a run, from start_s.")
+      .def(py::init([](double start, std::string name) { return PhaseMark{start, std::move(name)}; }), py::arg("start_s"),
+           py::arg("name"))
+      .def_readwrite("start_s", &PhaseMark::start_s)
+      .def_readwrite("name", &PhaseMark::name);
+  py::class_<RunOptions>(m, "RunOptions", "What run_session runs: duration, pacing, status line, named phases.")
+      .def(py::init<>())
+      .def_readwrite("duration_s", &RunOptions::duration_s)
+      .def_readwrite("real_time", &RunOptions::real_time)
+      .def_readwrite("status_line", &RunOptions::status_line)
+      .def_readwrite("phases", &RunOptions::phases);
+  py::class_<PhaseSummary>(m, "PhaseSummary", "One row of the end-of-run table.")
+      .def_readonly("name", &PhaseSummary::name)
+      .def_readonly("start_s", &PhaseSummary::start_s)
+      .def_readonly("end_s", &PhaseSummary::end_s)
+      .def_readonly("ee_position_error_max_mm", &PhaseSummary::ee_position_error_max_mm)
+      .def_readonly("ee_position_error_rms_mm", &PhaseSummary::ee_position_error_rms_mm)
+      .def_readonly("wrench_norm_max", &PhaseSummary::wrench_norm_max)
+      .def_readonly("cycle_median_us", &PhaseSummary::cycle_median_us);
+  py::class_<RunSummary>(m, "RunSummary", "What run_session measured.")
+      .def_readonly("cycles", &RunSummary::cycles)
+      .def_readonly("simulated_s", &RunSummary::simulated_s)
+      .def_readonly("wall_s", &RunSummary::wall_s)
+      .def_readonly("cycle_median_us", &RunSummary::cycle_median_us)
+      .def_readonly("cycle_p99_us", &RunSummary::cycle_p99_us)
+      .def_readonly("overruns", &RunSummary::overruns)
+      .def_readonly("refused_writes", &RunSummary::refused_writes)
+      .def_readonly("safe_hold", &RunSummary::safe_hold)
+      .def_readonly("safe_hold_reason", &RunSummary::safe_hold_reason)
+      .def_readonly("phases", &RunSummary::phases);
+  m.def("run_session",
+        [](RobotInterface& robot, Controller& controller, Fsm& fsm, Logger* logger, const RunOptions& options) {
+          PythonStream out;
+          const py::gil_scoped_release release;
+          return run_session(robot, controller, fsm, nullptr, logger, options, out);
+        },
+        py::arg("robot"), py::arg("controller"), py::arg("fsm"), py::arg("logger") = nullptr, py::arg("options") = RunOptions{},
+        "The `phri run` loop (read, FSM, step, write, log) for options.duration_s of robot time, GIL released; "
+        "progress lines go to sys.stdout.");
+  m.def("run_summary_text", [](const RunSummary& summary) {
+        std::ostringstream text;
+        print_run_summary(summary, text);
+        return text.str();
+      }, py::arg("summary"), "The end-of-run report (markdown), as `phri run` prints it.");
+}
+
+}  // namespace
+
+void bind_app(py::module_& m) {
+  bind_fsm(m);
+  bind_logger(m);
+  bind_config(m);
+  bind_run_session(m);
+}
+
+}  // namespace phri::python
