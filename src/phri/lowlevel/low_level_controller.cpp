@@ -134,8 +134,9 @@ void LowLevelController::update(const RobotState& state, const Eigen::VectorXd& 
 // accelerates: share * Coulomb friction along the motion; without it the joint crawls at the
 // threshold, the assist switching on and off as it crosses. The share grows (a hand pushing
 // harder) while the joint stays slow and asked the same way, up to the whole friction; it starts
-// again at the base share otherwise. Off (the ramp disabled: dual compliance, where the hand
-// leaves the arm anywhere): the breakaway case alone at the base share.
+// again at the base share otherwise. Off (the controller disables the ramp while a hand carries the
+// arm in full-body compliance and in dual compliance once a hand has placed the end effector): the
+// breakaway case alone at the base share.
 void LowLevelController::update_friction_assist(const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd_desired) {
   for (Eigen::Index i = 0; i < breakaway_.size(); ++i) {
     const FrictionParameters& friction = friction_[static_cast<std::size_t>(i)];

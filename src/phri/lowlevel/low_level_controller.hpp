@@ -63,8 +63,9 @@ public:
   /// The assist goes on while a joint slides slower than this many times the friction model's
   /// velocity threshold (see update_friction_assist).
   static constexpr double kSlowSlideFactor = 3.0;
-  /// Off: the share stays at kVendorBreakawayShare (the controller turns the ramp off in dual
-  /// compliance, where a joint held by friction off the posture target is meant to stay put).
+  /// Off: the share stays at kVendorBreakawayShare and slow slides get nothing (the controller
+  /// turns it off while a hand carries the arm in full-body compliance, and in dual compliance
+  /// once a hand has placed the end effector, where a joint held by friction is meant to stay put).
   void enable_breakaway_ramp(bool on) { breakaway_ramp_ = on; }
   const Eigen::VectorXd& breakaway() const { return breakaway_; }
   const CustomTorqueController& custom() const { return custom_; }
