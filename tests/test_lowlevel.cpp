@@ -201,14 +201,20 @@ TEST(VendorLoops, BreakawayFeedForwardOnlyForAStuckJointAskedToMove) {
   EXPECT_NEAR(command.tau_Nm[3], 0.0, 1e-6);
 }
 
-TEST(VendorLoops, BreakawayShareGrowsWhileAJointStaysStuckAndStartsAgainWhenItMoves) {
-  const phri::ActuatorTable table = phri::ActuatorTable::from_yaml_file(kActuators);
-  phri::LowLevelController low(table, phri::CustomTorqueSettings{}, phri::LowLevelMode::kKinovaTorque);
+// A 7-joint arm at rest at zero, no torque, no current reading.
+phri::RobotState resting_state() {
   phri::RobotState state(7);
   state.q_rad.setZero();
   state.qd_rad_s.setZero();
   state.tau_sensor_Nm.setZero();
   state.current.valid = false;
+  return state;
+}
+
+TEST(VendorLoops, BreakawayShareGrowsWhileAJointStaysStuckAndStartsAgainWhenItMoves) {
+  const phri::ActuatorTable table = phri::ActuatorTable::from_yaml_file(kActuators);
+  phri::LowLevelController low(table, phri::CustomTorqueSettings{}, phri::LowLevelMode::kKinovaTorque);
+  phri::RobotState state = resting_state();
   Eigen::VectorXd tau_d = Eigen::VectorXd::Zero(7), qdd = Eigen::VectorXd::Zero(7);
   qdd[4] = 5.0;  // joint 5 stuck, asked to move
   phri::RobotCommand command(7);
@@ -238,11 +244,7 @@ TEST(VendorLoops, BreakawayShareGrowsWhileAJointStaysStuckAndStartsAgainWhenItMo
 TEST(VendorLoops, FrictionAssistFollowsASlowSlideTheTaskStillAccelerates) {
   const phri::ActuatorTable table = phri::ActuatorTable::from_yaml_file(kActuators);
   phri::LowLevelController low(table, phri::CustomTorqueSettings{}, phri::LowLevelMode::kKinovaTorque);
-  phri::RobotState state(7);
-  state.q_rad.setZero();
-  state.qd_rad_s.setZero();
-  state.tau_sensor_Nm.setZero();
-  state.current.valid = false;
+  phri::RobotState state = resting_state();
   Eigen::VectorXd tau_d = Eigen::VectorXd::Zero(7), qdd = Eigen::VectorXd::Zero(7);
   phri::RobotCommand command(7);
   const phri::FrictionParameters& f = table[5].friction;
