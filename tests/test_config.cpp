@@ -208,7 +208,7 @@ TEST(Config, OutOfRangeValuesNameTheirPath) {
                       {.element = "fsm.stiffness_step", .file = "test.yaml"});
   expect_config_error(loading_demo_with("buffer_rows: 16384", "buffer_rows: 4"),
                       {.element = "logging.buffer_rows", .file = "test.yaml"});
-  expect_config_error(loading_demo_with("{at: 32.0, event: stop}", "{at: 99.0, event: stop}"),
+  expect_config_error(loading_demo_with("{at: 34.0, event: stop}", "{at: 99.0, event: stop}"),
                       {.element = "events[9].at", .mentions = {"after the end of the run"}, .file = "test.yaml"});
   expect_config_error(
       loading_demo_with("{at: 8.0, event: full_body_compliance}", "{at: -1, event: full_body_compliance}"),
@@ -225,11 +225,11 @@ TEST(Config, OutOfRangeValuesNameTheirPath) {
 // Sizes that would exhaust memory before the run starts: run.duration_s (one cycle time per period
 // is kept) and logging.buffer_rows (the log ring, ~700 B a row).
 TEST(Config, RunLengthAndLogRingAreCapped) {
-  expect_config_error(loading_demo_with("duration_s: 33.5", "duration_s: 1e9"),
+  expect_config_error(loading_demo_with("duration_s: 35.5", "duration_s: 1e9"),
                       {.element = "run.duration_s", .mentions = {"at most 3600 s"}, .file = "test.yaml"});
-  expect_config_error(loading_demo_with("duration_s: 33.5", "duration_s: 3600.5"),
+  expect_config_error(loading_demo_with("duration_s: 35.5", "duration_s: 3600.5"),
                       {.element = "run.duration_s", .mentions = {"at most 3600 s"}, .file = "test.yaml"});
-  EXPECT_DOUBLE_EQ(load_edited("duration_s: 33.5", "duration_s: 3600").run.duration_s, 3600.0);
+  EXPECT_DOUBLE_EQ(load_edited("duration_s: 35.5", "duration_s: 3600").run.duration_s, 3600.0);
   expect_config_error(loading_demo_with("buffer_rows: 16384", "buffer_rows: 4194304"),
                       {.element = "logging.buffer_rows", .mentions = {"100 MiB"}, .file = "test.yaml"});
   const std::size_t max_rows = phri::log_ring_max_rows();

@@ -211,6 +211,34 @@ TEST(SimControl, DualComplianceKeepsTheNewPoseAndIgnoresLightTouches) {
   EXPECT_LT(drift, 0.001);
 }
 
+// Dual compliance in Kinova's high-velocity torque loop: a hand moves the end effector 10 cm or so
+// and lets go. The configuration it leaves is the posture's new target (with the old one the arm
+// crept along its self-motion at ~0.05 rad/s for seconds after the release, the end effector still).
+TEST(SimControl, DualComplianceHoldsTheWholeArmWhereTheHandLeftIt) {
+  Rig rig(phri::ComplianceMode::kDual,
+          {push("tool", Eigen::Vector3d(0, 0, 0.05), Eigen::Vector3d(0, 12, 0), 1.0, 1.0)},
+          phri::LowLevelMode::kKinovaTorqueHighVelocity);
+  const Eigen::VectorXd home = rig.cycle_.qp().posture().target();
+  rig.run(3.0);
+  ASSERT_EQ(rig.cycle_.compliance().touch_count(), 1);
+  ASSERT_FALSE(rig.cycle_.compliance().touched());
+  const Eigen::VectorXd released = rig.robot_.read().q_rad;
+  const Eigen::VectorXd& target = rig.cycle_.qp().posture().target();
+  double creep = 0.0, speed = 0.0;
+  rig.run(3.0, [&]() {
+    const phri::RobotState& s = rig.robot_.read();
+    creep = std::max(creep, (s.q_rad - released).cwiseAbs().maxCoeff());
+    speed = s.qd_rad_s.cwiseAbs().maxCoeff();
+  });
+  std::printf("dual (high-velocity loop): hand moved the arm %.3f rad; posture target %.4f rad from the pose at "
+              "t = 3 s; creep over the next 3 s %.4f rad, final speed %.4f rad/s\n",
+              (released - home).cwiseAbs().maxCoeff(), (target - released).cwiseAbs().maxCoeff(), creep, speed);
+  EXPECT_GT((released - home).cwiseAbs().maxCoeff(), 0.1);
+  EXPECT_LT((target - released).cwiseAbs().maxCoeff(), 0.05);
+  EXPECT_LT(creep, 0.02);
+  EXPECT_LT(speed, 0.01);
+}
+
 // Directions computed on the controller's model at the start posture.
 struct StartPose {
   phri::Model model = phri::Model::from_urdf_file(kRoot + "/robots/kinova_gen3/gen3.urdf");

@@ -189,33 +189,26 @@ TEST_F(WholeBodyQpTest, OneFullCycleDoesNotAllocate) {
   EXPECT_FALSE(compliance.touched());
 }
 
-// Dual compliance: after a hand has placed the end effector (touch, release) the posture target is
-// off the new pose's self-motion manifold; the controller keeps the stiction terms off until a new
-// posture target or a new start.
-TEST_F(WholeBodyQpTest, DualComplianceRemembersAHandPlacedTheEndEffectorUntilANewPostureTarget) {
+// Dual compliance's Schmitt trigger (8 N up, 4 N down): update() reports the release, once, so the
+// controller can re-anchor the posture where the hand left the arm.
+TEST_F(WholeBodyQpTest, DualComplianceReportsTheReleaseOnceAfterTheSchmittTrigger) {
   phri::WholeBodyQp qp(model_, nullptr, phri::WholeBodyQpSettings{});
   phri::ComplianceController compliance{phri::ComplianceSettings{}};
   compliance.initialise(phri::ComplianceMode::kDual, qp, data_);
-  compliance.update(5.0, qp, data_);  // below the touch threshold: nothing
-  EXPECT_FALSE(compliance.placed_by_hand());
-  compliance.update(9.0, qp, data_);  // touched
-  EXPECT_TRUE(compliance.touched());
-  EXPECT_FALSE(compliance.placed_by_hand());
-  compliance.update(5.0, qp, data_);  // between the thresholds: still touched (Schmitt trigger)
-  EXPECT_TRUE(compliance.touched());
-  compliance.update(3.0, qp, data_);  // released
+  EXPECT_FALSE(compliance.update(5.0, qp, data_));  // below the touch threshold: nothing
   EXPECT_FALSE(compliance.touched());
-  EXPECT_TRUE(compliance.placed_by_hand());
-  compliance.set_mode(phri::ComplianceMode::kNullSpace, qp, data_);  // a mode change keeps it
-  EXPECT_TRUE(compliance.placed_by_hand());
-  compliance.posture_target_set();
-  EXPECT_FALSE(compliance.placed_by_hand());
-  compliance.set_mode(phri::ComplianceMode::kDual, qp, data_);
-  compliance.update(9.0, qp, data_);
-  compliance.update(1.0, qp, data_);
-  EXPECT_TRUE(compliance.placed_by_hand());
-  compliance.initialise(phri::ComplianceMode::kDual, qp, data_);  // a new start
-  EXPECT_FALSE(compliance.placed_by_hand());
+  EXPECT_FALSE(compliance.update(9.0, qp, data_));  // touched
+  EXPECT_TRUE(compliance.touched());
+  EXPECT_FALSE(compliance.update(5.0, qp, data_));  // between the thresholds: still touched
+  EXPECT_TRUE(compliance.touched());
+  EXPECT_TRUE(compliance.update(3.0, qp, data_));  // released
+  EXPECT_FALSE(compliance.touched());
+  EXPECT_FALSE(compliance.update(3.0, qp, data_));  // only once
+  EXPECT_FALSE(compliance.update(std::nan(""), qp, data_));
+  compliance.set_mode(phri::ComplianceMode::kNullSpace, qp, data_);
+  EXPECT_FALSE(compliance.update(20.0, qp, data_));  // no trigger outside dual compliance
+  EXPECT_FALSE(compliance.touched());
+  EXPECT_EQ(compliance.touch_count(), 1);
 }
 
 TEST_F(WholeBodyQpTest, TargetGovernorReachesAJumpedTargetWithBoundedSpeedAndTracksStreams) {

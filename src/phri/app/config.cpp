@@ -321,13 +321,15 @@ void parse_fsm(const YamlReader& r, int dof, FsmSettings& f) {
   }
   if (r.has("static")) {
     const YamlReader s = r.at("static");
-    s.allow_keys({"posture_q_rad", "move_speed_m_s", "move_angular_speed_rad_s", "min_move_duration_s"});
+    s.allow_keys({"posture_q_rad", "move_speed_m_s", "move_angular_speed_rad_s", "move_joint_speed_rad_s",
+                  "min_move_duration_s"});
     StaticScenarioSettings& st = f.static_scenario;
     if (s.has("posture_q_rad")) {
       st.posture_q_rad = s.per_joint("posture_q_rad", dof, -kMaxJointAngle_rad, kMaxJointAngle_rad);
     }
     st.move_speed_m_s = positive_or(s, "move_speed_m_s", st.move_speed_m_s, 2.0);
     st.move_angular_speed_rad_s = positive_or(s, "move_angular_speed_rad_s", st.move_angular_speed_rad_s, 10.0);
+    st.move_joint_speed_rad_s = positive_or(s, "move_joint_speed_rad_s", st.move_joint_speed_rad_s, 2.0);
     st.min_move_duration_s = non_negative_or(s, "min_move_duration_s", st.min_move_duration_s, 1000.0);
   }
   if (r.has("dynamic")) {

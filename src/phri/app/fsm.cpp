@@ -31,6 +31,7 @@ void check_settings(const FsmSettings& s, int nv) {
   non_negative(s.startup.timeout_s, "startup.timeout_s");
   positive(s.static_scenario.move_speed_m_s, "static.move_speed_m_s");
   positive(s.static_scenario.move_angular_speed_rad_s, "static.move_angular_speed_rad_s");
+  positive(s.static_scenario.move_joint_speed_rad_s, "static.move_joint_speed_rad_s");
   non_negative(s.static_scenario.min_move_duration_s, "static.min_move_duration_s");
   const DynamicScenarioSettings& d = s.dynamic_scenario;
   non_negative(d.vertical_amplitude_m, "dynamic.vertical_amplitude_m");
@@ -253,11 +254,11 @@ void Fsm::enter(FsmState next, double t, const Controller& cycle) {
       const Eigen::Isometry3d from = pose_target(cycle);
       q_ref_ = posture_target(cycle);
       pose_move_.start(from, static_pose_, s.move_speed_m_s, s.move_angular_speed_rad_s, s.min_move_duration_s);
-      joint_move_.start(q_ref_, static_q_, settings_.startup.max_joint_speed_rad_s, s.min_move_duration_s);
+      joint_move_.start(q_ref_, static_q_, s.move_joint_speed_rad_s, s.min_move_duration_s);
       // One duration for both, the longer.
       const double duration = std::max(pose_move_.duration(), joint_move_.duration());
       pose_move_.start(from, static_pose_, s.move_speed_m_s, s.move_angular_speed_rad_s, duration);
-      joint_move_.start(q_ref_, static_q_, settings_.startup.max_joint_speed_rad_s, duration);
+      joint_move_.start(q_ref_, static_q_, s.move_joint_speed_rad_s, duration);
       motion_ = Motion::kPoseMove;
       return;
     }

@@ -41,6 +41,10 @@ struct StaticScenarioSettings {
   std::vector<double> posture_q_rad = paper_posture_target();  ///< held posture (one per joint)
   double move_speed_m_s = 0.1;          ///< peak EE speed of the move into the static pose
   double move_angular_speed_rad_s = 0.5;
+  /// Peak joint speed of the posture's move back. Dual compliance leaves the posture where the
+  /// hand put the arm, a wrist turned by up to ~2 rad; at the start-up's 0.3 rad/s the way back
+  /// took 12 s. Half the Gen3's smallest velocity limit (1.22 rad/s).
+  double move_joint_speed_rad_s = 0.6;
   double min_move_duration_s = 1.0;
 };
 

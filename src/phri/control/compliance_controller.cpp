@@ -54,7 +54,7 @@ void ComplianceController::apply(WholeBodyQp& qp) {
 
 void ComplianceController::initialise(ComplianceMode mode, WholeBodyQp& qp, const Data& data) {
   mode_ = mode;
-  touched_ = released_ = false;
+  touched_ = false;
   apply(qp);
   // Start at the set values rather than filtering from zero.
   EndEffectorTask& ee = qp.end_effector();
@@ -81,9 +81,9 @@ void ComplianceController::set_stiffness_scale(double scale, WholeBodyQp& qp) {
   apply(qp);
 }
 
-void ComplianceController::update(double wrench_norm, WholeBodyQp& qp, const Data& data) {
-  if (mode_ != ComplianceMode::kDual) return;
-  if (!std::isfinite(wrench_norm)) return;  // a bad sample changes nothing
+bool ComplianceController::update(double wrench_norm, WholeBodyQp& qp, const Data& data) {
+  if (mode_ != ComplianceMode::kDual) return false;
+  if (!std::isfinite(wrench_norm)) return false;  // a bad sample changes nothing
   if (!touched_ && wrench_norm >= settings_.touch_threshold) {
     // The spring fades out through the gain filter (the target stays put, so nothing steps).
     touched_ = true;
@@ -92,10 +92,11 @@ void ComplianceController::update(double wrench_norm, WholeBodyQp& qp, const Dat
   } else if (touched_ && wrench_norm < settings_.release_threshold) {
     // The pose at release is the new target; the spring, faded by now, grows back from zero.
     touched_ = false;
-    released_ = true;
     qp.end_effector().hold_current_pose(data);
     apply(qp);
+    return true;
   }
+  return false;
 }
 
 }  // namespace phri

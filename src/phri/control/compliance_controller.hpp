@@ -54,17 +54,14 @@ public:
   /// Changes mode (smoothly, from the next cycle on).
   void set_mode(ComplianceMode mode, WholeBodyQp& qp, const Data& data);
   /// Once per cycle before qp.update: wrench_norm is the end-effector wrench's norm (F/T).
-  void update(double wrench_norm, WholeBodyQp& qp, const Data& data);
+  /// Returns true on the cycle a hand lets go of the end effector in dual compliance (its pose
+  /// is then the task's new target; the caller re-anchors what depends on the configuration).
+  bool update(double wrench_norm, WholeBodyQp& qp, const Data& data);
 
   ComplianceMode mode() const { return mode_; }
   bool touched() const { return touched_; }
   /// How many times dual compliance entered and left the touched state.
   int touch_count() const { return touch_count_; }
-  /// True once a hand has placed the end effector (a release in dual compliance) until the next
-  /// posture target (posture_target_set()): the posture target is then off the new pose's
-  /// self-motion manifold, and pulling the arm there is not wanted.
-  bool placed_by_hand() const { return released_; }
-  void posture_target_set() { released_ = false; }
   const ComplianceSettings& settings() const { return settings_; }
   void set_stiffness_scale(double scale, WholeBodyQp& qp);  ///< live stiffness up/down (gamepad)
   /// The scale set_stiffness_scale keeps: clamped to [0.1, 4].
@@ -77,7 +74,6 @@ private:
   ComplianceSettings settings_;
   ComplianceMode mode_ = ComplianceMode::kNullSpace;
   bool touched_ = false;
-  bool released_ = false;
   int touch_count_ = 0;
   double stiffness_scale_ = 1.0;
 };

@@ -188,7 +188,6 @@ bool Controller::apply(const ControllerTargets& targets) {
     compliance_.set_stiffness_scale(*targets.stiffness_scale, qp_);
   }
   if (targets.has_posture && accept(usable(targets.posture, model_.nv()))) {
-    if (targets.posture.q != qp_.posture().target()) compliance_.posture_target_set();
     qp_.posture().set_target(targets.posture.q, targets.posture.qd, targets.posture.qdd);
   }
   if (targets.has_pose && accept(usable(targets.pose))) {
@@ -345,6 +344,55 @@ void Controller::check_qp(WholeBodyQpStatus qp_status, double t) {
   }
 }
 
+// Start, pending mode change, dual compliance's touch trigger.
+void Controller::update_modes_and_targets() {
+  if (!started_) {
+    started_ = true;
+    qp_.posture().set_target(q_);
+    compliance_.initialise(settings_.initial_compliance, qp_, data_);
+    leash_.reset();
+  }
+  if (pending_mode_) {
+    compliance_.set_mode(*pending_mode_, qp_, data_);
+    pending_mode_.reset();
+  }
+  // The trigger sees the wrench norm through a short low-pass (settings.wrench_trigger_filter_s):
+  // single-sample spikes of the F/T signal (tool inertia during stick-slip jolts, noise) must not
+  // free the end effector for a few milliseconds.
+  if (compliance_.update(trigger_filter_.update(wrench_.calibrated() ? wrench_.norm() : 0.0), qp_, data_)) {
+    // A hand let go in dual compliance: its pose is the end effector's new target (paper), and the
+    // configuration it left the arm in is the posture's. The old posture target lies off the new
+    // pose's self-motion manifold; the paper's posture stiffness of 0 there leaves the arm where the
+    // hand put it, and with ours it would creep along the self-motion toward the old target.
+    qp_.posture().set_target(q_);
+    leash_.reset();
+  }
+}
+
+// After the external torque is known: the return leash, the posture's weight and the stiction
+// terms for this cycle.
+void Controller::shape_tasks() {
+  // The way back after a hand carried the arm (return_leash.hpp): dragged in full-body compliance
+  // while a hand is on the arm (tau_ext beyond the compliance dead band on some joint), never by
+  // the arm's own motion, which would otherwise pull the leash along with it.
+  const bool carried = compliance_.mode() == ComplianceMode::kFullBody &&
+                       (tau_ext_.cwiseAbs().array() > qp_.compliance_deadband().array()).any();
+  leash_.update(model_, q_, qd_, qp_.posture().target(), qp_.posture().target_velocity(), carried, settings_.period_s);
+  qp_.posture().set_target_offset(leash_.offset());
+  qp_.end_effector().set_target_offset(leash_.pose_offset());
+  qp_.posture().set_weight(leash_.posture_weight(compliance_.settings().posture_weight));
+  // The tasks' stiction terms and the vendor loops' friction assist in the torque loops, where
+  // friction pre-compensation (custom loop) or the assist (vendor loops) turns their acceleration
+  // into torque at rest. Off while a hand carries the arm in full-body compliance (they would wind
+  // up against it; the leash follows the hand instead), and in dual compliance while a hand guides
+  // the end effector (its task has no target to hold then).
+  const bool stiction_terms = low_level_.requested() != LowLevelMode::kPosition && !carried &&
+                              !(compliance_.mode() == ComplianceMode::kDual && compliance_.touched());
+  qp_.posture().enable_integral(stiction_terms);
+  qp_.end_effector().enable_integral(stiction_terms);
+  low_level_.enable_breakaway_ramp(stiction_terms);
+}
+
 CycleStatus Controller::step(const RobotState& state, const ControllerTargets& targets, RobotCommand& command) {
   const bool targets_accepted = apply(targets);
   const bool had_good = supervisor_.has_good();
@@ -368,46 +416,14 @@ CycleStatus Controller::step(const RobotState& state, const ControllerTargets& t
   estimate(state, dt);
 
   // ---- modes and targets
-  if (!started_) {
-    started_ = true;
-    qp_.posture().set_target(q_);
-    compliance_.initialise(settings_.initial_compliance, qp_, data_);
-    leash_.reset();
-  }
-  if (pending_mode_) {
-    compliance_.set_mode(*pending_mode_, qp_, data_);
-    pending_mode_.reset();
-  }
-  // The trigger sees the wrench norm through a short low-pass (settings.wrench_trigger_filter_s):
-  // single-sample spikes of the F/T signal (tool inertia during stick-slip jolts, noise) must not
-  // free the end effector for a few milliseconds.
-  compliance_.update(trigger_filter_.update(wrench_.calibrated() ? wrench_.norm() : 0.0), qp_, data_);
+  update_modes_and_targets();
 
   // ---- QP and inverse dynamics. Under the robot's position loop the external torque is not fed
   // back: the stiff servo rejects it and the observer would only see servo effort.
   select_external_torque();
   bound_external_torque();
   if (low_level_.requested() == LowLevelMode::kPosition) tau_ext_.setZero();
-  // The way back after a hand carried the arm (return_leash.hpp): dragged in full-body compliance
-  // while a hand is on the arm (tau_ext beyond the compliance dead band on some joint), never by
-  // the arm's own motion, which would otherwise pull the leash along with it.
-  const bool carried = compliance_.mode() == ComplianceMode::kFullBody &&
-                       (tau_ext_.cwiseAbs().array() > qp_.compliance_deadband().array()).any();
-  leash_.update(model_, q_, qd_, qp_.posture().target(), qp_.posture().target_velocity(), carried, settings_.period_s);
-  qp_.posture().set_target_offset(leash_.offset());
-  qp_.end_effector().set_target_offset(leash_.pose_offset());
-  // The tasks' stiction terms and the vendor loops' friction assist in the torque loops, where
-  // friction pre-compensation (custom loop) or the assist (vendor loops) turns their acceleration
-  // into torque at rest. Off while a hand carries the arm in full-body compliance (they would wind
-  // up against it; the leash follows the hand instead), and in
-  // dual compliance once the hand has placed the end effector: the posture target is then off the
-  // new pose's self-motion manifold, and the terms would only make the arm creep toward it.
-  const bool stiction_terms =
-      low_level_.requested() != LowLevelMode::kPosition && !carried &&
-      !(compliance_.mode() == ComplianceMode::kDual && (compliance_.touched() || compliance_.placed_by_hand()));
-  qp_.posture().enable_integral(stiction_terms);
-  qp_.end_effector().enable_integral(stiction_terms);
-  low_level_.enable_breakaway_ramp(stiction_terms);
+  shape_tasks();
   const WholeBodyQpStatus qp_status = qp_.update(model_, data_, q_, qd_, tau_ext_, settings_.period_s);
   check_qp(qp_status, state.time_s);
   if (supervisor_.safe_stop()) {

@@ -123,6 +123,8 @@ private:
   void estimate(const RobotState& state, double dt);
   void select_external_torque();
   void bound_external_torque();
+  void update_modes_and_targets();
+  void shape_tasks();
   void guard_torque(Eigen::VectorXd& tau) const;
   void check_qp(WholeBodyQpStatus qp_status, double t);
 

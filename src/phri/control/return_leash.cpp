@@ -20,13 +20,24 @@ ReturnLeash::ReturnLeash(const Model& model, int frame_id, const ReturnLeashSett
   if (!positive(settings.return_speed_rad_s)) {
     throw ConfigError("ReturnLeashSettings", "return_speed_rad_s", "must be > 0 and finite");
   }
+  if (!positive(settings.walk_posture_weight)) {
+    throw ConfigError("ReturnLeashSettings", "walk_posture_weight", "must be > 0 and finite");
+  }
+  if (!positive(settings.weight_blend_s)) {
+    throw ConfigError("ReturnLeashSettings", "weight_blend_s", "must be > 0 and finite");
+  }
   for (const Joint& j : model.joints()) continuous_.push_back(j.type == JointType::kContinuous);
 }
 
 void ReturnLeash::reset() {
   offset_.setZero();
   out_ = false;
+  walk_blend_ = 0.0;
   pose_offset_.setIdentity();
+}
+
+double ReturnLeash::posture_weight(double usual) const {
+  return usual * std::pow(settings_.walk_posture_weight / usual, walk_blend_);
 }
 
 void ReturnLeash::update(const Model& model, const Eigen::VectorXd& q, const Eigen::VectorXd& qd,
@@ -38,6 +49,8 @@ void ReturnLeash::update(const Model& model, const Eigen::VectorXd& q, const Eig
   if (largest > 0.0) offset_ *= std::max(0.0, 1.0 - settings_.return_speed_rad_s * dt / largest);
   if (dragging) drag(q, qd, q_target, qd_target, dt);
   out_ = offset_.cwiseAbs().maxCoeff() > 0.0;
+  const double step = dt / settings_.weight_blend_s;
+  walk_blend_ = out_ && !dragging ? std::min(1.0, walk_blend_ + step) : std::max(0.0, walk_blend_ - step);
   if (out_) {
     compute_pose_offset(model, q_target);
   } else {

@@ -28,6 +28,15 @@ struct ReturnLeashSettings {
   /// Walking speed of q_l back to q* (largest joint). Slow enough for Kinova's damped torque loops
   /// to follow with the wrist against friction: at 0.5 rad/s the arm fell behind the walk.
   double return_speed_rad_s = 0.15;
+  /// Posture weight while q_l walks back (no hand on the arm). Both targets then come from one
+  /// configuration, so weighting the posture like the end effector (ComplianceSettings::ee_weight)
+  /// costs no conflict at the targets and makes the walk a joint-space motion: with the posture's
+  /// usual weight 1 the end-effector task won every trade-off, and an arm carried through a
+  /// straight elbow walked onto the other elbow branch of the same pose and stayed there.
+  double walk_posture_weight = 1e4;
+  /// [s] the posture weight moves between its usual value and walk_posture_weight geometrically
+  /// over this time (a linear filter would multiply it by 100 in the first millisecond: a step).
+  double weight_blend_s = 0.3;
 };
 
 class ReturnLeash {
@@ -49,6 +58,9 @@ public:
   /// T(q_l) T(q*)^-1 (identity when in).
   const Eigen::Isometry3d& pose_offset() const { return pose_offset_; }
   const ReturnLeashSettings& settings() const { return settings_; }
+  /// The posture task's weight this cycle: `usual` blended toward walk_posture_weight while q_l
+  /// walks back with no hand on the arm.
+  double posture_weight(double usual) const;
 
 private:
   void drag(const Eigen::VectorXd& q, const Eigen::VectorXd& qd, const Eigen::VectorXd& q_target,
@@ -60,6 +72,7 @@ private:
   std::vector<bool> continuous_;
   Data scratch_;
   bool out_ = false;
+  double walk_blend_ = 0.0;  ///< 0: usual posture weight, 1: walk_posture_weight
   Eigen::VectorXd offset_, previous_offset_, leash_q_;
   Eigen::Isometry3d pose_offset_ = Eigen::Isometry3d::Identity();
 };

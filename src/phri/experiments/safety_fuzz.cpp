@@ -271,8 +271,10 @@ void describe_push(FuzzRecord& r, const PushSpec& p) {
 }
 
 // One push on a warmed-up rig, until the arm is back and settled, or stopped, or out of time.
-// The reference is q_ref (the held pose); in dual compliance the arm keeps the pose it is pushed
-// to, so "back" there means at rest. Returns whether the rig can take the next push.
+// The reference is q_ref (the held pose). In dual compliance a hand on the end effector sets a new
+// pose, so there "back" means back at q_ref (an untouched end effector keeps its target, and the
+// posture walks home like in null-space compliance) or at rest wherever the hand left it.
+// Returns whether the rig can take the next push.
 bool run_push(Rig& rig, const Shared& s, const PushSpec& p, const Eigen::VectorXd& q_ref, bool dual, FuzzRecord& r) {
   const SafetyFuzzThresholds& th = s.o.thresholds;
   WindowMetrics& m = r.metrics;
@@ -294,13 +296,11 @@ bool run_push(Rig& rig, const Shared& s, const PushSpec& p, const Eigen::VectorX
     const double scale = force.scale_at(t - 0.5 * s.dt);
     if (scale > 0.0) rig.monitor().push_torque_ratio(p.body, p.point_local, scale * p.force_N, p.local_frame, m);
     int joint = -1;
-    const double deviation = dual ? (rig.speed() < th.rest_speed_rad_s ? 0.0 : std::numeric_limits<double>::infinity())
-                                  : rig.monitor().deviation(rig.q(), q_ref, joint);
-    if (!dual) {
-      m.final_deviation_rad = deviation;
-      m.final_deviation_joint = joint;
-    }
-    if (t >= start + p.duration_s) m.max_deviation_rad = std::max(m.max_deviation_rad, dual ? 0.0 : deviation);
+    const double from_reference = rig.monitor().deviation(rig.q(), q_ref, joint);
+    const double deviation = dual && rig.speed() < th.rest_speed_rad_s ? 0.0 : from_reference;
+    m.final_deviation_rad = deviation;
+    m.final_deviation_joint = joint;
+    if (t >= start + p.duration_s) m.max_deviation_rad = std::max(m.max_deviation_rad, deviation);
     m.final_speed_rad_s = rig.speed();
     tracker.sample(t, deviation, rig.speed(), rig.safe_stop_time());
   }
