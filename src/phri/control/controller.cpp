@@ -84,12 +84,7 @@ const ControllerSettings& checked(const ControllerSettings& settings) {
 // What the drives and sensors can report: the URDF range, the drives' limits.
 SensorRanges sensor_ranges(const Model& model, const ActuatorTable& actuators) {
   const int n = model.nv();
-  SensorRanges r;
-  r.q_lower = model.lower_limits();
-  r.q_upper = model.upper_limits();
-  r.velocity_limit.resize(n);
-  r.torque_range.resize(n);
-  r.current_range.resize(n);
+  SensorRanges r{model.lower_limits(), model.upper_limits(), Eigen::VectorXd(n), Eigen::VectorXd(n), Eigen::VectorXd(n)};
   for (int i = 0; i < n; ++i) {
     if (!model.joint(i).has_position_limits()) {
       r.q_lower[i] = -std::numeric_limits<double>::infinity();
@@ -98,15 +93,6 @@ SensorRanges sensor_ranges(const Model& model, const ActuatorTable& actuators) {
     r.velocity_limit[i] = actuators[i].velocity_limit_rad_s;
     r.torque_range[i] = std::max(actuators[i].max_motor_torque_Nm(), actuators[i].torque_limit_Nm);
     r.current_range[i] = actuators[i].current_limit_A;
-  }
-  r.torque_per_amp.resize(n);
-  r.friction_bound.resize(n);
-  r.reflected_inertia.resize(n);
-  for (int i = 0; i < n; ++i) {
-    const ActuatorParameters& a = actuators[i];
-    r.torque_per_amp[i] = a.torque_per_amp();
-    r.friction_bound[i] = std::max(a.friction.static_Nm, a.friction.coulomb_Nm + a.friction.viscous_Nms_per_rad * a.velocity_limit_rad_s);
-    r.reflected_inertia[i] = a.reflected_inertia_kgm2;
   }
   return r;
 }

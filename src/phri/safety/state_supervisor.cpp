@@ -38,18 +38,6 @@ void check_settings(const SensorRanges& r, const SupervisorSettings& s) {
         (r.current_range.array() > 0).all() && (r.q_lower.array() < r.q_upper.array()).all())) {
     throw ConfigError(kWhere, "ranges", "limits must be > 0 and lower < upper");
   }
-  const long compared = r.torque_per_amp.size();
-  if (compared != 0 && (compared != n || r.friction_bound.size() != n || r.reflected_inertia.size() != n ||
-                        !(r.torque_per_amp.array() >= 0).all() || !(r.friction_bound.array() >= 0).all() ||
-                        !(r.reflected_inertia.array() >= 0).all() || !r.torque_per_amp.allFinite() ||
-                        !r.friction_bound.allFinite() || !r.reflected_inertia.allFinite())) {
-    throw ConfigError(kWhere, "ranges", "torque_per_amp, friction_bound, reflected_inertia: one finite value >= 0 per joint");
-  }
-  if (!(s.motor_acceleration_bound_rad_s2 >= 0) || !(s.torque_current_relative >= 0) ||
-      !(s.torque_current_margin_Nm >= 0) || !std::isfinite(s.motor_acceleration_bound_rad_s2 + s.torque_current_relative +
-                                                           s.torque_current_margin_Nm)) {
-    throw ConfigError(kWhere, "settings", "the torque-current tolerances must be finite and >= 0");
-  }
   if (!(s.period_s > 0) || !(s.position_margin_rad >= 0) || !(s.velocity_bound_factor >= 1) ||
       !(s.position_step_factor >= 1) || !(s.position_step_slack_rad >= 0) || !(s.velocity_consistency_rad_s > 0) || !(s.encoder_quantum_rad >= 0) || !(s.torque_range_factor >= 1) ||
       !(s.current_range_factor >= 1) || !(s.max_degraded_s >= s.period_s) || !(s.recovery_samples >= 1) ||
@@ -120,24 +108,8 @@ SafetyFault StateSupervisor::check_ranges(const RobotState& s, int& joint) const
   if (s.current.valid && (joint = first_beyond(s.current_A, ranges_.current_range, c.current_range_factor)) >= 0) {
     return SafetyFault::kCurrentRange;
   }
-  if (s.current.valid && (joint = first_torque_current_mismatch(s)) >= 0) return SafetyFault::kTorqueCurrentMismatch;
   joint = -1;
   return SafetyFault::kNone;
-}
-
-// The first joint whose τ_s the motor current cannot explain (-1: none, or nothing to compare).
-int StateSupervisor::first_torque_current_mismatch(const RobotState& s) const {
-  if (ranges_.torque_per_amp.size() != n_) return -1;
-  const SupervisorSettings& c = settings_;
-  for (int i = 0; i < n_; ++i) {
-    if (!(ranges_.torque_per_amp[i] > 0.0)) continue;
-    const double motor = ranges_.torque_per_amp[i] * s.current_A[i];
-    const double tolerance = ranges_.friction_bound[i] + ranges_.reflected_inertia[i] * c.motor_acceleration_bound_rad_s2 +
-                             c.torque_current_relative * std::max(std::abs(s.tau_sensor_Nm[i]), std::abs(motor)) +
-                             c.torque_current_margin_Nm;
-    if (std::abs(s.tau_sensor_Nm[i] - motor) > tolerance) return i;
-  }
-  return -1;
 }
 
 SafetyFault StateSupervisor::classify(const RobotState& s, int& joint) const {

@@ -51,8 +51,7 @@ enum class SafetyFault : std::uint8_t {
   kQpFailure,       ///< the QP kept failing (brake fallback for longer than allowed)
   kFollowingError,  ///< the position loop could not follow its reference (re-synced too often)
   kVelocityMismatch,///< q̇ disagrees with the rate of q between consecutive samples
-  kTorqueCurrentMismatch,  ///< τ_s disagrees with the motor torque K_T G_r i beyond friction and rotor inertia
-  kLast = kTorqueCurrentMismatch,
+  kLast = kVelocityMismatch,
 };
 
 constexpr std::string_view to_string(SupervisorState s) {
@@ -77,7 +76,6 @@ constexpr std::string_view to_string(SafetyFault f) {
     case SafetyFault::kPositionJump: return "position_jump";
     case SafetyFault::kVelocityRange: return "velocity_out_of_range";
     case SafetyFault::kVelocityMismatch: return "velocity_mismatch";
-    case SafetyFault::kTorqueCurrentMismatch: return "torque_current_mismatch";
     case SafetyFault::kTorqueRange: return "torque_out_of_range";
     case SafetyFault::kCurrentRange: return "current_out_of_range";
     case SafetyFault::kFrozenValues: return "frozen_values";
@@ -97,10 +95,6 @@ struct SensorRanges {
   Eigen::VectorXd velocity_limit;    ///< the drive's velocity limit [rad/s]
   Eigen::VectorXd torque_range;      ///< |τ_s| the drive can carry [N.m] (its peak motor torque)
   Eigen::VectorXd current_range;     ///< |i| the drive can carry [A]
-  /// τ_s against the motor current (left empty: not compared). K_T G_r [N.m/A]; the friction
-  /// between motor and torque sensor at the velocity limit [N.m]; the reflected rotor inertia
-  /// I_r G_r^2 [kg.m^2].
-  Eigen::VectorXd torque_per_amp, friction_bound, reflected_inertia;
 };
 
 struct SupervisorSettings {
@@ -125,14 +119,6 @@ struct SupervisorSettings {
   /// stop, an impact), but not several times more.
   double torque_range_factor = 2.0;
   double current_range_factor = 1.5;
-  /// τ_s against the motor current: a push loads motor and sensor alike, so |τ_s - K_T G_r i| can
-  /// only be friction, the rotor's inertia torque and K_T's spread. Beyond
-  ///   friction_bound + I_r G_r^2 a + relative max(|τ_s|, |K_T G_r i|) + margin
-  /// the torque sensor is wrong (an offset, a spike within range), and an observer fed with it
-  /// would report a push nobody makes. a bounds the rotor's acceleration (impacts, hard stops).
-  double motor_acceleration_bound_rad_s2 = 500.0;
-  double torque_current_relative = 0.15;
-  double torque_current_margin_Nm = 2.0;
   /// [s] how long the last good state may stand in for missing ones before a safe stop. Kortex's
   /// low-level servoing faults after a few missed 1 kHz frames; 20 ms is the same order.
   double max_degraded_s = 0.02;
@@ -189,7 +175,6 @@ private:
   SafetyFault classify(const RobotState& s, int& joint) const;
   SafetyFault check_freshness(const RobotState& s) const;
   SafetyFault check_ranges(const RobotState& s, int& joint) const;
-  int first_torque_current_mismatch(const RobotState& s) const;
   bool frozen(const RobotState& s);
   void accept(const RobotState& s);
   void reject(const RobotState& s, SafetyFault fault, int joint);
