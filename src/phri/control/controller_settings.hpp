@@ -5,6 +5,7 @@
 #include <phri/control/compliance_mode.hpp>
 #include <phri/control/whole_body_qp.hpp>
 #include <phri/control/wrench_estimator.hpp>
+#include <phri/core/enum_names.hpp>
 #include <phri/lowlevel/custom_torque_controller.hpp>
 #include <phri/lowlevel/low_level_controller.hpp>
 
@@ -12,7 +13,10 @@
 #include <phri/robot/paper_end_of_arm.hpp>
 #include <phri/safety/state_supervisor.hpp>
 
+#include <array>
+#include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace phri {
@@ -24,6 +28,14 @@ enum class ExternalTorqueSource {
                       ///< torque-tracking experiment: "the weight measured by the F/T sensor is compensated")
   kFused,             ///< the paper's code: observer + high-pass of J^T F/T (complementary filter, pole K_O)
 };
+inline constexpr int kExternalTorqueSourceCount = 3;
+/// The names of the run YAML's controller.external_torque_source and of the reports.
+inline constexpr std::array<std::string_view, kExternalTorqueSourceCount> kExternalTorqueSourceNames = {"observer", "ft",
+                                                                                                      "fused"};
+constexpr std::string_view to_string(ExternalTorqueSource s) { return enum_name(s, kExternalTorqueSourceNames); }
+constexpr std::optional<ExternalTorqueSource> external_torque_source_from_string(std::string_view name) {
+  return enum_from_string<ExternalTorqueSource, kExternalTorqueSourceCount>(name);
+}
 
 /// What the controller does after the supervisor's plausibility checks: the guards behind the QP
 /// and the safe stop (Controller::step).
