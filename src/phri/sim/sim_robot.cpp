@@ -27,6 +27,7 @@ constexpr double kWrenchSign = -1.0;
 constexpr std::uint64_t kJointNoiseStream = 1;
 constexpr std::uint64_t kFtNoiseStream = 2;
 constexpr std::uint64_t kMismatchStream = 3;
+constexpr std::uint64_t kReleaseStream = 4;
 
 SimRobotConfig completed(SimRobotConfig config) {
   config.fill_defaults();
@@ -312,14 +313,23 @@ Eigen::Vector3d SimRobot::place_initial_pose() {
   }
   mj_kinematics(m_.get(), d_.get());
   if (drop_body_ < 0) return Eigen::Vector3d::Zero();
-  // The mass hangs on the latch at its static deflection m g / k below the anchor.
+  // Where this run's hand holds the mass relative to the anchor (world axes, z up).
+  RandomGenerator release(config_.seed, kReleaseStream);
+  const double h = config_.drop_test.release_horizontal_spread_m;
+  const double v = config_.drop_test.release_vertical_spread_m;
+  release_offset_ = Eigen::Vector3d(release.uniform(-h, h), release.uniform(-h, h), release.uniform(-v, v));
+  // The mass hangs on the latch at its static deflection m g / k below the held point.
   const double k = config_.drop_test.latch_stiffness_N_per_m;
   const Eigen::Vector3d g(m_->opt.gravity[0], m_->opt.gravity[1], m_->opt.gravity[2]);
   const mjtNum* anchor = d_->site_xpos + 3 * anchor_site_;
-  const Eigen::Vector3d p = Eigen::Vector3d(anchor[0], anchor[1], anchor[2]) + config_.drop_test.mass_kg * g / k;
+  const Eigen::Vector3d p =
+      Eigen::Vector3d(anchor[0], anchor[1], anchor[2]) + release_offset_ + config_.drop_test.mass_kg * g / k;
   for (int k3 = 0; k3 < 3; ++k3) d_->qpos[drop_qadr_ + k3] = p[k3];
   d_->qpos[drop_qadr_ + 3] = 1.0;
   d_->qpos[drop_qadr_ + 4] = d_->qpos[drop_qadr_ + 5] = d_->qpos[drop_qadr_ + 6] = 0.0;
+  hand_point_ = Eigen::Vector3d(anchor[0], anchor[1], anchor[2]) + release_offset_;
+  // A hand carries the weight itself: the arm holds only its own (and the slack cable's nothing).
+  if (config_.drop_test.held_by_hand) return Eigen::Vector3d::Zero();
   return config_.drop_test.mass_kg * g;
 }
 
@@ -582,8 +592,11 @@ void SimRobot::apply_drop_forces(double t) {
   const Eigen::Vector3d rel_v = v - anchor_velocity;
 
   Eigen::Vector3d on_mass = Eigen::Vector3d::Zero();
-  if (!truth_.drop_released) {
-    on_mass = -cfg.latch_stiffness_N_per_m * rel - latch_damping_ * rel_v;
+  Eigen::Vector3d on_mass_by_hand = Eigen::Vector3d::Zero();  // from the world: no reaction on the arm
+  if (!truth_.drop_released && cfg.held_by_hand) {
+    on_mass_by_hand = -cfg.latch_stiffness_N_per_m * (p - hand_point_) - latch_damping_ * v;
+  } else if (!truth_.drop_released) {
+    on_mass = -cfg.latch_stiffness_N_per_m * (rel - release_offset_) - latch_damping_ * rel_v;
   }
   const double length = rel.norm();
   double tension = 0.0;
@@ -595,9 +608,10 @@ void SimRobot::apply_drop_forces(double t) {
   }
   truth_.cable_length_m = length;
   truth_.cable_force_N = tension;
+  mjtNum* fm = d_->xfrc_applied + 6 * drop_body_;
+  for (int k = 0; k < 3; ++k) fm[k] += on_mass_by_hand[k];
   if (on_mass.squaredNorm() == 0.0) return;
   // On the mass at its centre; the reaction on the tool at the anchor (world axes).
-  mjtNum* fm = d_->xfrc_applied + 6 * drop_body_;
   for (int k = 0; k < 3; ++k) fm[k] += on_mass[k];
   const Eigen::Vector3d com(d_->xipos[3 * tool_body_], d_->xipos[3 * tool_body_ + 1], d_->xipos[3 * tool_body_ + 2]);
   const Eigen::Vector3d m = (anchor - com).cross(-on_mass);

@@ -195,6 +195,8 @@ private:
   int anchor_site_ = -1;
   int drop_body_ = -1, drop_qadr_ = -1, drop_dadr_ = -1;
   double latch_damping_ = 0.0;
+  Eigen::Vector3d release_offset_ = Eigen::Vector3d::Zero();  // world axes, drawn at reset()
+  Eigen::Vector3d hand_point_ = Eigen::Vector3d::Zero();      // held_by_hand: where the hand holds it
   std::vector<int> disturbance_bodies_;
   int live_body_ = -1;        // set_live_disturbance
   ExternalForce live_force_;  // its body name unused

@@ -186,7 +186,8 @@ void parse_vendor(const YamlReader& r, int n, SimRobotConfig::Vendor& v) {
 
 void parse_drop_test(const YamlReader& d, SimRobotConfig::DropTest& s) {
   d.allow_keys({"enabled", "mass_kg", "radius_m", "cable_length_m", "cable_stiffness_N_per_m", "cable_damping_Ns_per_m",
-                "anchor_m", "release_time_s", "latch_stiffness_N_per_m"});
+                "anchor_m", "release_time_s", "latch_stiffness_N_per_m", "release_vertical_spread_m",
+                "release_horizontal_spread_m", "held_by_hand"});
   s.enabled = d.boolean_or("enabled", false);
   s.mass_kg = d.number_or("mass_kg", s.mass_kg, 1e-3, kMaxCarriedMass_kg);
   s.radius_m = d.number_or("radius_m", s.radius_m, 1e-3, 0.5);
@@ -196,6 +197,10 @@ void parse_drop_test(const YamlReader& d, SimRobotConfig::DropTest& s) {
   s.anchor_m = d.vector3_or("anchor_m", s.anchor_m, -1.0, 1.0);
   s.release_time_s = d.number_or("release_time_s", s.release_time_s, 0.0, kHuge);
   s.latch_stiffness_N_per_m = d.number_or("latch_stiffness_N_per_m", s.latch_stiffness_N_per_m, 1.0, 1e7);
+  // A hand, not a throw: a few centimetres at most (and never past the cable's length).
+  s.release_vertical_spread_m = d.number_or("release_vertical_spread_m", s.release_vertical_spread_m, 0.0, 0.1);
+  s.release_horizontal_spread_m = d.number_or("release_horizontal_spread_m", s.release_horizontal_spread_m, 0.0, 0.1);
+  s.held_by_hand = d.boolean_or("held_by_hand", s.held_by_hand);
 }
 
 void parse_floor(const YamlReader& f, SimRobotConfig::Floor& s) {

@@ -149,6 +149,17 @@ struct SimRobotConfig {
     Eigen::Vector3d anchor_m = Eigen::Vector3d(0.0, 0.0, 0.1);  ///< cable anchor, sensor frame
     double release_time_s = 1.0;
     double latch_stiffness_N_per_m = 1.0e5;  ///< holds the mass at the anchor until release
+    /// Drop-to-drop variability of a hand's release (the paper's weight is let go by hand): the
+    /// mass starts its fall offset from the anchor by a uniform draw in [-s, s], vertically (the
+    /// fall height, hence the catch's speed) and along each horizontal axis (a swing after the
+    /// catch), drawn from the plant's `seed`. 0: every release the same.
+    double release_vertical_spread_m = 0.0;
+    double release_horizontal_spread_m = 0.0;
+    /// Who holds the mass until the release: false, a latch on the tool (the arm carries the
+    /// weight, and the release unloads it before the catch loads it); true, a hand fixed in the
+    /// world at the anchor's initial position (the arm feels the mass only through the cable, as
+    /// in the paper's protocol where the weight is let go by hand).
+    bool held_by_hand = false;
   } drop_test;
 
   struct Floor {
