@@ -137,6 +137,9 @@ struct TorqueTrackingRun {
   double p95_true_Nm = 0.0;
   double ee_position_rms_mm = 0.0;  ///< end-effector position error (task target vs plant)
   double ee_position_max_mm = 0.0;
+  /// RMS of the end effector's y and z position errors (target - plant) and velocity errors
+  /// (the target's reference velocity - plant), the axes of the paper's Fig. dynamic-comparison.
+  double ee_y_rms_mm = 0.0, ee_z_rms_mm = 0.0, ee_vy_rms_mm_s = 0.0, ee_vz_rms_mm_s = 0.0;
   int samples = 0;
   long qp_fallbacks = 0;      ///< cycles where the QP failed (should be 0)
   std::string csv_path;       ///< time series, when written
