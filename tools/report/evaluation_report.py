@@ -155,11 +155,13 @@ def drop_section(rep, out):
     d = f"{out}/drop_test"
     rep.h(2, "3. Drop test: torque vs position mode")
     rep.p("Protocol (paper, 'Stiffness in static configurations'; issue 15): the arm half extended forward holds the "
-          "6-D pose of its end effector; a 1.25 kg weight under the tool is let go at t = 6 s (a hand's release: fall "
-          "height and sideways offset vary by +-2 cm / +-1 cm per drop) and caught by a 25 cm cable; drop i uses noise "
-          "seed i and mismatch seed 1000 + i. Torque mode: custom low-level loop, stiff end-effector task (K 400), "
-          "null-space compliance, the paper code's external torque (momentum observer K_O = 10 plus the high-pass of "
-          "J^T F/T, complementary filter). Position mode: the vendor position servo on the QP's integrated state.")
+          "6-D pose of its end effector; a 1.25 kg weight held by a hand under the tool is let go (t = 6 s; quick: 2 s; "
+          "the fall height and sideways offset vary by +-2 cm / +-1 cm per drop) and caught by a 25 cm cable anchored "
+          "on the tool; drop i uses noise seed i and mismatch seed 1000 + i. Torque mode: custom low-level loop, stiff "
+          "end-effector task (K 400), null-space compliance, the paper code's external torque (momentum observer "
+          "K_O = 10 plus the high-pass of J^T F/T, complementary filter). Position mode: the vendor position servo "
+          "tracking the QP's acceleration integrated from the measured state (the closed variant; the paper's mc_rtc "
+          "integrates its own state open loop, not built here).")
     rep.p("Metrics over 6 s after the catch (cable taut, what the paper's F/T sensor synchronises on), e = target - "
           "measured end-effector z: peak = max |e|; residual = |mean of e over the last second|; stabilisation = time "
           "from the catch until e stays within 5 % of the peak around that mean (the paper does not state its band). "
@@ -167,6 +169,7 @@ def drop_section(rep, out):
           "rank-biserial correlation (the paper's 'effect size').")
     runs = read_rows(f"{d}/drop_test_runs.csv")
     st = drop_statistics(runs)
+    st["tail_sd"] = tail_sd(d)
     rep.table(statistics_table(st))
     verdicts = []
     for key, label in (("peak_mm", "peak"), ("stabilisation_s", "stabilisation"), ("residual_mm", "residual")):
@@ -184,10 +187,23 @@ def drop_section(rep, out):
     return st
 
 
+def tail_sd(d):
+    """Mean over drops of the error's standard deviation in the last second, per mode [mm]."""
+    rows = read_rows(f"{d}/drop_test_traces.csv")
+    t = np.array([float(r["t_s"]) for r in rows])
+    last = t >= t[-1] - 1.0
+    out = {}
+    for mode in ("torque", "position"):
+        cols = [c for c in rows[0] if c.startswith(mode + "_")]
+        sds = [np.std(np.array([float(r[c]) for r in rows])[last]) for c in cols]
+        out[mode] = float(np.mean(sds)) if sds else float("nan")
+    return out
+
+
 def drop_explanation(st):
     """Why the simulated drop test differs from the paper, from the plant's physics."""
     parts = []
-    if not (st["residual_mm"]["torque_better"]):
+    if not (st["residual_mm"]["torque_better"] and st["residual_mm"]["p"] < 0.01):
         parts.append("Residual: the plant's transmission is rigid and the vendor position servo has an integrator "
                      "acting on the joint angle, so in position mode the arm returns to its target exactly (residual "
                      "~0). On the real arm the harmonic drive is a torsional spring (catalogue CSF-17-100 about "
@@ -195,10 +211,16 @@ def drop_explanation(st):
                      "(10 N.m on joint 2) leaves ~0.7 mrad, i.e. ~0.6 mm at the tool, the order of the paper's "
                      "0.35 mm; torque mode closes on the link side and the F/T sensor and has no such deflection. "
                      "Joint elasticity is not in this plant (left for later), so it cannot show that effect.")
-    if not st["stabilisation_s"]["torque_better"]:
-        parts.append("Stabilisation: the cord (2000 N/m, damping ratio 0.1) bounces the mass for seconds; the "
-                     "sensitivity table shows how it depends on the cable damping.")
-    if not st["peak_mm"]["torque_better"]:
+    if not (st["stabilisation_s"]["torque_better"] and st["stabilisation_s"]["p"] < 0.01):
+        tail = st["tail_sd"]
+        parts.append("Stabilisation: the cord (2000 N/m, damping ratio 0.1) bounces the mass for seconds in both "
+                     "modes (it goes slack and catches again), which the sensitivity row with 50 N.s/m shortens. "
+                     "The band is relative (5 % of each drop's own peak): torque mode's peak is small, so its band is "
+                     f"about {0.05 * st['peak_mm']['torque_mean']:.3f} mm, while its error keeps wandering with a "
+                     f"standard deviation of {tail['torque']:.3f} mm in the last second (position: {tail['position']:.3f} "
+                     "mm): sensor noise through the fused external-torque estimate and stick-slip in the compliant null "
+                     "space. The smaller peak is what makes the torque mode's stabilisation long.")
+    if not (st["peak_mm"]["torque_better"] and st["peak_mm"]["p"] < 0.01):
         parts.append("Peak: torque mode rejects the catch only as fast as its external-torque estimate; see the "
                      "sensitivity rows with the observer alone.")
     return " ".join(parts) if parts else "The simulated plant reproduces the paper's ordering in all three metrics."
@@ -271,7 +293,7 @@ def draw_dynamic(d, output):
 def dual_section(rep, out):
     d = f"{out}/dual_compliance"
     rep.h(2, "5. Dual compliance")
-    rep.p("Dual compliance with the custom loop: a hand (a half-sine force on the tool, 20 N over 1.5 s) guides the end "
+    rep.p("Dual compliance with the custom loop: a hand (a half-sine force on the tool, 12 N peak over 1.5 s) guides the end "
           "effector sideways, then down, and lets go. Metrics per guide: trigger in/out times (Schmitt trigger on the "
           "F/T wrench norm, 8 up / 4 down as in the paper's Fig. dual-compliance), peak wrench norm, how far the end "
           "effector moved while touched, and its drift in the 2 s after the release (the pose at release becomes the "

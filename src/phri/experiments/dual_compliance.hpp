@@ -29,12 +29,12 @@ struct DualComplianceOptions {
   std::vector<double> start_q_rad = {0.0, 0.58, 3.14, -1.84, 0.0, 0.85, 1.57};
   double switch_s = 1.0;  ///< position control until then (F/T bias), then the custom loop
   /// The hand's guides: force on the tool (world axes) [N], start [s], duration [s] (half sine).
-  /// ESTIMATE: a hand pulling a tool by about 10 cm takes of the order of a second and 10-20 N.
+  /// ESTIMATE: a hand guiding a tool by ~10 cm: about a second and ~10 N, above the 8 N touch threshold.
   struct Guide {
     Eigen::Vector3d force_N;
     double start_s, duration_s;
   };
-  std::vector<Guide> guides = {{Eigen::Vector3d(0.0, 20.0, 0.0), 2.5, 1.5}, {Eigen::Vector3d(0.0, 0.0, -20.0), 6.5, 1.5}};
+  std::vector<Guide> guides = {{Eigen::Vector3d(0.0, 12.0, 0.0), 2.5, 1.5}, {Eigen::Vector3d(0.0, 0.0, -12.0), 6.5, 1.5}};
   double drift_window_s = 2.0;
   double duration_s = 10.5;
 };

@@ -112,6 +112,7 @@ void sensitivity(const EvaluationOptions& o, std::ostream& out) {
       {"cable_damping_50", [](DropTestOptions& d) { d.cable_damping_Ns_per_m = 50.0; }},
       {"vendor_gains_x0.5", [](DropTestOptions& d) { d.vendor_gain_scale = 0.5; }},
       {"no_release_spread", [](DropTestOptions& d) { d.release_spread_scale = 0.0; }},
+      {"weight_latched_on_tool", [](DropTestOptions& d) { d.held_by_hand = false; }},
   };
   for (const Variant& v : variants) {
     DropTestOptions d = drop_files(o, std::string("sensitivity/") + v.name);
