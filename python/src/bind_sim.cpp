@@ -112,7 +112,10 @@ void bind_config_parts(py::class_<SimRobotConfig>& c) {
       .def_readwrite("cable_damping_Ns_per_m", &C::DropTest::cable_damping_Ns_per_m)
       .def_readwrite("anchor_m", &C::DropTest::anchor_m, "Cable anchor in the sensor frame [m].")
       .def_readwrite("release_time_s", &C::DropTest::release_time_s)
-      .def_readwrite("latch_stiffness_N_per_m", &C::DropTest::latch_stiffness_N_per_m);
+      .def_readwrite("latch_stiffness_N_per_m", &C::DropTest::latch_stiffness_N_per_m)
+      .def_readwrite("release_vertical_spread_m", &C::DropTest::release_vertical_spread_m, "Hand's release: fall height +- [m].")
+      .def_readwrite("release_horizontal_spread_m", &C::DropTest::release_horizontal_spread_m, "Hand's release: sideways +- [m].")
+      .def_readwrite("held_by_hand", &C::DropTest::held_by_hand, "True: a hand, not the tool, holds the mass until release.");
   py::class_<C::FtSensor>(c, "FtSensor", "The F/T sensor between flange and tool.")
       .def_readwrite("rate_Hz", &C::FtSensor::rate_Hz)
       .def_readwrite("force_std_N", &C::FtSensor::force_std_N)
