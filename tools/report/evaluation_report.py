@@ -138,16 +138,34 @@ def torque_tracking_section(rep, out):
         rows.append([scen, f"{float(c['rms_Nm']):.4f}", f"{float(c['p95_Nm']):.4f}", f"{float(hv['rms_Nm']):.4f}",
                      f"{float(hv['p95_Nm']):.4f}", f"{ratio:.2f}", "custom below Kinova HV (Fig. torque-control-results, "
                      "log scale; no numbers given)"])
+    elastic = f"{out}/torque_tracking_elastic/torque_tracking_summary.csv"
+    if os.path.exists(elastic):
+        e = {(r["scenario"], r["loop"]): r for r in read_rows(elastic)}
+        c, hv = e.get(("static", "custom")), e.get(("static", "kinova_torque_high_velocity"))
+        if c is not None and hv is not None:
+            ratio = float(hv["rms_Nm"]) / float(c["rms_Nm"])
+            rows.append(["static, elastic joints", f"{float(c['rms_Nm']):.4f}", f"{float(c['p95_Nm']):.4f}",
+                         f"{float(hv['rms_Nm']):.4f}", f"{float(hv['p95_Nm']):.4f}", f"{ratio:.2f}", "(same figure)"])
     rep.table(md_table(["scenario", "custom RMS [N.m]", "custom p95", "Kinova HV RMS", "Kinova HV p95", "HV / custom",
                         "paper"], rows))
-    static = [r for r in rows if r[0] == "static"]
-    if static and float(static[0][5]) < 1.5:
+    static = [r for r in rows if r[0].startswith("static")]
+    if static and min(float(r[5]) for r in static) < 1.5:
         rep.p("Why the static ratio is near 1 here: at rest the inverse dynamics subtracts the observer's tau_ext, which "
               "converges to g - tau_s, so tau_d follows the sensors whatever loop runs; the loops differ only when joints "
-              "slide, i.e. through friction. The plant's transmission is rigid (no harmonic-drive elasticity between a "
-              "motor-side and a link-side encoder), so nothing oscillates in the transmission that the custom loop's "
-              "filter H(z) could damp better than Kinova's; the elastic plant of issue 15 was not built in this change, "
-              "so the comparison was not re-run on it.")
+              "slide, i.e. through friction, and with the paper's 1.25 kg on the tool no joint slides in either loop. "
+              "The paper shows a clear gap in its static figure; its arm evidently moved or rang where this rigid "
+              "plant rests.")
+    elastic_rows = [r for r in rows if r[0] == "static, elastic joints"]
+    if elastic_rows:
+        ratio = float(elastic_rows[0][5])
+        rep.p(f"Static scenario on the elastic plant (springs between rotor and link, torque sensors measuring them; "
+              f"run without retuning anything): Kinova HV / custom = {ratio:.2f}. "
+              + ("The custom loop does worse there: its error rings at about 50 Hz on joint 2 (the spectrum of "
+                 "torque_tracking_elastic/torque_tracking_static_custom.csv), an interaction of its transfer-function "
+                 "feedback lambda H(z) and friction pre-compensation with the drive's spring that the paper's real arm "
+                 "evidently does not show; the gains were identified on the real (elastic) arm, so the plant's "
+                 "spring, damping or rotor-side friction model is the suspect, not left tuned away here."
+                 if ratio < 1.0 else "The custom loop keeps its advantage on the elastic plant."))
     rep.figure(f"{d}/torque_tracking.png", "Torque tracking error, custom vs Kinova high-velocity loop")
 
 
@@ -159,9 +177,10 @@ def drop_section(rep, out):
           "the fall height and sideways offset vary by +-2 cm / +-1 cm per drop) and caught by a 25 cm cable anchored "
           "on the tool; drop i uses noise seed i and mismatch seed 1000 + i. Torque mode: custom low-level loop, stiff "
           "end-effector task (K 400), null-space compliance, the paper code's external torque (momentum observer "
-          "K_O = 10 plus the high-pass of J^T F/T, complementary filter). Position mode: the vendor position servo "
-          "tracking the QP's acceleration integrated from the measured state (the closed variant; the paper's mc_rtc "
-          "integrates its own state open loop, not built here).")
+          "K_O = 10 plus the high-pass of J^T F/T, complementary filter). Position mode: as the paper's mc_rtc, the QP "
+          "runs on its own state integrated open loop and the vendor position servo tracks it. Plant: elastic joints "
+          "(harmonic-drive springs between rotor and link, torque sensors measuring them; the servo closes on the "
+          "motor encoder).")
     rep.p("Metrics over 6 s after the catch (cable taut, what the paper's F/T sensor synchronises on), e = target - "
           "measured end-effector z: peak = max |e|; residual = |mean of e over the last second|; stabilisation = time "
           "from the catch until e stays within 5 % of the peak around that mean (the paper does not state its band). "
@@ -169,7 +188,7 @@ def drop_section(rep, out):
           "rank-biserial correlation (the paper's 'effect size').")
     runs = read_rows(f"{d}/drop_test_runs.csv")
     st = drop_statistics(runs)
-    st["tail_sd"] = tail_sd(d)
+    st["traces"] = trace_summary(d)
     rep.table(statistics_table(st))
     verdicts = []
     for key, label in (("peak_mm", "peak"), ("stabilisation_s", "stabilisation"), ("residual_mm", "residual")):
@@ -187,43 +206,51 @@ def drop_section(rep, out):
     return st
 
 
-def tail_sd(d):
-    """Mean over drops of the error's standard deviation in the last second, per mode [mm]."""
+def trace_summary(d):
+    """Per mode, from the traces: the error at the catch (before the shock reaches the arm) and the
+    error's standard deviation over the last second, averaged over drops [mm]."""
     rows = read_rows(f"{d}/drop_test_traces.csv")
     t = np.array([float(r["t_s"]) for r in rows])
     last = t >= t[-1] - 1.0
     out = {}
     for mode in ("torque", "position"):
         cols = [c for c in rows[0] if c.startswith(mode + "_")]
-        sds = [np.std(np.array([float(r[c]) for r in rows])[last]) for c in cols]
-        out[mode] = float(np.mean(sds)) if sds else float("nan")
+        series = [np.array([float(r[c]) for r in rows]) for c in cols]
+        out[mode] = {"at_catch": float(np.mean([x[0] for x in series])) if series else float("nan"),
+                     "tail_sd": float(np.mean([np.std(x[last]) for x in series])) if series else float("nan"),
+                     "shift": float(np.mean([np.mean(x[last]) - x[0] for x in series])) if series else float("nan")}
     return out
 
 
 def drop_explanation(st):
     """Why the simulated drop test differs from the paper, from the plant's physics."""
-    parts = []
-    if not (st["residual_mm"]["torque_better"] and st["residual_mm"]["p"] < 0.01):
-        parts.append("Residual: the plant's transmission is rigid and the vendor position servo has an integrator "
-                     "acting on the joint angle, so in position mode the arm returns to its target exactly (residual "
-                     "~0). On the real arm the harmonic drive is a torsional spring (catalogue CSF-17-100 about "
-                     "1.5e4 N.m/rad): if the servo closes on the motor-side encoder, the extra 12.3 N at ~0.85 m "
-                     "(10 N.m on joint 2) leaves ~0.7 mrad, i.e. ~0.6 mm at the tool, the order of the paper's "
-                     "0.35 mm; torque mode closes on the link side and the F/T sensor and has no such deflection. "
-                     "Joint elasticity is not in this plant (left for later), so it cannot show that effect.")
-    if not (st["stabilisation_s"]["torque_better"] and st["stabilisation_s"]["p"] < 0.01):
-        tail = st["tail_sd"]
-        parts.append("Stabilisation: the cord (2000 N/m, damping ratio 0.1) bounces the mass for seconds in both "
-                     "modes (it goes slack and catches again), which the sensitivity row with 50 N.s/m shortens. "
-                     "The band is relative (5 % of each drop's own peak): torque mode's peak is small, so its band is "
-                     f"about {0.05 * st['peak_mm']['torque_mean']:.3f} mm, while its error keeps wandering with a "
-                     f"standard deviation of {tail['torque']:.3f} mm in the last second (position: {tail['position']:.3f} "
-                     "mm): sensor noise through the fused external-torque estimate and stick-slip in the compliant null "
-                     "space. The smaller peak is what makes the torque mode's stabilisation long.")
+    tr = st["traces"]
+    parts = [f"Error before the shock (at the catch): torque {tr['torque']['at_catch']:.3f} mm, position "
+             f"{tr['position']['at_catch']:.3f} mm; the last second's mean minus it (the weight's own static effect): "
+             f"torque {tr['torque']['shift']:.3f} mm, position {tr['position']['shift']:.3f} mm."]
+    parts.append("Position mode: the paper's mc_rtc integrates the QP's own state open loop into the vendor servo, "
+                 "which closes on the motor-side encoder behind the harmonic drive's spring (K 1.3e4 N.m/rad large, "
+                 "5.5e3 small actuators): the servo's integrator brings the rotors back, but the links stay deflected "
+                 "by tau / K, under the arm's own weight before the drop and by the 1.25 kg weight after it. That "
+                 "deflection is the position residual; no feedback sees it (the QP's state is its own). Torque mode "
+                 "closes on the link-side joint positions and the F/T sensor and returns to its target.")
     if not (st["peak_mm"]["torque_better"] and st["peak_mm"]["p"] < 0.01):
         parts.append("Peak: torque mode rejects the catch only as fast as its external-torque estimate; see the "
                      "sensitivity rows with the observer alone.")
-    return " ".join(parts) if parts else "The simulated plant reproduces the paper's ordering in all three metrics."
+    else:
+        parts.append("Peak: the F/T sensor's fast part of the fused estimate cancels the catch within a cycle in torque "
+                     "mode; the position servo, behind the joints' springs, lets the catch through (the observer alone "
+                     "at K_O = 10 is far slower: see the sensitivity table).")
+    if not (st["stabilisation_s"]["torque_better"] and st["stabilisation_s"]["p"] < 0.01):
+        parts.append("Stabilisation: the band is relative (5 % of each drop's own peak): torque mode's small peak gives "
+                     f"a band of about {0.05 * st['peak_mm']['torque_mean']:.3f} mm, while its error keeps moving with "
+                     f"a standard deviation of {tr['torque']['tail_sd']:.3f} mm in the last second (position "
+                     f"{tr['position']['tail_sd']:.3f} mm): the mass keeps swinging on its 25 cm cord (a pendulum at "
+                     "1.0 Hz, started by the hand's sideways release offset, loading the tool at twice that), which the "
+                     "stiff position servo hardly shows and the torque-controlled end effector (K 400 1/s^2, through "
+                     "its estimate) does. The row without release spread (no swing) shortens it. The cord (2000 N/m, "
+                     "damping ratio 0.1) also bounces the mass for about 1.5 s in both modes.")
+    return " ".join(parts)
 
 
 def sensitivity_section(rep, out):
@@ -232,8 +259,11 @@ def sensitivity_section(rep, out):
         rep.p("Sensitivity table: not run (--quick).")
         return
     rep.h(3, "Sensitivity: the drop test with one setting changed")
-    rep.p("Fewer drops per variant (see the counts); same seeds as the main table. Joint elasticity is not a row: the "
-          "plant has none (not built in this change).")
+    rep.p("Fewer drops per variant (see the counts); same seeds as the main table; each row changes one thing from the "
+          "main table's setting: the external-torque source and observer gain, the cable damping (50 N.s/m: damping "
+          "ratio 0.5), the vendor servo gains (x 0.5), no release spread, the weight latched on the tool (the arm "
+          "carries it until the release), rigid joints, the servo on the link-side encoder, softer joints (4000 / 3500 "
+          "N.m/rad, a Gen3 impedance controller's tuned values), the position-mode QP on the measured state.")
     rows = []
     for name in sorted(os.listdir(base)):
         path = f"{base}/{name}/drop_test_runs.csv"
@@ -340,7 +370,8 @@ def main(argv):
     rep.p(f"Protocol: {'QUICK (shortened protocols: a smoke test, not the paper numbers)' if mode == 'quick' else 'full'}; "
           f"experiments took {seconds:.1f} s of wall time. Reproduce: phri evaluate --out {out}"
           f"{' --quick' if mode == 'quick' else ''}. Plant: MuJoCo Gen3 with drive friction, rotor inertia, sensor "
-          "noise, 5 % link and drive-gain mismatch, a rigid transmission (no joint elasticity).")
+          "noise, 5 % link and drive-gain mismatch; rigid joints except in the drop test, which enables the plant's joint "
+          "elasticity (plant.elasticity).")
     friction_section(rep, out)
     torque_tracking_section(rep, out)
     drop_section(rep, out)

@@ -366,6 +366,12 @@ CycleStatus Controller::step(const RobotState& state, const ControllerTargets& t
                                           settings_.period_s + supervisor_.settings().max_degraded_s)
                              : settings_.period_s;
   estimate(state, dt);
+  if (settings_.position_mode_open_loop && low_level_.integrating_position()) {
+    // The paper's position mode: the QP sees its own integrated state, not the arm.
+    q_ = low_level_.position_reference();
+    qd_ = low_level_.velocity_reference();
+    compute_all_terms(model_, data_, q_, qd_);
+  }
 
   // ---- modes and targets
   if (!started_) {

@@ -92,6 +92,11 @@ struct ControllerSettings {
   /// of 5x more torque-sensor noise in tau_ext (about 0.05 N.m rms with the plant's sensor noise).
   double observer_gain = 50.0;
   ExternalTorqueSource external_torque_source = ExternalTorqueSource::kObserver;
+  /// Under the robot's position loop, the QP runs on the measured state (false: what the servo
+  /// cannot follow comes back as task error and is corrected) or, as the paper's mc_rtc controller
+  /// in position mode ("OpenLoop", reference notes paper_parameters section 1.1), on the state the
+  /// low level integrates from its own accelerations (true: the servo alone rejects disturbances).
+  bool position_mode_open_loop = false;
   WholeBodyQpSettings qp;  ///< torque/velocity limits default to actuators.yaml's
   /// Dead band of tau_ext in the compliant tasks when qp.compliance_deadband is empty, by actuator
   /// size [N.m]: above the estimate's bias (5 % mismatch, sensor offsets), far below a push.

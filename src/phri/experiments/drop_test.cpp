@@ -32,6 +32,7 @@ ControllerSettings drop_settings(const DropTestOptions& o, DropMode mode) {
   s.initial_loop = LowLevelMode::kPosition;
   s.observer_gain = o.observer_gain;
   s.external_torque_source = o.external_torque_source;
+  s.position_mode_open_loop = o.position_open_loop;
   // Position mode: the vendor servo holds the QP's pose; the task is stiff (no compliance to show).
   s.initial_compliance = mode == DropMode::kTorque ? o.torque_compliance : ComplianceMode::kStiff;
   return s;
@@ -47,6 +48,9 @@ SimRobotConfig drop_plant(const DropShared& sh, int index) {
   c.drop_test.enabled = true;
   c.drop_test.release_time_s = o.release_s;
   c.drop_test.held_by_hand = o.held_by_hand;
+  c.elasticity.enabled = o.elastic;
+  c.elasticity.position_loop_encoder = o.servo_encoder;
+  if (o.joint_stiffness_Nm_per_rad) c.elasticity.stiffness_Nm_per_rad = *o.joint_stiffness_Nm_per_rad;
   if (o.cable_damping_Ns_per_m) c.drop_test.cable_damping_Ns_per_m = *o.cable_damping_Ns_per_m;
   if (o.release_spread_scale) {
     c.drop_test.release_vertical_spread_m *= *o.release_spread_scale;
@@ -227,7 +231,12 @@ std::string drop_test_table(const DropTestResult& r, const DropTestOptions& o) {
   }
   s << "\n" << o.drops << " drops per mode; torque mode: " << to_string(o.torque_loop) << " loop, "
     << to_string(o.torque_compliance) << " compliance, external torque " << to_string(o.external_torque_source)
-    << ", K_O " << format_fixed(o.observer_gain, 0) << " 1/s; release at " << format_fixed(o.release_s, 1)
+    << ", K_O " << format_fixed(o.observer_gain, 0) << " 1/s; position mode "
+    << (o.position_open_loop ? "open loop (the paper's)" : "on the measured state") << "; "
+    << (o.elastic ? std::string("elastic joints, servo on the ") +
+                        (o.servo_encoder == SimRobotConfig::Elasticity::Encoder::kMotor ? "motor" : "link") + " encoder"
+                  : std::string("rigid joints"))
+    << "; release at " << format_fixed(o.release_s, 1)
     << " s, metrics over " << format_fixed(o.window_s, 1) << " s after the catch. Simulated "
     << format_fixed(r.simulated_s, 0) << " s in " << format_fixed(r.wall_s, 1) << " s of wall time (" << o.jobs
     << " jobs).\n";

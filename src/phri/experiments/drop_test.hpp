@@ -19,6 +19,7 @@
 #include <phri/control/compliance_mode.hpp>
 #include <phri/control/controller_settings.hpp>
 #include <phri/robot/low_level_mode.hpp>
+#include <phri/sim/sim_robot_config.hpp>
 
 #include <cstdint>
 #include <iosfwd>
@@ -63,6 +64,20 @@ struct DropTestOptions {
   /// paper_parameters section 4) and its complementary F/T fusion ("use_force_sensor", section 1.6).
   double observer_gain = 10.0;
   ExternalTorqueSource external_torque_source = ExternalTorqueSource::kFused;
+
+  /// Position mode as the paper runs it: the QP integrates its own state open loop into the
+  /// vendor servo (ControllerSettings::position_mode_open_loop); false: the QP on the measured state.
+  bool position_open_loop = true;
+
+  // ---- plant
+  /// Joint elasticity (the plant file's plant.elasticity, enabled here): the harmonic drives'
+  /// torsional springs between motor and link, the torque sensors measuring them.
+  bool elastic = true;
+  /// The vendor position servo's encoder with elastic joints. Motor side: a servo closed through an
+  /// elastic transmission on the link side is non-collocated (prone to ring); drives with both
+  /// encoders close the position loop on the motor (Kinova does not document which).
+  SimRobotConfig::Elasticity::Encoder servo_encoder = SimRobotConfig::Elasticity::Encoder::kMotor;
+  std::optional<std::vector<double>> joint_stiffness_Nm_per_rad;  ///< empty: the plant file's
 
   // ---- plant variations for the sensitivity table (empty: the plant file's values)
   bool model_mismatch = true;

@@ -62,6 +62,16 @@ void torque_tracking(const EvaluationOptions& o, std::ostream& out) {
     t.dynamic_duration_s = 4.0;
   }
   run_torque_tracking_command(t, out);
+  // Issue 15: the static comparison again on the elastic plant (the spring between the drive and
+  // the sensor is what the custom loop's filter H(z) was designed against).
+  out << "-- static scenario, elastic joints" << std::endl;
+  TorqueTrackingOptions e = tracking_files(o, "torque_tracking_elastic");
+  e.scenarios = {TrackingScenario::kStatic};
+  e.elastic = true;
+  e.figure_script.clear();
+  if (o.quick) e.static_duration_s = 2.0;
+  const TorqueTrackingResult r = run_torque_tracking(e, nullptr);
+  out << torque_tracking_table(r, e);
 }
 
 // The dynamic scenario with the four low-level loops of the paper's Fig. dynamic-comparison.
@@ -113,6 +123,11 @@ void sensitivity(const EvaluationOptions& o, std::ostream& out) {
       {"vendor_gains_x0.5", [](DropTestOptions& d) { d.vendor_gain_scale = 0.5; }},
       {"no_release_spread", [](DropTestOptions& d) { d.release_spread_scale = 0.0; }},
       {"weight_latched_on_tool", [](DropTestOptions& d) { d.held_by_hand = false; }},
+      {"rigid_joints", [](DropTestOptions& d) { d.elastic = false; }},
+      {"servo_on_link_encoder", [](DropTestOptions& d) { d.servo_encoder = SimRobotConfig::Elasticity::Encoder::kLink; }},
+      {"soft_joints_4000_3500",
+       [](DropTestOptions& d) { d.joint_stiffness_Nm_per_rad = std::vector<double>{4000, 4000, 4000, 4000, 3500, 3500, 3500}; }},
+      {"position_qp_on_measured_state", [](DropTestOptions& d) { d.position_open_loop = false; }},
   };
   for (const Variant& v : variants) {
     DropTestOptions d = drop_files(o, std::string("sensitivity/") + v.name);

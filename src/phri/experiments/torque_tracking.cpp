@@ -118,6 +118,7 @@ SimRobotConfig plant_config(const TorqueTrackingOptions& o, TrackingScenario sce
   c.initial_q_rad = o.start_q_rad;
   c.seed = o.seed;
   c.mismatch.enabled = o.model_mismatch;
+  if (o.elastic) c.elasticity.enabled = true;
   if (o.torque_constant_error >= 0.0) c.mismatch.torque_constant_fraction = o.torque_constant_error;
   if (o.mismatch_seed) c.mismatch.seed = *o.mismatch_seed;
   if (o.friction_perturbation > 0.0) {

@@ -76,6 +76,7 @@ struct TorqueTrackingOptions {
   // ---- plant
   std::uint64_t seed = 1;              ///< sensor noise (and friction perturbation)
   bool model_mismatch = true;          ///< plant link inertials +-5 % from the controller's URDF
+  bool elastic = false;                ///< the plant's joint elasticity (plant.elasticity) enabled
   double friction_perturbation = 0.0;  ///< plant friction off actuators.yaml by up to this fraction
   /// Start posture: the paper demo's postureTarget (arm half extended forward).
   std::vector<double> start_q_rad = {0.0, 0.58, 3.14, -1.84, 0.0, 0.85, 1.57};

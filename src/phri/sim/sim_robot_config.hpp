@@ -138,6 +138,18 @@ struct SimRobotConfig {
     double high_velocity_rate_Hz = 1000.0;
   } vendor;
 
+  // ---- joint elasticity: a torsional spring between each drive's rotor and its link
+  // (ElasticTransmission); off: a rigid transmission (rotor inertia and friction on the link).
+  struct Elasticity {
+    bool enabled = false;
+    /// K per joint [N.m/rad]; empty: by actuator size (configs/plant_gen3.yaml gives the source).
+    std::vector<double> stiffness_Nm_per_rad;
+    /// D = 2 ratio sqrt(K B) in parallel with K (B the reflected rotor inertia).
+    double damping_ratio = 0.05;
+    /// Which encoder the vendor position servo closes on; the arm reports the link side.
+    enum class Encoder { kMotor, kLink } position_loop_encoder = Encoder::kMotor;
+  } elasticity;
+
   // ---- the paper's drop test: a mass on a slack cable under the tool, released at a given time
   struct DropTest {
     bool enabled = false;

@@ -1,0 +1,81 @@
+// ctest-labels: physics
+// Joint elasticity in the simulated plant (SimRobotConfig::Elasticity, ElasticTransmission): at rest
+// under the vendor position servo, the spring carries the gravity torque MuJoCo computes for the
+// link (qfrc_bias), the torque sensor reads it, and the link sags by tau / K behind a motor-side
+// servo while a link-side servo holds the link itself at its set-point.
+#include <phri/sim/sim_robot.hpp>
+
+#include <mujoco/mujoco.h>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+namespace {
+
+const std::string kRoot = PHRI_SOURCE_DIR;
+const std::vector<double> kPose = {0.0, 0.58, 3.14, -1.84, 0.0, 0.85, 1.57};
+
+struct Held {
+  Eigen::VectorXd q_link, q_motor, tau_sensor, gravity, command;
+};
+
+Held hold_at_rest(phri::SimRobotConfig::Elasticity::Encoder encoder) {
+  phri::SimRobotConfig c = phri::SimRobotConfig::from_yaml_file(kRoot + "/configs/plant_gen3.yaml");
+  c.initial_q_rad = kPose;
+  c.noise.torque_sensor_std_Nm = 0.0;
+  c.noise.velocity_std_rad_s = 0.0;
+  c.noise.current_std_A = 0.0;
+  c.noise.encoder_counts_per_rev = 0.0;
+  c.noise.torque_sensor_offset_Nm.assign(7, 0.0);
+  c.elasticity.enabled = true;
+  c.elasticity.position_loop_encoder = encoder;
+  phri::SimRobot robot(c);
+  phri::RobotCommand hold(7);
+  hold.mode = phri::LowLevelMode::kPosition;
+  hold.q_rad = Eigen::Map<const Eigen::VectorXd>(kPose.data(), 7);
+  for (int k = 0; k < 4000; ++k) {
+    robot.write(hold);
+    robot.read();
+  }
+  Held h;
+  h.q_link = robot.truth().q_rad;
+  h.q_motor = robot.truth().q_motor_rad;
+  h.tau_sensor = robot.truth().tau_transmitted_Nm;
+  h.gravity = Eigen::VectorXd(7);
+  const mjModel* m = robot.mujoco_model();
+  const mjData* d = robot.mujoco_data();
+  for (int i = 0; i < 7; ++i) h.gravity[i] = d->qfrc_bias[i];  // the arm's 7 hinges come first in the scene
+  (void)m;
+  h.command = hold.q_rad;
+  EXPECT_FALSE(robot.state().fault);
+  return h;
+}
+
+TEST(SimElastic, MotorSideServoLeavesTheLinkSaggingByTorqueOverStiffness) {
+  const Held h = hold_at_rest(phri::SimRobotConfig::Elasticity::Encoder::kMotor);
+  const phri::SimRobotConfig c = phri::SimRobotConfig::from_yaml_file(kRoot + "/configs/plant_gen3.yaml");
+  for (int i = 0; i < 7; ++i) {
+    const double k = c.elasticity.stiffness_Nm_per_rad[static_cast<std::size_t>(i)];
+    // At rest the spring holds the link against gravity, and the sensor measures the spring.
+    EXPECT_NEAR(h.tau_sensor[i], h.gravity[i], 0.02 + 1e-3 * std::abs(h.gravity[i])) << "joint " << i + 1;
+    // The servo's integrator brings the rotor to the set-point; the link sits tau / K behind it.
+    EXPECT_NEAR(h.q_motor[i], h.command[i], 2e-5) << "joint " << i + 1;
+    EXPECT_NEAR(h.q_link[i] - h.q_motor[i], -h.gravity[i] / k, 2e-5 + 1e-3 * std::abs(h.gravity[i] / k)) << "joint " << i + 1;
+  }
+  std::printf("joint 2: gravity %.2f N.m, link - motor %.3f mrad (-tau/K %.3f mrad)\n", h.gravity[1],
+              1e3 * (h.q_link[1] - h.q_motor[1]), -1e3 * h.gravity[1] / 13000.0);
+}
+
+TEST(SimElastic, LinkSideServoHoldsTheLinkItself) {
+  const Held h = hold_at_rest(phri::SimRobotConfig::Elasticity::Encoder::kLink);
+  for (int i = 0; i < 7; ++i) {
+    EXPECT_NEAR(h.q_link[i], h.command[i], 2e-5) << "joint " << i + 1;
+    EXPECT_NEAR(h.tau_sensor[i], h.gravity[i], 0.02 + 1e-3 * std::abs(h.gravity[i])) << "joint " << i + 1;
+  }
+}
+
+}  // namespace
