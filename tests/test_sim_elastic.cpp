@@ -3,7 +3,10 @@
 // under the vendor position servo, the spring carries the gravity torque MuJoCo computes for the
 // link (qfrc_bias), the torque sensor reads it, and the link sags by tau / K behind a motor-side
 // servo while a link-side servo holds the link itself at its set-point.
+#include <phri/control/controller.hpp>
 #include <phri/sim/sim_robot.hpp>
+
+#include "gen3_settings.hpp"
 
 #include <mujoco/mujoco.h>
 
@@ -76,6 +79,37 @@ TEST(SimElastic, LinkSideServoHoldsTheLinkItself) {
     EXPECT_NEAR(h.q_link[i], h.command[i], 2e-5) << "joint " << i + 1;
     EXPECT_NEAR(h.tau_sensor[i], h.gravity[i], 0.02 + 1e-3 * std::abs(h.gravity[i])) << "joint " << i + 1;
   }
+}
+
+// The paper's position mode (ControllerSettings::position_mode_open_loop) on the elastic plant: the
+// QP runs on the state the low level integrates, so nothing feeds the links' deflection back; the
+// reference stays where the arm was when the loop started and the links settle tau / K below the
+// rotors, with tau the gravity torque MuJoCo computes at the settled pose.
+TEST(SimElastic, OpenLoopPositionModeLeavesTheSpringDeflectionUncorrected) {
+  phri::SimRobotConfig c = phri::SimRobotConfig::from_yaml_file(kRoot + "/configs/plant_gen3.yaml");
+  c.initial_q_rad = kPose;
+  c.elasticity.enabled = true;
+  phri::SimRobot robot(c);
+  phri::ControllerSettings s = phri::test::gen3_controller_settings(phri::ComplianceMode::kStiff);
+  s.position_mode_open_loop = true;
+  phri::Controller cycle(s);
+  phri::RobotCommand command(7);
+  phri::ControllerTargets targets(7);
+  const Eigen::VectorXd q_start = robot.state().q_rad;
+  for (int k = 0; k < 3000; ++k) {
+    const phri::RobotState& state = robot.read();
+    cycle.step(state, targets, command);
+    robot.write(command);
+  }
+  const Eigen::VectorXd& q_ref = cycle.low_level().position_reference();
+  const mjData* d = robot.mujoco_data();
+  for (int i = 0; i < 7; ++i) {
+    const double k = c.elasticity.stiffness_Nm_per_rad[static_cast<std::size_t>(i)];
+    EXPECT_NEAR(q_ref[i], q_start[i], 1e-4) << "joint " << i + 1;  // the QP saw no error to correct
+    EXPECT_NEAR(robot.truth().q_rad[i] - q_ref[i], -d->qfrc_bias[i] / k, 5e-5 + 0.02 * std::abs(d->qfrc_bias[i] / k))
+        << "joint " << i + 1;
+  }
+  EXPECT_FALSE(robot.state().fault);
 }
 
 }  // namespace
