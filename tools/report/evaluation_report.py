@@ -164,7 +164,7 @@ def torque_tracking_section(rep, out):
                  "torque_tracking_elastic/torque_tracking_static_custom.csv), an interaction of its transfer-function "
                  "feedback lambda H(z) and friction pre-compensation with the drive's spring that the paper's real arm "
                  "evidently does not show; the gains were identified on the real (elastic) arm, so the plant's "
-                 "spring, damping or rotor-side friction model is the suspect, not left tuned away here."
+                 "spring, damping or rotor-side friction model is the suspect; nothing was tuned to hide it."
                  if ratio < 1.0 else "The custom loop keeps its advantage on the elastic plant."))
     rep.figure(f"{d}/torque_tracking.png", "Torque tracking error, custom vs Kinova high-velocity loop")
 
@@ -294,8 +294,9 @@ def dynamic_section(rep, out):
     rep.table(md_table(["loop", "y RMS [mm]", "z RMS [mm]", "v_y RMS [mm/s]", "v_z RMS [mm/s]", "torque RMS [N.m]"], rows))
     rep.p("Paper (Fig. dynamic-comparison, no numbers): custom torque control about as precise as position control; "
           "much more precise than Kinova's torque loop. Differences: the paper's position mode integrates its QP state "
-          "open loop into the vendor servo, here the QP runs on the measured state (closed variant only); the plant is "
-          "rigid, so position control tracks with the vendor servo's full stiffness.")
+          "open loop into the vendor servo; here the QP runs on the measured state (the open-loop variant, "
+          "controller.position_mode_open_loop, is what the drop test uses); the joints are rigid here, so position "
+          "control tracks with the vendor servo's full stiffness.")
     draw_dynamic(d, f"{d}/dynamic_tracking.png")
     rep.figure(f"{d}/dynamic_tracking.png", "Dynamic tracking: y and z position and velocity errors per loop")
 
