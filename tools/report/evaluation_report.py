@@ -259,7 +259,7 @@ def sensitivity_section(rep, out):
         rep.p("Sensitivity table: not run (--quick).")
         return
     rep.h(3, "Sensitivity: the drop test with one setting changed")
-    rep.p("Fewer drops per variant (see the counts); same seeds as the main table; each row changes one thing from the "
+    rep.p("Fewer drops per variant (see the counts) released at 3 s; same seeds as the main table; each row changes one thing from the "
           "main table's setting: the external-torque source and observer gain, the cable damping (50 N.s/m: damping "
           "ratio 0.5), the vendor servo gains (x 0.5), no release spread, the weight latched on the tool (the arm "
           "carries it until the release), rigid joints, the servo on the link-side encoder, softer joints (4000 / 3500 "

@@ -7,6 +7,7 @@
 #include <phri/experiments/friction_identification.hpp>
 #include <phri/experiments/torque_tracking.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <ostream>
 #include <sstream>
@@ -132,6 +133,7 @@ void sensitivity(const EvaluationOptions& o, std::ostream& out) {
   for (const Variant& v : variants) {
     DropTestOptions d = drop_files(o, std::string("sensitivity/") + v.name);
     d.drops = o.sensitivity_drops;
+    d.release_s = std::min(d.release_s, 3.0);  // 2 s of torque control before the drop settle the arm
     d.figure_script.clear();
     v.apply(d);
     out << "-- " << v.name << std::endl;
