@@ -5,6 +5,10 @@
 //   phri identify-friction [options]           the paper's friction identification (simulated arm)
 //   phri experiment torque-tracking [options]  the paper's torque-tracking comparison
 //   phri experiment safety-fuzz [options]      seeded pushes and sensor faults against the safety stage
+//   phri experiment drop-test [options]        30 + 30 drops, torque vs position mode
+//   phri experiment dynamic-tracking [options] the dynamic scenario with the four low-level loops
+//   phri experiment dual-compliance [options]  guiding the end effector by hand, release, drift
+//   phri evaluate [--out DIR] [--quick]        all five of the paper's evaluations and report.md/.html
 // Every bad argument or file, and every failure of a run or an experiment (phri::Error: ConfigError,
 // IoError, ExperimentError), gives one line on stderr naming what is wrong and a non-zero exit status.
 #include <phri/app/config.hpp>
@@ -14,6 +18,9 @@
 #include <phri/core/process.hpp>
 #include <phri/sim/sim_robot.hpp>
 #include <phri/core/version.hpp>
+#include <phri/experiments/drop_test.hpp>
+#include <phri/experiments/dual_compliance.hpp>
+#include <phri/experiments/evaluation.hpp>
 #include <phri/experiments/experiment_files.hpp>
 #include <phri/experiments/friction_identification.hpp>
 #include <phri/experiments/safety_fuzz.hpp>
@@ -292,6 +299,59 @@ int safety_fuzz_command(SafetyFuzzArguments& args) {
   return phri::run_safety_fuzz_command(o, args.fail_on_violation, std::cout);
 }
 
+struct DropArguments {
+  phri::DropTestOptions drop;
+  std::string source = "fused";
+  double cable_damping = -1.0;  // < 0: the plant file's
+};
+
+CLI::App* add_drop_test_command(CLI::App& experiment, DropArguments& args) {
+  auto* drop = experiment.add_subcommand("drop-test", "The paper's drop test: torque vs position mode, metrics per drop");
+  phri::DropTestOptions& o = args.drop;
+  drop->add_option("--drops", o.drops, "drops per mode")->check(CLI::Range(1, 1000))->capture_default_str();
+  drop->add_option("--jobs", o.jobs, "threads (drops are independent)")->check(CLI::Range(1, 64))->capture_default_str();
+  drop->add_option("--out", o.output_dir, "output folder")->capture_default_str();
+  drop->add_option("--seed", o.first_seed, "noise seed of the first drop (mismatch: + 1000)")->capture_default_str();
+  drop->add_option("--source", args.source, "external torque of the torque mode: observer, ft or fused")
+      ->check(CLI::IsMember({"observer", "ft", "fused"}))
+      ->capture_default_str();
+  drop->add_option("--observer-gain", o.observer_gain, "K_O [1/s]")->check(CLI::Range(0.1, 999.0))->capture_default_str();
+  drop->add_option("--release", o.release_s, "release time [s]")->check(CLI::Range(1.0, 100.0))->capture_default_str();
+  drop->add_option("--cable-damping", args.cable_damping, "cable damping [N.s/m] (default: the plant file's)")
+      ->check(CLI::Range(0.0, 1e4));
+  return drop;
+}
+
+int drop_test_command(DropArguments& args) {
+  phri::DropTestOptions& o = args.drop;
+  o.external_torque_source = *phri::external_torque_source_from_string(args.source);
+  if (args.cable_damping >= 0.0) o.cable_damping_Ns_per_m = args.cable_damping;
+  for (std::string* path : {&o.plant_config_path, &o.urdf_path, &o.actuators_path, &o.collision_path, &o.figure_script}) {
+    *path = locate(*path);
+  }
+  phri::ensure_output_directory(o.output_dir);
+  return phri::run_drop_test_command(o, std::cout);
+}
+
+int dynamic_tracking_command(phri::TorqueTrackingOptions t) {
+  for (std::string* path : {&t.plant_config_path, &t.urdf_path, &t.actuators_path, &t.collision_path}) *path = locate(*path);
+  phri::ensure_output_directory(t.output_dir);
+  return phri::run_torque_tracking_command(t, std::cout);
+}
+
+int dual_compliance_command(phri::DualComplianceOptions d) {
+  for (std::string* path : {&d.plant_config_path, &d.urdf_path, &d.actuators_path, &d.collision_path}) *path = locate(*path);
+  phri::ensure_output_directory(d.output_dir);
+  return phri::run_dual_compliance_command(d, std::cout);
+}
+
+// `phri evaluate`: the files are found from the working directory, else from the source tree.
+int evaluate_command(phri::EvaluationOptions e) {
+  const std::string probe = locate("configs/plant_gen3.yaml");
+  e.root = probe == "configs/plant_gen3.yaml" ? "." : std::string(PHRI_SOURCE_DIR);
+  return phri::run_evaluation_command(e, std::cout);
+}
+
 // `phri identify-friction`: the experiment with its files found (see locate).
 int friction_identification_command(phri::FrictionIdentificationOptions friction) {
   for (std::string* path : {&friction.plant_config_path, &friction.urdf_path, &friction.figure_script}) *path = locate(*path);
@@ -381,6 +441,10 @@ int main(int argc, char** argv) {
   phri::FrictionIdentificationOptions friction;
   TrackingArguments tracking_args;
   SafetyFuzzArguments fuzz_args;
+  DropArguments drop_args;
+  phri::TorqueTrackingOptions dynamic_options = phri::dynamic_tracking_options();
+  phri::DualComplianceOptions dual_options;
+  phri::EvaluationOptions evaluation;
   const CLI::App* run = add_run_command(app, run_args);
   const CLI::App* info = add_info_command(app, info_args);
   const CLI::App* identify = add_identify_command(app, friction);
@@ -391,6 +455,18 @@ int main(int argc, char** argv) {
   auto* friction_alias = experiment->add_subcommand("friction-identification", "Same as 'phri identify-friction'");
   friction_alias->add_option("--out", friction.output_dir, "output folder");
   friction_alias->add_option("--seed", friction.seed, "seed");
+  const CLI::App* drop = add_drop_test_command(*experiment, drop_args);
+  auto* dynamic = experiment->add_subcommand("dynamic-tracking", "The dynamic scenario: position, custom, Kinova torque loops");
+  dynamic->add_option("--out", dynamic_options.output_dir, "output folder")->capture_default_str();
+  dynamic->add_option("--duration", dynamic_options.dynamic_duration_s, "after the switch [s]")
+      ->check(CLI::Range(1.0, 600.0))
+      ->capture_default_str();
+  auto* dual = experiment->add_subcommand("dual-compliance", "Guide the end effector by hand in dual compliance, release");
+  dual->add_option("--out", dual_options.output_dir, "output folder")->capture_default_str();
+  auto* evaluate = app.add_subcommand("evaluate", "The paper's five evaluations and a report (report.md, report.html)");
+  evaluate->add_option("--out", evaluation.output_dir, "output folder")->capture_default_str();
+  evaluate->add_flag("--quick", evaluation.quick, "short protocols (a smoke test; not the paper's numbers)");
+  evaluate->add_option("--jobs", evaluation.jobs, "threads for the drops")->check(CLI::Range(1, 64))->capture_default_str();
 
   if (const std::string error = command_word_error(app, argc, argv); !error.empty()) return print_error(error.c_str());
   try {
@@ -404,6 +480,10 @@ int main(int argc, char** argv) {
     if (identify->parsed() || friction_alias->parsed()) return friction_identification_command(friction);
     if (tracking->parsed()) return torque_tracking_command(tracking_args);
     if (fuzz->parsed()) return safety_fuzz_command(fuzz_args);
+    if (drop->parsed()) return drop_test_command(drop_args);
+    if (dynamic->parsed()) return dynamic_tracking_command(dynamic_options);
+    if (dual->parsed()) return dual_compliance_command(dual_options);
+    if (evaluate->parsed()) return evaluate_command(evaluation);
   } catch (const phri::Error& e) {
     return print_error(e.what());
   } catch (const std::exception& e) {  // from a library below (yaml-cpp, the standard library)

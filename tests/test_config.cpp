@@ -174,6 +174,15 @@ TEST(Config, WrongTypesNameTheirPath) {
                       {.element = "events[1].event", .mentions = {"unknown event"}, .file = "test.yaml"});
 }
 
+TEST(Config, ExternalTorqueSourceIsChosenByName) {
+  EXPECT_EQ(load_edited("external_torque_source: observer", "external_torque_source: fused").controller.external_torque_source,
+            phri::ExternalTorqueSource::kFused);
+  EXPECT_EQ(load_edited("external_torque_source: observer", "external_torque_source: ft").controller.external_torque_source,
+            phri::ExternalTorqueSource::kForceTorqueSensor);
+  expect_config_error(loading_demo_with("external_torque_source: observer", "external_torque_source: both"),
+                      {.element = "controller.external_torque_source", .mentions = {"one of"}, .file = "test.yaml"});
+}
+
 TEST(Config, SectionOfTheWrongKind) {
   const std::string head =
       "robot: {urdf: ../robots/kinova_gen3/gen3.urdf, actuators: ../robots/kinova_gen3/actuators.yaml}\n"

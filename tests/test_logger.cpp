@@ -122,7 +122,7 @@ TEST(Logger, HeaderNamesEveryColumnOnce) {
     EXPECT_FALSE(n[0] >= '0' && n[0] <= '9') << n;
   }
   for (const char* expected : {"q_1", "q_7", "qd_7", "tau_d_1", "tau_s_4", "tau_ext_7", "current_1", "ee_qw",
-                               "target_z", "err_pos_m", "err_ori_rad", "wrench_fx", "wrench_norm", "compliance_mode",
+                               "target_z", "err_pos_m", "err_ori_rad", "ee_vy", "target_vz", "wrench_fx", "wrench_norm", "compliance_mode",
                                "touched", "low_level_loop", "event", "cycle_status", "qp_status", "cycle_time_s"}) {
     EXPECT_EQ(unique.count(expected), 1u) << expected;
   }

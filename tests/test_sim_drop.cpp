@@ -31,6 +31,8 @@ TEST(SimRobotDrop, MassFallsJerksTheCableAndTheSensorSeesTheShock) {
   c.initial_q_rad = kTarget;
   c.drop_test.enabled = true;
   c.drop_test.release_time_s = 0.2;
+  c.drop_test.release_vertical_spread_m = 0.0;  // the closed forms below: a fall of exactly L
+  c.drop_test.release_horizontal_spread_m = 0.0;
   phri::SimRobot robot(c);
   phri::RobotCommand hold(7);
   hold.mode = phri::LowLevelMode::kPosition;
@@ -131,6 +133,74 @@ TEST(SimRobotDrop, MassFallsJerksTheCableAndTheSensorSeesTheShock) {
   EXPECT_GT(ee_peak, 1e-3);
   EXPECT_LT(ee_final, 2e-4);
   EXPECT_FALSE(robot.state().fault);
+}
+
+// A hand's release varies from run to run: the fall height (hence the impact speed, a free fall)
+// follows the drawn vertical offset, the same seed draws the same release, another seed another.
+TEST(SimRobotDrop, ReleaseSpreadChangesTheFallHeightPerSeed) {
+  auto impact = [](std::uint64_t seed, double& start_offset_z) {
+    phri::SimRobotConfig c = phri::SimRobotConfig::from_yaml_file(kRoot + "/configs/plant_gen3.yaml");
+    c.initial_q_rad = kTarget;
+    c.seed = seed;
+    c.drop_test.enabled = true;
+    c.drop_test.release_time_s = 0.05;
+    c.drop_test.release_vertical_spread_m = 0.03;
+    c.drop_test.release_horizontal_spread_m = 0.01;
+    phri::SimRobot robot(c);
+    phri::RobotCommand hold(7);
+    hold.mode = phri::LowLevelMode::kPosition;
+    hold.q_rad = Eigen::Map<const Eigen::VectorXd>(kTarget.data(), 7);
+    double v_in = 0.0;
+    Eigen::Vector3d p_release = Eigen::Vector3d::Zero();
+    for (int k = 0; k < 600; ++k) {
+      robot.write(hold);
+      robot.read();
+      const auto& t = robot.truth();
+      if (k == 49) p_release = t.drop_mass_position_m;
+      if (t.cable_force_N > 0.0 && t.drop_released) {
+        v_in = -t.drop_mass_velocity_m_s.z();
+        break;
+      }
+    }
+    start_offset_z = p_release.z();
+    return v_in;
+  };
+  double z1 = 0.0, z1b = 0.0, z2 = 0.0;
+  const double v1 = impact(1, z1), v1b = impact(1, z1b), v2 = impact(2, z2);
+  EXPECT_EQ(v1, v1b);
+  EXPECT_NE(v1, v2);
+  // Free fall: the speed difference follows the height difference, v2^2 - v1^2 = 2 g (z2 - z1)
+  // (the tool barely moves in Position mode; 1 % of the kinetic energy's difference as tolerance).
+  EXPECT_NEAR(v2 * v2 - v1 * v1, 2.0 * kG * (z2 - z1), 0.02 + 0.01 * std::abs(v2 * v2 - v1 * v1));
+  EXPECT_GT(std::abs(z2 - z1), 1e-4);
+  std::printf("release z %.4f / %.4f m: impact %.4f / %.4f m/s\n", z1, z2, v1, v2);
+}
+
+// Held by a hand, the mass weighs on the world, not on the arm: before the release the F/T sensor
+// carries the tool alone (m_tool g), against tool + mass with the latch on the tool.
+TEST(SimRobotDrop, HandHeldMassDoesNotLoadTheArmBeforeRelease) {
+  auto sensor_force = [](bool hand) {
+    phri::SimRobotConfig c = phri::SimRobotConfig::from_yaml_file(kRoot + "/configs/plant_gen3.yaml");
+    c.initial_q_rad = kTarget;
+    c.noise.torque_sensor_std_Nm = 0.0;
+    c.ft_sensor.force_std_N = 0.0;
+    c.ft_sensor.force_bias_N.setZero();
+    c.drop_test.enabled = true;
+    c.drop_test.held_by_hand = hand;
+    c.drop_test.release_time_s = 10.0;
+    phri::SimRobot robot(c);
+    phri::RobotCommand hold(7);
+    hold.mode = phri::LowLevelMode::kPosition;
+    hold.q_rad = Eigen::Map<const Eigen::VectorXd>(kTarget.data(), 7);
+    for (int k = 0; k < 300; ++k) {
+      robot.write(hold);
+      robot.read();
+    }
+    return robot.state().wrench_sensor.head<3>().norm();
+  };
+  const phri::SimRobotConfig c = phri::SimRobotConfig::from_yaml_file(kRoot + "/configs/plant_gen3.yaml");
+  EXPECT_NEAR(sensor_force(true), c.tool.mass_kg * kG, 0.02 * c.tool.mass_kg * kG);
+  EXPECT_NEAR(sensor_force(false), (c.tool.mass_kg + c.drop_test.mass_kg) * kG, 0.02 * (c.tool.mass_kg + 1.25) * kG);
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 #include "bindings.hpp"
 #include "python_stream.hpp"
 
+#include <phri/experiments/drop_test.hpp>
 #include <phri/experiments/friction_identification.hpp>
 #include <phri/experiments/safety_fuzz.hpp>
 #include <phri/experiments/torque_tracking.hpp>
@@ -193,9 +194,48 @@ void bind_safety_fuzz(py::module_& m) {
       }, py::arg("options"), py::arg("fail_on_violation") = false, "`phri experiment safety-fuzz`; returns its exit status.");
 }
 
+void bind_drop_test(py::module_& m) {
+  py::enum_<DropMode>(m, "DropMode", "Drop-test mode.").value("torque", DropMode::kTorque).value("position", DropMode::kPosition);
+  py::class_<DropRun>(m, "DropRun", "Metrics of one drop (e_z after the catch).")
+      .def_readonly("mode", &DropRun::mode)
+      .def_readonly("index", &DropRun::index)
+      .def_readonly("seed", &DropRun::seed)
+      .def_readonly("catch_s", &DropRun::catch_s)
+      .def_readonly("peak_mm", &DropRun::peak_mm)
+      .def_readonly("stabilisation_s", &DropRun::stabilisation_s)
+      .def_readonly("residual_mm", &DropRun::residual_mm)
+      .def_readonly("qp_fallbacks", &DropRun::qp_fallbacks)
+      .def_readonly("error_mm", &DropRun::error_mm, "e_z over the window, one sample per period (a copy).");
+  py::class_<DropTestResult>(m, "DropTestResult", "Every drop, torque mode first, and the files written.")
+      .def_readonly("runs", &DropTestResult::runs)
+      .def_readonly("simulated_s", &DropTestResult::simulated_s)
+      .def_readonly("wall_s", &DropTestResult::wall_s)
+      .def_readonly("files", &DropTestResult::files);
+  using O = DropTestOptions;
+  py::class_<O>(m, "DropTestOptions", "`phri experiment drop-test`: torque vs position mode, 30 + 30 drops.")
+      .def(py::init([] {
+        return located(O{}, {&O::plant_config_path, &O::urdf_path, &O::actuators_path, &O::collision_path, &O::figure_script});
+      }))
+      .def_readwrite("output_dir", &O::output_dir, "Empty: no files.")
+      .def_readwrite("figure_script", &O::figure_script, "Empty: no figure.")
+      .def_readwrite("drops", &O::drops)
+      .def_readwrite("jobs", &O::jobs)
+      .def_readwrite("first_seed", &O::first_seed)
+      .def_readwrite("release_s", &O::release_s)
+      .def_readwrite("window_s", &O::window_s)
+      .def_readwrite("observer_gain", &O::observer_gain)
+      .def_readwrite("external_torque_source", &O::external_torque_source)
+      .def_readwrite("held_by_hand", &O::held_by_hand)
+      .def_readwrite("cable_damping_Ns_per_m", &O::cable_damping_Ns_per_m, "None: the plant file's.");
+  m.def("run_drop_test", [](const O& o, bool progress) {
+        return run_released<DropTestResult>(o, progress, [](const O& x, std::ostream* s) { return run_drop_test(x, s); });
+      }, py::arg("options"), py::arg("progress") = true, "Runs the drops (threads, GIL released).");
+}
+
 }  // namespace
 
 void bind_experiments(py::module_& m) {
+  bind_drop_test(m);
   bind_friction(m);
   bind_tracking(m);
   bind_safety_fuzz(m);

@@ -112,7 +112,18 @@ void bind_config_parts(py::class_<SimRobotConfig>& c) {
       .def_readwrite("cable_damping_Ns_per_m", &C::DropTest::cable_damping_Ns_per_m)
       .def_readwrite("anchor_m", &C::DropTest::anchor_m, "Cable anchor in the sensor frame [m].")
       .def_readwrite("release_time_s", &C::DropTest::release_time_s)
-      .def_readwrite("latch_stiffness_N_per_m", &C::DropTest::latch_stiffness_N_per_m);
+      .def_readwrite("latch_stiffness_N_per_m", &C::DropTest::latch_stiffness_N_per_m)
+      .def_readwrite("release_vertical_spread_m", &C::DropTest::release_vertical_spread_m, "Hand's release: fall height +- [m].")
+      .def_readwrite("release_horizontal_spread_m", &C::DropTest::release_horizontal_spread_m, "Hand's release: sideways +- [m].")
+      .def_readwrite("held_by_hand", &C::DropTest::held_by_hand, "True: a hand, not the tool, holds the mass until release.");
+  py::enum_<C::Elasticity::Encoder>(c, "Encoder", "The encoder the vendor position servo closes on.")
+      .value("motor", C::Elasticity::Encoder::kMotor)
+      .value("link", C::Elasticity::Encoder::kLink);
+  py::class_<C::Elasticity>(c, "Elasticity", "Joint elasticity: rotor -- torsional spring -- link.")
+      .def_readwrite("enabled", &C::Elasticity::enabled)
+      .def_readwrite("stiffness_Nm_per_rad", &C::Elasticity::stiffness_Nm_per_rad, "Per joint; a copy: assign a whole list.")
+      .def_readwrite("damping_ratio", &C::Elasticity::damping_ratio)
+      .def_readwrite("position_loop_encoder", &C::Elasticity::position_loop_encoder);
   py::class_<C::FtSensor>(c, "FtSensor", "The F/T sensor between flange and tool.")
       .def_readwrite("rate_Hz", &C::FtSensor::rate_Hz)
       .def_readwrite("force_std_N", &C::FtSensor::force_std_N)
@@ -150,6 +161,7 @@ void bind_config(py::module_& m) {
       .def_readwrite("tool", &C::tool)
       .def_readwrite("mismatch", &C::mismatch)
       .def_readwrite("drop_test", &C::drop_test)
+      .def_readwrite("elasticity", &C::elasticity)
       .def_readwrite("floor", &C::floor)
       .def_readwrite("disturbances", &C::disturbances, "Scripted pushes (a list: assign a new one).")
       .def_readwrite("random_pushes", &C::random_pushes);

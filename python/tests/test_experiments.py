@@ -36,3 +36,19 @@ def test_experiment_options_find_the_shipped_files():
         options.plant_config_path = "/nonexistent/plant.yaml"
         options.pushes = 1
         phri.run_safety_fuzz(options, progress=False)
+
+
+def test_drop_test_from_python_catches_after_a_free_fall():
+    options = phri.DropTestOptions()
+    options.output_dir = ""
+    options.figure_script = ""
+    options.drops = 1
+    options.release_s = 2.0
+    options.window_s = 1.5
+    result = phri.run_drop_test(options, progress=False)
+    assert [r.mode for r in result.runs] == [phri.DropMode.torque, phri.DropMode.position]
+    for run in result.runs:
+        fall = run.catch_s - options.release_s
+        # Free fall over the slack length, the hand's release +-2 cm: sqrt(2 (0.25 +- 0.02) / g).
+        assert (2 * 0.23 / 9.81) ** 0.5 - 2e-3 < fall < (2 * 0.27 / 9.81) ** 0.5 + 2e-3
+        assert run.peak_mm == pytest.approx(max(abs(e) for e in run.error_mm), rel=1e-6)

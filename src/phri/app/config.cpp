@@ -259,8 +259,13 @@ void parse_wrench(const YamlReader& w, WrenchEstimatorSettings& s) {
 }
 
 void parse_controller(const YamlReader& r, const ActuatorTable& drives, ControllerSettings& c) {
-  r.allow_keys({"period_s", "observer_gain", "compliance_deadband", "compliance", "qp", "wrench"});
+  r.allow_keys({"period_s", "observer_gain", "external_torque_source", "position_mode_open_loop", "compliance_deadband",
+                "compliance", "qp", "wrench"});
+  c.position_mode_open_loop = r.boolean_or("position_mode_open_loop", c.position_mode_open_loop);
   c.period_s = positive_or(r, "period_s", c.period_s, 0.1);
+  if (r.has("external_torque_source")) {
+    c.external_torque_source = *external_torque_source_from_string(r.choice("external_torque_source", {"observer", "ft", "fused"}));
+  }
   c.observer_gain = positive_or(r, "observer_gain", c.observer_gain, 1e4);
   // The discrete observer's residual follows r[k] = (1 - K T) r[k-1] + K T tau_ext[k]: it rings
   // for K T > 1 and diverges for K T > 2. K T < 1 keeps it a first-order low-pass.

@@ -41,6 +41,10 @@ void fill_log_row(LogRow& row, const RobotState& state, const Controller& cycle)
   for (int i = 0; i < 6; ++i) row.error[static_cast<std::size_t>(i)] = error[i];
   row.error_position_m = error.head<3>().norm();
   row.error_orientation_rad = error.tail<3>().norm();
+  for (int i = 0; i < 3; ++i) {
+    row.ee_velocity[static_cast<std::size_t>(i)] = ee.velocity()[i];
+    row.target_velocity[static_cast<std::size_t>(i)] = ee.target_velocity()[i];
+  }
   const Vector6d& wrench = cycle.wrench().wrench_world();
   for (int i = 0; i < 6; ++i) row.wrench[static_cast<std::size_t>(i)] = wrench[i];
   row.wrench_norm = cycle.wrench().norm();

@@ -14,6 +14,9 @@
 //   target_x ..., target_qw ...                       end-effector target the task tracks
 //   err_x err_y err_z, err_rx err_ry err_rz           target - pose [m], log(R* R^T) [rad]
 //   err_pos_m, err_ori_rad                            their norms
+//   ee_vx ee_vy ee_vz, target_vx target_vy target_vz  end-effector velocity (J qd, measured joints) and the
+//                                                     tracked target's velocity, world axes [m/s] (the paper's
+//                                                     velocity errors, Fig. dynamic-comparison, without derivatives)
 //   wrench_fx wrench_fy wrench_fz wrench_mx wrench_my wrench_mz, wrench_norm
 //                                         operator wrench at the EE, world axes [N, N.m] (F/T)
 //   compliance_mode, touched, low_level_loop, fsm_state, event,
@@ -46,6 +49,8 @@ struct LogRow {
   std::array<double, 6> error{};  ///< position (3), orientation log (3)
   double error_position_m = 0.0;
   double error_orientation_rad = 0.0;
+  std::array<double, 3> ee_velocity{};      ///< linear, world axes [m/s]
+  std::array<double, 3> target_velocity{};  ///< linear, world axes [m/s]
   std::array<double, 6> wrench{};  ///< force (3), moment (3)
   double wrench_norm = 0.0;
   std::int32_t compliance_mode = 0;    ///< ComplianceMode
@@ -89,6 +94,8 @@ void visit_log_columns(const LogRow& r, int dof, Visitor&& v) {
   visit_numbers<Visitor, 6>(v, {"err_x", "err_y", "err_z", "err_rx", "err_ry", "err_rz"}, r.error);
   v.number("err_pos_m", r.error_position_m);
   v.number("err_ori_rad", r.error_orientation_rad);
+  visit_numbers<Visitor, 3>(v, {"ee_vx", "ee_vy", "ee_vz"}, r.ee_velocity);
+  visit_numbers<Visitor, 3>(v, {"target_vx", "target_vy", "target_vz"}, r.target_velocity);
   visit_numbers<Visitor, 6>(v, {"wrench_fx", "wrench_fy", "wrench_fz", "wrench_mx", "wrench_my", "wrench_mz"}, r.wrench);
   v.number("wrench_norm", r.wrench_norm);
   v.integer("compliance_mode", r.compliance_mode);

@@ -222,6 +222,13 @@ void Controller::estimate(const RobotState& state, double dt) {
     ++wrench_samples_;
     wrench_.update(wrench_median_, sensor, ee.translation());
   }
+  if (settings_.position_mode_open_loop && low_level_.integrating_position()) {
+    // The paper's position mode: from here on the cycle sees its own integrated state, not the
+    // arm (the estimates above used the measurements).
+    q_ = low_level_.position_reference();
+    qd_ = low_level_.velocity_reference();
+    compute_all_terms(model_, data_, q_, qd_);
+  }
 }
 
 // tau_ext for the QP and the inverse dynamics, from the source the settings choose.

@@ -120,6 +120,8 @@ private:
   bool apply(const ControllerTargets& targets);
   void hold_previous(const RobotState& state, RobotCommand& command);
   void safe_stop(bool sample_good, RobotCommand& command);
+  // Model terms, observer, wrench from the measured state; then, in the open-loop position mode,
+  // the model terms of the integrated state the cycle runs on.
   void estimate(const RobotState& state, double dt);
   void select_external_torque();
   void bound_external_torque();

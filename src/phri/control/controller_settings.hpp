@@ -5,6 +5,7 @@
 #include <phri/control/compliance_mode.hpp>
 #include <phri/control/whole_body_qp.hpp>
 #include <phri/control/wrench_estimator.hpp>
+#include <phri/core/enum_names.hpp>
 #include <phri/lowlevel/custom_torque_controller.hpp>
 #include <phri/lowlevel/low_level_controller.hpp>
 
@@ -12,7 +13,10 @@
 #include <phri/robot/paper_end_of_arm.hpp>
 #include <phri/safety/state_supervisor.hpp>
 
+#include <array>
+#include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace phri {
@@ -24,6 +28,14 @@ enum class ExternalTorqueSource {
                       ///< torque-tracking experiment: "the weight measured by the F/T sensor is compensated")
   kFused,             ///< the paper's code: observer + high-pass of J^T F/T (complementary filter, pole K_O)
 };
+inline constexpr int kExternalTorqueSourceCount = 3;
+/// The names of the run YAML's controller.external_torque_source and of the reports.
+inline constexpr std::array<std::string_view, kExternalTorqueSourceCount> kExternalTorqueSourceNames = {"observer", "ft",
+                                                                                                      "fused"};
+constexpr std::string_view to_string(ExternalTorqueSource s) { return enum_name(s, kExternalTorqueSourceNames); }
+constexpr std::optional<ExternalTorqueSource> external_torque_source_from_string(std::string_view name) {
+  return enum_from_string<ExternalTorqueSource, kExternalTorqueSourceCount>(name);
+}
 
 /// What the controller does after the supervisor's plausibility checks: the guards behind the QP
 /// and the safe stop (Controller::step).
@@ -83,6 +95,11 @@ struct ControllerSettings {
   /// of 5x more torque-sensor noise in tau_ext (about 0.05 N.m rms with the plant's sensor noise).
   double observer_gain = 50.0;
   ExternalTorqueSource external_torque_source = ExternalTorqueSource::kObserver;
+  /// Under the robot's position loop, the QP runs on the measured state (false: what the servo
+  /// cannot follow comes back as task error and is corrected) or, as the paper's mc_rtc controller
+  /// in position mode ("OpenLoop", reference notes paper_parameters section 1.1), on the state the
+  /// low level integrates from its own accelerations (true: the servo alone rejects disturbances).
+  bool position_mode_open_loop = false;
   WholeBodyQpSettings qp;  ///< torque/velocity limits default to actuators.yaml's
   /// Dead band of tau_ext in the compliant tasks when qp.compliance_deadband is empty, by actuator
   /// size [N.m]: above the estimate's bias (5 % mismatch, sensor offsets), far below a push.

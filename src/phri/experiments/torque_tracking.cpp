@@ -10,6 +10,7 @@
 #include <phri/sim/sim_robot.hpp>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <optional>
@@ -117,6 +118,7 @@ SimRobotConfig plant_config(const TorqueTrackingOptions& o, TrackingScenario sce
   c.initial_q_rad = o.start_q_rad;
   c.seed = o.seed;
   c.mismatch.enabled = o.model_mismatch;
+  if (o.elastic) c.elasticity.enabled = true;
   if (o.torque_constant_error >= 0.0) c.mismatch.torque_constant_fraction = o.torque_constant_error;
   if (o.mismatch_seed) c.mismatch.seed = *o.mismatch_seed;
   if (o.friction_perturbation > 0.0) {
@@ -156,6 +158,10 @@ RunSchedule run_schedule(const TorqueTrackingOptions& o, TrackingScenario scenar
           static_cast<int>(std::lround(o.transient_s / dt)), static_cast<int>(std::lround(o.trajectory_delay_s / dt))};
 }
 
+struct EeErrors {
+  Eigen::Vector3d position, velocity;
+};
+
 // The errors of one run after the switch: every sample into the time series (CSV), those past the
 // transient into the statistics.
 class TrackingRecorder {
@@ -163,16 +169,23 @@ public:
   TrackingRecorder(int dof, int test_cycles, int skip) : error_sum_(Eigen::VectorXd::Zero(dof)), skip_(skip) {
     csv_ << "t_s,error_norm_Nm,error_norm_true_Nm";
     for (int i = 0; i < dof; ++i) csv_ << ",error_" << (i + 1) << "_Nm";
-    csv_ << ",ee_error_mm\n";
+    csv_ << ",ee_error_mm,ee_err_y_mm,ee_err_z_mm,ee_verr_y_mm_s,ee_verr_z_mm_s\n";
     for (std::vector<double>* v : {&norms_, &norms_true_, &ee_errors_}) v->reserve(static_cast<std::size_t>(test_cycles));
+    for (std::vector<double>& v : axis_errors_) v.reserve(static_cast<std::size_t>(test_cycles));
   }
 
   /// Sample `sample` (0: the first period after the switch) at time sample * dt.
-  void record(int sample, double dt, const Eigen::VectorXd& error, const Eigen::VectorXd& error_true, double ee_error) {
+  /// ee: end-effector position error (target - plant) [m] and velocity error (reference - plant) [m/s].
+  void record(int sample, double dt, const Eigen::VectorXd& error, const Eigen::VectorXd& error_true, const EeErrors& ee) {
+    const double ee_error = ee.position.norm();
     csv_ << format_fixed(sample * dt, 3) << ',' << format_fixed(error.norm(), 5) << ',' << format_fixed(error_true.norm(), 5);
     for (int i = 0; i < error.size(); ++i) csv_ << ',' << format_fixed(error[i], 5);
-    csv_ << ',' << format_fixed(1e3 * ee_error, 4) << '\n';
+    csv_ << ',' << format_fixed(1e3 * ee_error, 4) << ',' << format_fixed(1e3 * ee.position.y(), 4) << ','
+         << format_fixed(1e3 * ee.position.z(), 4) << ',' << format_fixed(1e3 * ee.velocity.y(), 3) << ','
+         << format_fixed(1e3 * ee.velocity.z(), 3) << '\n';
     if (sample < skip_) return;
+    const double axes[4] = {ee.position.y(), ee.position.z(), ee.velocity.y(), ee.velocity.z()};
+    for (int a = 0; a < 4; ++a) axis_errors_[static_cast<std::size_t>(a)].push_back(axes[a]);
     norms_.push_back(error.norm());
     error_sum_ += error;
     norms_true_.push_back(error_true.norm());
@@ -189,6 +202,10 @@ public:
     run.ee_position_rms_mm = 1e3 * rms(ee_errors_);
     run.ee_position_max_mm = ee_errors_.empty() ? 0.0 : 1e3 * *std::max_element(ee_errors_.begin(), ee_errors_.end());
     run.samples = static_cast<int>(norms_.size());
+    run.ee_y_rms_mm = 1e3 * rms(axis_errors_[0]);
+    run.ee_z_rms_mm = 1e3 * rms(axis_errors_[1]);
+    run.ee_vy_rms_mm_s = 1e3 * rms(axis_errors_[2]);
+    run.ee_vz_rms_mm_s = 1e3 * rms(axis_errors_[3]);
   }
 
   std::string csv() const { return csv_.str(); }
@@ -196,17 +213,22 @@ public:
 private:
   std::ostringstream csv_;
   std::vector<double> norms_, norms_true_, ee_errors_;
+  std::array<std::vector<double>, 4> axis_errors_;  // y, z position [m]; y, z velocity [m/s]
   Eigen::VectorXd error_sum_;
   int skip_;
 };
 
-// How far the plant's true end effector (forward kinematics of its true joint angles) is from the
-// end-effector task's target [m].
-double true_ee_error(const Controller& cycle, const SimRobot& robot, Data& truth_data) {
-  forward_kinematics(cycle.model(), truth_data, robot.truth().q_rad);
+// How far the plant's true end effector (forward kinematics of its true joint angles and
+// velocities) is from the end-effector task's target [m] and its reference velocity [m/s].
+EeErrors true_ee_error(const Controller& cycle, const SimRobot& robot, Data& truth_data) {
+  forward_kinematics(cycle.model(), truth_data, robot.truth().q_rad, robot.truth().qd_rad_s);
   update_frame_placements(cycle.model(), truth_data);
-  const std::size_t ee = static_cast<std::size_t>(cycle.end_effector_frame());
-  return (cycle.qp().end_effector().target_pose().translation() - truth_data.frame_placements[ee].translation()).norm();
+  const int frame = cycle.end_effector_frame();
+  const std::size_t ee = static_cast<std::size_t>(frame);
+  const EndEffectorTask& task = cycle.qp().end_effector();
+  const Vector6d v = frame_velocity(cycle.model(), truth_data, frame, ReferenceFrame::kLocalWorldAligned);
+  return {task.target_pose().translation() - truth_data.frame_placements[ee].translation(),
+          task.target_velocity().head<3>() - v.head<3>()};
 }
 
 // Runs the schedule: position control, the switch to `loop`, the dynamic scenario's trajectory;
@@ -287,12 +309,15 @@ TorqueTrackingRun run_one(const TorqueTrackingOptions& o, TrackingScenario scena
 // The statistics of every run, one row each.
 std::string summary_csv(const TorqueTrackingResult& result, const TorqueTrackingOptions& o) {
   std::ostringstream summary;
-  summary << "scenario,loop,rms_Nm,p95_Nm,max_Nm,bias_Nm,rms_true_Nm,p95_true_Nm,window_start_s,samples\n";
+  summary << "scenario,loop,rms_Nm,p95_Nm,max_Nm,bias_Nm,rms_true_Nm,p95_true_Nm,window_start_s,samples,"
+             "ee_rms_mm,ee_y_rms_mm,ee_z_rms_mm,ee_vy_rms_mm_s,ee_vz_rms_mm_s\n";
   for (const TorqueTrackingRun& run : result.runs) {
     summary << to_string(run.scenario) << ',' << loop_name(run.loop) << ',' << format_fixed(run.rms_Nm, 6) << ','
             << format_fixed(run.p95_Nm, 6) << ',' << format_fixed(run.max_Nm, 6) << ',' << format_fixed(run.bias_Nm, 6) << ','
             << format_fixed(run.rms_true_Nm, 6) << ',' << format_fixed(run.p95_true_Nm, 6) << ','
-            << format_fixed(o.transient_s, 3) << ',' << run.samples << '\n';
+            << format_fixed(o.transient_s, 3) << ',' << run.samples << ',' << format_fixed(run.ee_position_rms_mm, 4) << ','
+            << format_fixed(run.ee_y_rms_mm, 4) << ',' << format_fixed(run.ee_z_rms_mm, 4) << ','
+            << format_fixed(run.ee_vy_rms_mm_s, 3) << ',' << format_fixed(run.ee_vz_rms_mm_s, 3) << '\n';
   }
   return summary.str();
 }

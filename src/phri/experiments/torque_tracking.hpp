@@ -76,6 +76,7 @@ struct TorqueTrackingOptions {
   // ---- plant
   std::uint64_t seed = 1;              ///< sensor noise (and friction perturbation)
   bool model_mismatch = true;          ///< plant link inertials +-5 % from the controller's URDF
+  bool elastic = false;                ///< the plant's joint elasticity (plant.elasticity) enabled
   double friction_perturbation = 0.0;  ///< plant friction off actuators.yaml by up to this fraction
   /// Start posture: the paper demo's postureTarget (arm half extended forward).
   std::vector<double> start_q_rad = {0.0, 0.58, 3.14, -1.84, 0.0, 0.85, 1.57};
@@ -137,6 +138,9 @@ struct TorqueTrackingRun {
   double p95_true_Nm = 0.0;
   double ee_position_rms_mm = 0.0;  ///< end-effector position error (task target vs plant)
   double ee_position_max_mm = 0.0;
+  /// RMS of the end effector's y and z position errors (target - plant) and velocity errors
+  /// (the target's reference velocity - plant), the axes of the paper's Fig. dynamic-comparison.
+  double ee_y_rms_mm = 0.0, ee_z_rms_mm = 0.0, ee_vy_rms_mm_s = 0.0, ee_vz_rms_mm_s = 0.0;
   int samples = 0;
   long qp_fallbacks = 0;      ///< cycles where the QP failed (should be 0)
   std::string csv_path;       ///< time series, when written

@@ -70,6 +70,11 @@ public:
   const Eigen::VectorXd& breakaway() const { return breakaway_; }
   const CustomTorqueController& custom() const { return custom_; }
   const Eigen::VectorXd& position_reference() const { return q_ref_; }
+  const Eigen::VectorXd& velocity_reference() const { return qd_ref_; }
+  /// True once the position loop runs and stays requested: its reference is the integrated state.
+  bool integrating_position() const {
+    return started_ && loop_ == LowLevelMode::kPosition && requested_ == LowLevelMode::kPosition;
+  }
 
 private:
   void update_friction_assist(const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd_desired);

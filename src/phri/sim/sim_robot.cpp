@@ -27,6 +27,7 @@ constexpr double kWrenchSign = -1.0;
 constexpr std::uint64_t kJointNoiseStream = 1;
 constexpr std::uint64_t kFtNoiseStream = 2;
 constexpr std::uint64_t kMismatchStream = 3;
+constexpr std::uint64_t kReleaseStream = 4;
 
 SimRobotConfig completed(SimRobotConfig config) {
   config.fill_defaults();
@@ -162,6 +163,10 @@ int SimRobot::bind_joint(int i) {
   viscous_[i] = a.friction.viscous_Nms_per_rad;
   offsets_[i] = config_.noise.torque_sensor_offset_Nm[k];
   const int d = dadr_[k];
+  if (config_.elasticity.enabled) {
+    bind_elastic(i);
+    return m_->jnt_bodyid[j];
+  }
   m_->dof_armature[d] = a.reflected_inertia_kgm2;
   // Dry friction: StickSlipFriction (its spring through qfrc_applied, its damper and the viscous
   // friction through MuJoCo's joint damping, which the Euler step integrates implicitly).
@@ -171,6 +176,24 @@ int SimRobot::bind_joint(int i) {
                                                   a.reflected_inertia_kgm2, config_.physics_step_s(),
                                                   config_.friction.breakaway_velocity_rad_s));
   return m_->jnt_bodyid[j];
+}
+
+// The rotor inertia and the drive's friction move to the motor side of a spring: the link's MuJoCo
+// joint keeps neither armature nor damping.
+void SimRobot::bind_elastic(int i) {
+  const ActuatorParameters& a = plant_actuators_[i];
+  const int d = dadr_[static_cast<std::size_t>(i)];
+  m_->dof_armature[d] = 0.0;
+  m_->dof_damping[d] = 0.0;
+  m_->dof_frictionloss[d] = 0.0;
+  ElasticTransmission::Parameters p;
+  p.stiffness_Nm_per_rad = config_.elasticity.stiffness_Nm_per_rad[static_cast<std::size_t>(i)];
+  p.rotor_inertia_kgm2 = a.reflected_inertia_kgm2;
+  p.damping_Nms_per_rad = 2.0 * config_.elasticity.damping_ratio * std::sqrt(p.stiffness_Nm_per_rad * p.rotor_inertia_kgm2);
+  p.viscous_Nms_per_rad = a.friction.viscous_Nms_per_rad;
+  elastic_.emplace_back(p, StickSlipFriction::presliding(a.friction.coulomb_Nm, a.friction.static_Nm, a.reflected_inertia_kgm2,
+                                                         config_.physics_step_s(), config_.friction.breakaway_velocity_rad_s));
+  dry_.emplace_back();  // unused: keeps the joint indexing of the rigid path
 }
 
 // Arm links only; the scene's tool is configured explicitly.
@@ -255,7 +278,7 @@ void SimRobot::allocate_buffers() {
   for (Eigen::VectorXd* v : {&q_meas_, &qd_meas_, &tau_meas_, &current_, &tau_motor_, &tau_viscous_, &tau_dry_, &tau_s_,
                              &v_before_, &f_dry_, &damping_, &qdd_, &truth_.q_rad, &truth_.qd_rad_s,
                              &truth_.qdd_rad_s2, &truth_.current_A, &truth_.tau_motor_Nm, &truth_.tau_friction_Nm,
-                             &truth_.tau_transmitted_Nm}) {
+                             &truth_.tau_transmitted_Nm, &truth_.q_motor_rad, &q_before_}) {
     *v = Eigen::VectorXd::Zero(n_);
   }
 }
@@ -312,14 +335,23 @@ Eigen::Vector3d SimRobot::place_initial_pose() {
   }
   mj_kinematics(m_.get(), d_.get());
   if (drop_body_ < 0) return Eigen::Vector3d::Zero();
-  // The mass hangs on the latch at its static deflection m g / k below the anchor.
+  // Where this run's hand holds the mass relative to the anchor (world axes, z up).
+  RandomGenerator release(config_.seed, kReleaseStream);
+  const double h = config_.drop_test.release_horizontal_spread_m;
+  const double v = config_.drop_test.release_vertical_spread_m;
+  release_offset_ = Eigen::Vector3d(release.uniform(-h, h), release.uniform(-h, h), release.uniform(-v, v));
+  // The mass hangs on the latch at its static deflection m g / k below the held point.
   const double k = config_.drop_test.latch_stiffness_N_per_m;
   const Eigen::Vector3d g(m_->opt.gravity[0], m_->opt.gravity[1], m_->opt.gravity[2]);
   const mjtNum* anchor = d_->site_xpos + 3 * anchor_site_;
-  const Eigen::Vector3d p = Eigen::Vector3d(anchor[0], anchor[1], anchor[2]) + config_.drop_test.mass_kg * g / k;
+  const Eigen::Vector3d p =
+      Eigen::Vector3d(anchor[0], anchor[1], anchor[2]) + release_offset_ + config_.drop_test.mass_kg * g / k;
   for (int k3 = 0; k3 < 3; ++k3) d_->qpos[drop_qadr_ + k3] = p[k3];
   d_->qpos[drop_qadr_ + 3] = 1.0;
   d_->qpos[drop_qadr_ + 4] = d_->qpos[drop_qadr_ + 5] = d_->qpos[drop_qadr_ + 6] = 0.0;
+  hand_point_ = Eigen::Vector3d(anchor[0], anchor[1], anchor[2]) + release_offset_;
+  // A hand carries the weight itself: the arm holds only its own (and the slack cable's nothing).
+  if (config_.drop_test.held_by_hand) return Eigen::Vector3d::Zero();
   return config_.drop_test.mass_kg * g;
 }
 
@@ -352,9 +384,13 @@ void SimRobot::start_drives_holding(const Eigen::VectorXd& hold) {
   f_dry_.setZero();
   qdd_.setZero();
 
+  for (std::size_t k = 0; k < elastic_.size(); ++k) elastic_[k].reset(config_.initial_q_rad[k], hold[static_cast<int>(k)]);
+  // The servo holds what its encoder reads now (a motor-side encoder reads the wound spring too).
   command_.mode = LowLevelMode::kPosition;
-  for (int i = 0; i < n_; ++i) command_.q_rad[i] = config_.initial_q_rad[static_cast<std::size_t>(i)];
-  for (int i = 0; i < n_; ++i) q_meas_[i] = quantize(d_->qpos[qadr_[static_cast<std::size_t>(i)]]);
+  for (int i = 0; i < n_; ++i) {
+    command_.q_rad[i] = elastic() ? servo_position(i) : config_.initial_q_rad[static_cast<std::size_t>(i)];
+    q_meas_[i] = quantize(servo_position(i));
+  }
   drive_ = KinovaDriveEmulator(config_.actuators, config_.vendor, config_.physics_step_s(), config_.control_period_s);
   drive_.begin_cycle(command_, false, q_meas_, vendor_torque());
   drive_.set_position_integral(vendor_torque());
@@ -461,9 +497,19 @@ const RobotState& SimRobot::read() {
   return state_;
 }
 
-void SimRobot::substep() {
-  // 1. Dry friction from the current state (its damping enters MuJoCo's passive forces in
-  //    mj_step1 and the implicit part of the Euler step), then positions, velocities, bias forces.
+double SimRobot::servo_position(int i) const {
+  const bool motor = elastic() && config_.elasticity.position_loop_encoder == SimRobotConfig::Elasticity::Encoder::kMotor;
+  return motor ? elastic_[static_cast<std::size_t>(i)].position() : d_->qpos[qadr_[static_cast<std::size_t>(i)]];
+}
+
+double SimRobot::servo_velocity(int i) const {
+  const bool motor = elastic() && config_.elasticity.position_loop_encoder == SimRobotConfig::Elasticity::Encoder::kMotor;
+  return motor ? elastic_[static_cast<std::size_t>(i)].velocity() : d_->qvel[dadr_[static_cast<std::size_t>(i)]];
+}
+
+// Rigid: dry friction from the current state (its damping enters MuJoCo's passive forces in
+// mj_step1 and the implicit part of the Euler step); the link carries motor torque and friction.
+void SimRobot::prepare_rigid() {
   for (int i = 0; i < n_; ++i) {
     const auto k = static_cast<std::size_t>(i);
     const int d = dadr_[k];
@@ -471,6 +517,54 @@ void SimRobot::substep() {
     f_dry_[i] = dry_[k].update(d_->qpos[qadr_[k]], d_->qvel[d]);
     damping_[i] = viscous_[i] + dry_[k].damping();
     m_->dof_damping[d] = damping_[i];
+  }
+}
+
+// Elastic: the link carries the spring's torque from the state at the step's start (f_dry_ holds it).
+void SimRobot::prepare_elastic() {
+  for (int i = 0; i < n_; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    const int d = dadr_[k];
+    v_before_[i] = d_->qvel[d];
+    q_before_[i] = d_->qpos[qadr_[k]];
+    f_dry_[i] = elastic_[k].spring_torque(q_before_[i], v_before_[i]);
+  }
+}
+
+// Transmitted torque: motor torque, minus friction and rotor inertia on the motor side. The
+// damping (viscous + presliding) acted on the new velocity, and the step's acceleration is
+// (v1 - v0) / dt (d->qacc is MuJoCo's explicit value, before the implicit damping).
+void SimRobot::finish_rigid() {
+  for (int i = 0; i < n_; ++i) {
+    const int d = dadr_[static_cast<std::size_t>(i)];
+    const double v1 = d_->qvel[d];
+    qdd_[i] = (v1 - v_before_[i]) / m_->opt.timestep;
+    tau_viscous_[i] = -viscous_[i] * v1;
+    tau_dry_[i] = f_dry_[i] - (damping_[i] - viscous_[i]) * v1;
+    tau_s_[i] = tau_motor_[i] + tau_viscous_[i] + tau_dry_[i] - armature_[i] * qdd_[i];
+  }
+}
+
+// The rotors advance over the same step (link state at its start); the sensor reads the spring.
+void SimRobot::finish_elastic() {
+  for (int i = 0; i < n_; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    const int d = dadr_[k];
+    const double v1 = d_->qvel[d];
+    qdd_[i] = (v1 - v_before_[i]) / m_->opt.timestep;
+    elastic_[k].step(tau_motor_[i], q_before_[i], v_before_[i], m_->opt.timestep);
+    tau_viscous_[i] = -viscous_[i] * elastic_[k].velocity();
+    tau_dry_[i] = elastic_[k].friction_torque() - tau_viscous_[i];
+    tau_s_[i] = elastic_[k].spring_torque(d_->qpos[qadr_[k]], v1);
+  }
+}
+
+void SimRobot::substep() {
+  // 1. Friction or spring from the current state, then positions, velocities, bias forces.
+  if (elastic()) {
+    prepare_elastic();
+  } else {
+    prepare_rigid();
   }
   mj_step1(m_.get(), d_.get());
   const double t = d_->time;
@@ -481,18 +575,17 @@ void SimRobot::substep() {
   const double sv = config_.noise.velocity_std_rad_s;
   const double st = config_.noise.torque_sensor_std_Nm;
   for (int i = 0; i < n_; ++i) {
-    const auto k = static_cast<std::size_t>(i);
-    q_meas_[i] = quantize(d_->qpos[qadr_[k]]);
-    qd_meas_[i] = d_->qvel[dadr_[k]] + (noisy_velocity ? joint_noise_.normal(sv) : 0.0);
+    q_meas_[i] = quantize(servo_position(i));
+    qd_meas_[i] = servo_velocity(i) + (noisy_velocity ? joint_noise_.normal(sv) : 0.0);
     tau_meas_[i] = tau_s_[i] + offsets_[i] + (noisy_torque ? joint_noise_.normal(st) : 0.0);
   }
   drive_.tick(q_meas_, qd_meas_, tau_meas_, substep_count_ % static_cast<std::uint64_t>(filter_decimation_) == 0, current_);
 
-  // 3. Joint torques on the motor side: motor and the explicit part of the dry friction.
+  // 3. Joint torques: rigid, motor and the explicit part of the dry friction; elastic, the spring.
   for (int i = 0; i < n_; ++i) {
     const int d = dadr_[static_cast<std::size_t>(i)];
     tau_motor_[i] = torque_per_amp_[i] * current_[i];
-    d_->qfrc_applied[d] = tau_motor_[i] + f_dry_[i];
+    d_->qfrc_applied[d] = elastic() ? f_dry_[i] : tau_motor_[i] + f_dry_[i];
   }
 
   // 4. External forces.
@@ -505,16 +598,10 @@ void SimRobot::substep() {
   mj_step2(m_.get(), d_.get());
   if (ft_step) m_->opt.disableflags |= mjDSBL_SENSOR;
 
-  // Transmitted torque: motor torque, minus friction and rotor inertia on the motor side. The
-  // damping (viscous + presliding) acted on the new velocity, and the step's acceleration is
-  // (v1 - v0) / dt (d->qacc is MuJoCo's explicit value, before the implicit damping).
-  for (int i = 0; i < n_; ++i) {
-    const int d = dadr_[static_cast<std::size_t>(i)];
-    const double v1 = d_->qvel[d];
-    qdd_[i] = (v1 - v_before_[i]) / m_->opt.timestep;
-    tau_viscous_[i] = -viscous_[i] * v1;
-    tau_dry_[i] = f_dry_[i] - (damping_[i] - viscous_[i]) * v1;
-    tau_s_[i] = tau_motor_[i] + tau_viscous_[i] + tau_dry_[i] - armature_[i] * qdd_[i];
+  if (elastic()) {
+    finish_elastic();
+  } else {
+    finish_rigid();
   }
 
   // 6. F/T sample.
@@ -582,8 +669,11 @@ void SimRobot::apply_drop_forces(double t) {
   const Eigen::Vector3d rel_v = v - anchor_velocity;
 
   Eigen::Vector3d on_mass = Eigen::Vector3d::Zero();
-  if (!truth_.drop_released) {
-    on_mass = -cfg.latch_stiffness_N_per_m * rel - latch_damping_ * rel_v;
+  Eigen::Vector3d on_mass_by_hand = Eigen::Vector3d::Zero();  // from the world: no reaction on the arm
+  if (!truth_.drop_released && cfg.held_by_hand) {
+    on_mass_by_hand = -cfg.latch_stiffness_N_per_m * (p - hand_point_) - latch_damping_ * v;
+  } else if (!truth_.drop_released) {
+    on_mass = -cfg.latch_stiffness_N_per_m * (rel - release_offset_) - latch_damping_ * rel_v;
   }
   const double length = rel.norm();
   double tension = 0.0;
@@ -595,9 +685,10 @@ void SimRobot::apply_drop_forces(double t) {
   }
   truth_.cable_length_m = length;
   truth_.cable_force_N = tension;
+  mjtNum* fm = d_->xfrc_applied + 6 * drop_body_;
+  for (int k = 0; k < 3; ++k) fm[k] += on_mass_by_hand[k];
   if (on_mass.squaredNorm() == 0.0) return;
   // On the mass at its centre; the reaction on the tool at the anchor (world axes).
-  mjtNum* fm = d_->xfrc_applied + 6 * drop_body_;
   for (int k = 0; k < 3; ++k) fm[k] += on_mass[k];
   const Eigen::Vector3d com(d_->xipos[3 * tool_body_], d_->xipos[3 * tool_body_ + 1], d_->xipos[3 * tool_body_ + 2]);
   const Eigen::Vector3d m = (anchor - com).cross(-on_mass);
@@ -631,6 +722,7 @@ void SimRobot::sample_state() {
     torque_ok = torque_ok && std::isfinite(state_.tau_sensor_Nm[i]);
     current_ok = current_ok && std::isfinite(state_.current_A[i]);
     truth_.q_rad[i] = q;
+    truth_.q_motor_rad[i] = elastic() ? elastic_[k].position() : q;
     truth_.qd_rad_s[i] = qd;
     truth_.qdd_rad_s2[i] = qdd_[i];
     truth_.current_A[i] = current_[i];

@@ -41,6 +41,7 @@
 // A divergence of the physics (MuJoCo reports bad accelerations) latches RobotState::fault.
 #include <phri/core/random_generator.hpp>
 #include <phri/robot/actuator_table.hpp>
+#include <phri/sim/elastic_transmission.hpp>
 #include <phri/sim/kinova_drive_emulator.hpp>
 #include <phri/sim/mujoco_handles.hpp>
 #include <phri/sim/random_push_generator.hpp>
@@ -63,6 +64,7 @@ public:
   struct Truth {
     double time_s = 0.0;
     Eigen::VectorXd q_rad, qd_rad_s, qdd_rad_s2;  ///< qdd: of the last physics step
+    Eigen::VectorXd q_motor_rad;  ///< rotor angle / G_r (elastic joints); = q_rad with a rigid transmission
     Eigen::VectorXd current_A;                     ///< applied (saturated) motor current
     Eigen::VectorXd tau_motor_Nm;                  ///< K_T G_r i
     Eigen::VectorXd tau_friction_Nm;               ///< friction acting on the joint (viscous + dry), opposing motion
@@ -123,6 +125,7 @@ private:
   void set_physics_options();
   std::vector<int> bind_arm_joints();  // returns the joints' bodies, in the order of actuators.yaml
   int bind_joint(int i);               // returns the joint's body
+  void bind_elastic(int i);
   void perturb_link_inertials(const std::vector<int>& arm_bodies);
   void find_ft_sensor();
   void find_drop_test();
@@ -139,6 +142,16 @@ private:
 
   void sample_ft_sensor();
   void substep();
+  // Step 1 and 5 of substep() per transmission: rigid (friction and rotor inertia on the link) or
+  // elastic (ElasticTransmission: the link feels the spring only).
+  void prepare_rigid();
+  void finish_rigid();
+  void prepare_elastic();
+  void finish_elastic();
+  bool elastic() const { return !elastic_.empty(); }
+  // What the vendor position servo's encoder reads (motor or link side) [rad, rad/s].
+  double servo_position(int i) const;
+  double servo_velocity(int i) const;
   void apply_external_forces(double t);
   void apply_force(int body, const Eigen::Vector3d& point_local, bool local_frame, const Eigen::Vector3d& force,
                    const Eigen::Vector3d& torque);
@@ -168,6 +181,8 @@ private:
   Eigen::VectorXd nominal_torque_per_amp_, vendor_torque_;
   Eigen::VectorXd viscous_, offsets_;
   std::vector<StickSlipFriction> dry_;
+  std::vector<ElasticTransmission> elastic_;  // empty: rigid transmission
+  Eigen::VectorXd q_before_;                  // link angles at a physics step's start
   double quantum_ = 0.0;
 
   KinovaDriveEmulator drive_;
@@ -195,6 +210,8 @@ private:
   int anchor_site_ = -1;
   int drop_body_ = -1, drop_qadr_ = -1, drop_dadr_ = -1;
   double latch_damping_ = 0.0;
+  Eigen::Vector3d release_offset_ = Eigen::Vector3d::Zero();  // world axes, drawn at reset()
+  Eigen::Vector3d hand_point_ = Eigen::Vector3d::Zero();      // held_by_hand: where the hand holds it
   std::vector<int> disturbance_bodies_;
   int live_body_ = -1;        // set_live_disturbance
   ExternalForce live_force_;  // its body name unused

@@ -186,7 +186,8 @@ void parse_vendor(const YamlReader& r, int n, SimRobotConfig::Vendor& v) {
 
 void parse_drop_test(const YamlReader& d, SimRobotConfig::DropTest& s) {
   d.allow_keys({"enabled", "mass_kg", "radius_m", "cable_length_m", "cable_stiffness_N_per_m", "cable_damping_Ns_per_m",
-                "anchor_m", "release_time_s", "latch_stiffness_N_per_m"});
+                "anchor_m", "release_time_s", "latch_stiffness_N_per_m", "release_vertical_spread_m",
+                "release_horizontal_spread_m", "held_by_hand"});
   s.enabled = d.boolean_or("enabled", false);
   s.mass_kg = d.number_or("mass_kg", s.mass_kg, 1e-3, kMaxCarriedMass_kg);
   s.radius_m = d.number_or("radius_m", s.radius_m, 1e-3, 0.5);
@@ -196,6 +197,10 @@ void parse_drop_test(const YamlReader& d, SimRobotConfig::DropTest& s) {
   s.anchor_m = d.vector3_or("anchor_m", s.anchor_m, -1.0, 1.0);
   s.release_time_s = d.number_or("release_time_s", s.release_time_s, 0.0, kHuge);
   s.latch_stiffness_N_per_m = d.number_or("latch_stiffness_N_per_m", s.latch_stiffness_N_per_m, 1.0, 1e7);
+  // A hand, not a throw: a few centimetres at most (and never past the cable's length).
+  s.release_vertical_spread_m = d.number_or("release_vertical_spread_m", s.release_vertical_spread_m, 0.0, 0.1);
+  s.release_horizontal_spread_m = d.number_or("release_horizontal_spread_m", s.release_horizontal_spread_m, 0.0, 0.1);
+  s.held_by_hand = d.boolean_or("held_by_hand", s.held_by_hand);
 }
 
 void parse_floor(const YamlReader& f, SimRobotConfig::Floor& s) {
@@ -254,11 +259,22 @@ void parse_random_pushes(const YamlReader& r, RandomPushSettings& s) {
   if (s.max_duration_s < s.min_duration_s) throw r.error("max_duration_s", "must be >= min_duration_s");
 }
 
+void parse_elasticity(const YamlReader& e, int n, SimRobotConfig::Elasticity& s) {
+  e.allow_keys({"enabled", "stiffness_Nm_per_rad", "damping_ratio", "position_loop_encoder"});
+  s.enabled = e.boolean_or("enabled", false);
+  if (e.has("stiffness_Nm_per_rad")) s.stiffness_Nm_per_rad = e.per_joint("stiffness_Nm_per_rad", n, 100.0, 1e7);
+  s.damping_ratio = e.number_or("damping_ratio", s.damping_ratio, 0.0, 2.0);
+  s.position_loop_encoder = e.choice_or("position_loop_encoder", "motor", {"motor", "link"}) == "motor"
+                                ? SimRobotConfig::Elasticity::Encoder::kMotor
+                                : SimRobotConfig::Elasticity::Encoder::kLink;
+}
+
 SimRobotConfig parse(const YamlReader& root, const std::string& base_dir) {
   root.allow_keys({"plant"});
   const YamlReader p = root.at("plant");
   p.allow_keys({"robot", "timing", "initial", "seed", "actuator_overrides", "friction_scale", "friction", "noise",
-                "ft_sensor", "tool", "mismatch", "vendor", "drop_test", "floor", "disturbances", "random_pushes"});
+                "ft_sensor", "tool", "mismatch", "vendor", "elasticity", "drop_test", "floor", "disturbances",
+                "random_pushes"});
   SimRobotConfig c;
   c.source = root.file();
   parse_robot_files(p.at("robot"), base_dir, c);
@@ -274,6 +290,7 @@ SimRobotConfig parse(const YamlReader& root, const std::string& base_dir) {
   if (p.has("tool")) parse_tool(p.at("tool"), c.tool);
   if (p.has("mismatch")) parse_mismatch(p.at("mismatch"), c.mismatch);
   if (p.has("vendor")) parse_vendor(p.at("vendor"), n, c.vendor);
+  if (p.has("elasticity")) parse_elasticity(p.at("elasticity"), n, c.elasticity);
   if (p.has("drop_test")) parse_drop_test(p.at("drop_test"), c.drop_test);
   if (p.has("floor")) parse_floor(p.at("floor"), c.floor);
   if (p.has("disturbances")) c.disturbances = parse_disturbances(p.at("disturbances"));
@@ -322,6 +339,9 @@ void SimRobotConfig::fill_defaults() {
   fill(v.position_integral_limit_Nm, 60.0, 30.0);
   fill(v.torque_feedback_gain, 0.5, 0.5);
   fill(v.torque_velocity_damping_Nms_per_rad, 15.0, 5.0);
+  // Harmonic-drive secant stiffness near 10-20 N.m: CSF-17-100 ~1.3e4 (large), size 14 ~5.5e3 (small);
+  // configs/plant_gen3.yaml, plant.elasticity, cites the catalogue values.
+  fill(elasticity.stiffness_Nm_per_rad, 13000.0, 5500.0);
   if (noise.torque_sensor_offset_Nm.empty()) noise.torque_sensor_offset_Nm.assign(static_cast<std::size_t>(n), 0.0);
 }
 
@@ -443,6 +463,7 @@ void SimRobotConfig::validate() const {
     throw ConfigError(f, "plant.noise.encoder_counts_per_rev", "must be 0 (no quantisation) or >= 4096");
   }
   validate_vendor(*this);
+  check_size(*this, elasticity.stiffness_Nm_per_rad, "plant.elasticity.stiffness_Nm_per_rad");
   validate_plant_drives(*this);
   validate_scripted_forces(*this);
 }

@@ -138,6 +138,18 @@ struct SimRobotConfig {
     double high_velocity_rate_Hz = 1000.0;
   } vendor;
 
+  // ---- joint elasticity: a torsional spring between each drive's rotor and its link
+  // (ElasticTransmission); off: a rigid transmission (rotor inertia and friction on the link).
+  struct Elasticity {
+    bool enabled = false;
+    /// K per joint [N.m/rad]; empty: by actuator size (configs/plant_gen3.yaml gives the source).
+    std::vector<double> stiffness_Nm_per_rad;
+    /// D = 2 ratio sqrt(K B) in parallel with K (B the reflected rotor inertia).
+    double damping_ratio = 0.05;
+    /// Which encoder the vendor position servo closes on; the arm reports the link side.
+    enum class Encoder { kMotor, kLink } position_loop_encoder = Encoder::kMotor;
+  } elasticity;
+
   // ---- the paper's drop test: a mass on a slack cable under the tool, released at a given time
   struct DropTest {
     bool enabled = false;
@@ -149,6 +161,17 @@ struct SimRobotConfig {
     Eigen::Vector3d anchor_m = Eigen::Vector3d(0.0, 0.0, 0.1);  ///< cable anchor, sensor frame
     double release_time_s = 1.0;
     double latch_stiffness_N_per_m = 1.0e5;  ///< holds the mass at the anchor until release
+    /// Drop-to-drop variability of a hand's release (the paper's weight is let go by hand): the
+    /// mass starts its fall offset from the anchor by a uniform draw in [-s, s], vertically (the
+    /// fall height, hence the catch's speed) and along each horizontal axis (a swing after the
+    /// catch), drawn from the plant's `seed`. 0: every release the same.
+    double release_vertical_spread_m = 0.0;
+    double release_horizontal_spread_m = 0.0;
+    /// Who holds the mass until the release: false, a latch on the tool (the arm carries the
+    /// weight, and the release unloads it before the catch loads it); true, a hand fixed in the
+    /// world at the anchor's initial position (the arm feels the mass only through the cable, as
+    /// in the paper's protocol where the weight is let go by hand).
+    bool held_by_hand = false;
   } drop_test;
 
   struct Floor {
