@@ -9,7 +9,7 @@ import uPlot from 'uplot';
 const token = new URLSearchParams(location.search).get('token') || '';
 const WINDOW_S = 10;          // plots show the last 10 s of robot time
 const PLOT_PERIOD_MS = 25;    // plots redrawn at up to 40 Hz
-const PUSH_STIFFNESS = 400;   // N per m of drag between the grabbed point and the pointer
+const PUSH_STIFFNESS = 200;   // N per m between the grabbed point and the pointer (a spring: the arm follows)
 const PUSH_RENEW_MS = 150;    // a held push is re-sent (the server ends a push 0.5 s after its last)
 
 const $ = (id) => document.getElementById(id);
@@ -109,6 +109,7 @@ const camera = new THREE.PerspectiveCamera(45, 1, 0.01, 20);
 camera.up.set(0, 0, 1);
 camera.position.set(1.6, -1.3, 1.0);
 const renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
+renderer.setPixelRatio(Math.min(window.devicePixelRatio, 2));
 $('scene').appendChild(renderer.domElement);
 const controls = new OrbitControls(camera, renderer.domElement);
 controls.target.set(0.3, 0, 0.45);
@@ -209,6 +210,7 @@ function resize() {
   renderer.setSize(el.clientWidth, el.clientHeight);
   camera.aspect = el.clientWidth / el.clientHeight;
   camera.updateProjectionMatrix();
+  renderer.render(scene, camera);
 }
 window.addEventListener('resize', resize);
 
@@ -222,7 +224,7 @@ phri.screenOfCapsule = (index) => {
 phri.capsuleIndex = (link) => view.capsules.findIndex((m) => m.userData.link === link);
 
 // ------------------------------------------------------------------ drag-to-push
-const drag = { active: false, body: -1, local: null, plane: new THREE.Plane(), hand: new THREE.Vector3(), timer: null };
+const drag = { active: false, body: -1, local: null, plane: new THREE.Plane(), hand: new THREE.Vector3(), timer: null, sent: 0 };
 const raycaster = new THREE.Raycaster();
 
 function pointerRay(event) {
@@ -242,6 +244,7 @@ function pushForce() {
 
 function sendPush() {
   if (!drag.active) return;
+  drag.sent = performance.now();
   const force = pushForce();
   phri.pushes++;
   $('push-readout').textContent = `pushing ${view.capsules.find((m) => m.userData.body === drag.body)?.userData.link}: ` +
@@ -268,6 +271,7 @@ renderer.domElement.addEventListener('pointermove', (event) => {
   if (!drag.active) return;
   pointerRay(event);
   raycaster.ray.intersectPlane(drag.plane, drag.hand);
+  if (performance.now() - drag.sent >= 50) sendPush();
 });
 
 function release() {
@@ -334,17 +338,22 @@ function record(f) {
   }
 }
 
-let lastPlot = 0, dirty = false;
-function animate(now) {
-  requestAnimationFrame(animate);
-  if (dirty && now - lastPlot >= PLOT_PERIOD_MS) {
+// Plots and the 3-D view are redrawn when frames arrive (at most every PLOT_PERIOD_MS / VIEW_PERIOD_MS),
+// not on timers or animation frames, which a browser throttles when it thinks nobody looks.
+const VIEW_PERIOD_MS = 33;
+let lastPlot = 0, lastView = 0;
+function redraw(now) {
+  if (now - lastPlot >= PLOT_PERIOD_MS) {
     lastPlot = now;
-    dirty = false;
     for (const p of plots) p.u.setData(p.data);
     phri.plotUpdates++;
   }
-  renderer.render(scene, camera);
+  if (now - lastView >= VIEW_PERIOD_MS) {
+    lastView = now;
+    renderer.render(scene, camera);
+  }
 }
+controls.addEventListener('change', () => renderer.render(scene, camera));
 phri.plotXMax = () => (plots.length ? plots[0].u.data[0][plots[0].u.data[0].length - 1] ?? null : null);
 
 // ------------------------------------------------------------------ the stream
@@ -364,10 +373,10 @@ function connect() {
     phri.frames++;
     phri.last = f;
     record(f);
-    dirty = true;
     showArm(f);
     showStatus(f);
     showGains(f.gains);
+    redraw(performance.now());
   };
   stream.onerror = () => { $('status').textContent = 'stream lost: is phri still running? (retrying)'; };
 }
@@ -386,6 +395,5 @@ async function main() {
   buildPlots(model);
   resize();
   connect();
-  requestAnimationFrame(animate);
 }
 main();

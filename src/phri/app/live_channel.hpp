@@ -76,12 +76,11 @@ public:
   bool due(std::uint64_t cycle) const noexcept {
     return settings_.decimation <= 1 || cycle % static_cast<std::uint64_t>(settings_.decimation) == 0;
   }
-  void publish(const LiveSnapshot& snapshot) noexcept {
-    if (snapshots_.try_push(snapshot)) {
-      published_.fetch_add(1, std::memory_order_relaxed);
-    } else {
-      dropped_.fetch_add(1, std::memory_order_relaxed);
-    }
+  /// False (counted as dropped) when the reader has not kept up and the queue is full.
+  bool publish(const LiveSnapshot& snapshot) noexcept {
+    const bool queued = snapshots_.try_push(snapshot);
+    (queued ? published_ : dropped_).fetch_add(1, std::memory_order_relaxed);
+    return queued;
   }
 
   // ---- any thread

@@ -23,6 +23,7 @@ namespace phri {
 namespace {
 
 constexpr std::uint64_t kMaxPrintedTransitions = 20;
+constexpr int kMaxSteps = 1 << 30;  // single steps asked and not yet run (they add up)
 
 // The sums of one phase, for its row of the summary table.
 struct PhaseAccumulator {
@@ -83,7 +84,7 @@ public:
       check_safety(status);
       check_overruns(clock_.wait_next(), t);
       print_status(t, pos, micros_[k]);
-      if (live_) publish_live(k, t);
+      if (live_) publish_live(k);
       if (fsm_.finished()) {
         ++k;
         break;
@@ -147,8 +148,11 @@ private:
   void take_live_commands() {
     for (LiveCommand c; live_->receive(c);) handle_live(c);
     if (!paused_) return;
-    bool waited = false;
+    bool waited = false, shown = row_.time_s <= 0.0;
     while (paused_ && steps_ == 0) {
+      // The page learns it is paused, and sees the last cycle (retried: the queue may be full
+      // of the snapshots of a burst of steps).
+      if (!shown) shown = publish_snapshot();
       std::this_thread::sleep_for(std::chrono::milliseconds(1));
       for (LiveCommand c; live_->receive(c);) handle_live(c);
       waited = true;
@@ -165,7 +169,7 @@ private:
       case LiveCommand::Kind::kRelease: end_push(); break;
       case LiveCommand::Kind::kRun: paused_ = false; steps_ = 0; break;
       case LiveCommand::Kind::kPause: paused_ = true; steps_ = 0; break;
-      case LiveCommand::Kind::kStep: paused_ = true; steps_ = std::max(1, c.steps); break;
+      case LiveCommand::Kind::kStep: paused_ = true; steps_ = std::min(steps_ + std::max(1, c.steps), kMaxSteps); break;
     }
   }
 
@@ -190,9 +194,13 @@ private:
     push_.body = -1;
   }
 
-  void publish_live(std::size_t k, double t) {
-    if (!paused_ && !live_->due(k)) return;
-    if (push_.body >= 0 && push_force_.scale_at(t) == 0.0) push_.body = -1;  // ran out unrenewed
+  void publish_live(std::size_t k) {
+    if (paused_ || live_->due(k)) publish_snapshot();
+  }
+
+  // The last cycle's row and what the loop knows beside it; false when the queue was full.
+  bool publish_snapshot() {
+    if (push_.body >= 0 && push_force_.scale_at(row_.time_s) == 0.0) push_.body = -1;  // ran out unrenewed
     snapshot_.row = row_;
     snapshot_.dof = robot_.dof();
     snapshot_.push = push_;
@@ -202,7 +210,7 @@ private:
     snapshot_.posture_gamma_override = compliance.posture_gamma_override();
     snapshot_.posture_stiffness = compliance.posture_stiffness();
     snapshot_.overruns = clock_.overruns();
-    live_->publish(snapshot_);
+    return live_->publish(snapshot_);
   }
 
   // Adds the cycle to its phase's sums; returns the end-effector position error [mm].

@@ -11,7 +11,7 @@
 //                      body: model body index; point: body frame [m], |point| <= 1; force: world [N]
 //   POST /api/release  {}                                          ends the push
 //   POST /api/run | /api/pause  {}
-//   POST /api/step     {"cycles": n}                               1 <= n <= 10000, default 1
+//   POST /api/step     {"cycles": n}      1 <= n <= 10000, default 1; pauses, runs n more cycles (steps add up)
 #include <phri/app/live_channel.hpp>
 
 #include <optional>

@@ -145,6 +145,8 @@ struct DashboardServer::Impl {
 
   std::atomic<std::uint64_t> frames{0}, streams_opened{0}, commands{0}, refused{0};
   std::atomic<int> streams_open{0};
+  std::atomic<double> last_time_s{-1.0};
+  std::atomic<bool> last_paused{false};
 };
 
 void DashboardServer::Impl::routes() {
@@ -164,7 +166,8 @@ void DashboardServer::Impl::routes() {
   server.Get("/api/status", [this](const httplib::Request&, httplib::Response& res) {
     std::ostringstream s;
     s << "{\"frames\":" << frames << ",\"streams_open\":" << streams_open << ",\"streams_opened\":" << streams_opened
-      << ",\"commands\":" << commands << ",\"refused\":" << refused << ",\"snapshots_dropped\":" << channel.dropped() << "}";
+      << ",\"commands\":" << commands << ",\"refused\":" << refused << ",\"snapshots_dropped\":" << channel.dropped()
+      << ",\"time_s\":" << last_time_s << ",\"paused\":" << (last_paused ? "true" : "false") << "}";
     res.set_content(s.str(), "application/json");
   });
   server.Get("/api/stream", [this](const httplib::Request&, httplib::Response& res) { serve_stream(res); });
@@ -269,6 +272,8 @@ void DashboardServer::Impl::pump() {
     bool fresh = false;
     while (channel.next_snapshot(snapshot)) fresh = true;
     if (!fresh) continue;
+    last_time_s = snapshot.row.time_s;
+    last_paused = snapshot.paused;
     auto text = std::make_shared<const std::string>("data: " + encoder.frame_json(snapshot) + "\n\n");
     {
       const std::lock_guard<std::mutex> lock(mutex);
@@ -305,6 +310,7 @@ DashboardServer::DashboardServer(LiveChannel& channel, const Controller& control
   Impl& s = *impl_;
   s.server.set_payload_max_length(s.limits.max_body_bytes);
   s.server.set_keep_alive_timeout(2);
+  s.server.set_tcp_nodelay(true);  // a frame goes out when written (Nagle would batch the stream's small writes)
   // One thread per open stream plus a few for the page's requests.
   const std::size_t threads = static_cast<std::size_t>(settings.max_streams) + 8;
   s.server.new_task_queue = [threads] { return new httplib::ThreadPool(threads); };
@@ -336,6 +342,8 @@ DashboardStats DashboardServer::stats() const {
   s.streams_open = impl_->streams_open;
   s.commands = impl_->commands;
   s.refused = impl_->refused;
+  s.time_s = impl_->last_time_s;
+  s.paused = impl_->last_paused;
   return s;
 }
 

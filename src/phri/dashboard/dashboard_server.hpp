@@ -53,6 +53,8 @@ struct DashboardStats {
   int streams_open = 0;
   std::uint64_t commands = 0;         ///< accepted and queued
   std::uint64_t refused = 0;          ///< 4xx answers (401 included)
+  double time_s = -1.0;               ///< robot time of the newest snapshot encoded (-1: none yet)
+  bool paused = false;                ///< ... and whether the loop was paused then
 };
 
 class DashboardServer {
