@@ -8,7 +8,7 @@ import uPlot from 'uplot';
 
 const token = new URLSearchParams(location.search).get('token') || '';
 const WINDOW_S = 10;          // plots show the last 10 s of robot time
-const PLOT_PERIOD_MS = 25;    // plots redrawn at up to 40 Hz
+const PLOT_PERIOD_MS = 12;    // plots redrawn with every frame, up to ~80 Hz (frames come at ~60 Hz)
 const PUSH_STIFFNESS = 200;   // N per m between the grabbed point and the pointer (a spring: the arm follows)
 const PUSH_RENEW_MS = 150;    // a held push is re-sent (the server ends a push 0.5 s after its last)
 
@@ -136,6 +136,10 @@ const targetAxes = frameAxes(0.18, 0.45);
 const pushArrow = new THREE.ArrowHelper(new THREE.Vector3(1, 0, 0), new THREE.Vector3(), 0.1, 0xff6d00, 0.04, 0.025);
 const wrenchArrow = new THREE.ArrowHelper(new THREE.Vector3(1, 0, 0), new THREE.Vector3(), 0.1, 0x8e24aa, 0.03, 0.02);
 pushArrow.visible = wrenchArrow.visible = false;
+for (const arrow of [pushArrow, wrenchArrow]) {  // drawn over the capsules they start inside
+  arrow.traverse((o) => { if (o.material) o.material.depthTest = false; });
+  arrow.renderOrder = 4;
+}
 scene.add(pushArrow, wrenchArrow);
 const pairLine = new THREE.Line(new THREE.BufferGeometry().setFromPoints([new THREE.Vector3(), new THREE.Vector3()]),
                                 new THREE.LineBasicMaterial({ color: 0xd50000, depthTest: false }));
@@ -151,7 +155,7 @@ function buildArm(model) {
     scene.add(g);
     view.bodies.push(g);
     // The joint that moves this body, at its origin, coloured by its limit margin.
-    const joint = new THREE.Mesh(new THREE.SphereGeometry(0.028, 20, 12), new THREE.MeshStandardMaterial({ color: 0x43a047 }));
+    const joint = new THREE.Mesh(new THREE.SphereGeometry(0.052, 20, 12), new THREE.MeshStandardMaterial({ color: 0x43a047 }));
     g.add(joint);
     view.joints.push(joint);
   }
@@ -193,7 +197,7 @@ function showArm(f) {
   f.margin.forEach((m, i) => view.joints[i].material.color.setHSL(0.33 * m, 0.8, 0.45));  // green -> red at a limit
   setPose(eeAxes, f.ee);
   setPose(targetAxes, f.target);
-  if (f.push) setArrow(pushArrow, f.push.point, f.push.force, 0.004); else pushArrow.visible = false;
+  if (f.push) setArrow(pushArrow, f.push.point, f.push.force, 0.006); else pushArrow.visible = false;
   setArrow(wrenchArrow, f.ee.p, f.wrench.slice(0, 3), 0.01);
   const names = f.collision ? new Set([f.collision.first, f.collision.second]) : new Set();
   for (const m of view.capsules) m.material.color.set(names.has(m.userData.link) ? 0xef9a9a : 0x90a4ae);
@@ -348,7 +352,7 @@ function redraw(now) {
     for (const p of plots) p.u.setData(p.data);
     phri.plotUpdates++;
   }
-  if (now - lastView >= VIEW_PERIOD_MS) {
+  if (phri.view3d !== false && now - lastView >= VIEW_PERIOD_MS) {
     lastView = now;
     renderer.render(scene, camera);
   }

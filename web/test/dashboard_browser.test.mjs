@@ -10,7 +10,7 @@
 // Screenshots go to --out (dashboard_*.png). Exit 77 (ctest: skipped) when chromium is absent.
 //
 //   node web/test/dashboard_browser.test.mjs --phri build/release/phri --config configs/dashboard.yaml --out DIR
-import { spawn } from 'node:child_process';
+import { spawn, spawnSync } from 'node:child_process';
 import fs from 'node:fs';
 import path from 'node:path';
 import { setTimeout as sleep } from 'node:timers/promises';
@@ -33,8 +33,12 @@ function check(ok, what) {
 }
 
 // phri, until it prints the dashboard's address.
+// On a small machine the browser (software WebGL) competes with the 1 kHz loop, whose policy is a safe
+// hold after two overruns in a row: the loop runs before the browser, as a controller would on a
+// real-time kernel (phri at nice -10 when the test may raise it, chromium at nice +15 always).
 function startPhri() {
-  const child = spawn(args.phri, ['run', '--config', args.config, '--realtime', '--dashboard', '--port', '0',
+  const [command, ...prefix] = process.getuid && process.getuid() === 0 ? ['nice', '-n', '-10', args.phri] : [args.phri];
+  const child = spawn(command, [...prefix, 'run', '--config', args.config, '--realtime', '--dashboard', '--port', '0',
                                   '--out', out, '--duration', '300', '--no-figure'], { stdio: ['ignore', 'pipe', 'pipe'] });
   let text = '';
   child.stderr.on('data', (d) => process.stderr.write(d));
@@ -60,9 +64,11 @@ async function waitFor(page, fn, what, timeout = 20000, arg = undefined) {
   }
 }
 
-// The log as the page downloads it, as rows of numbers by column name.
+// The log behind the page's "download log" link (fetched here, not in the page: it grows by
+// ~1 MB a second), as rows of numbers by column name.
 async function downloadLog(page) {
-  const csv = await page.evaluate(async () => (await fetch('/api/log')).text());
+  const href = await page.$eval('#log', (a) => a.href);
+  const csv = await (await fetch(href)).text();
   const lines = csv.trim().split('\n');
   const header = lines[0].split(',');
   const rows = lines.slice(1).map((l) => l.split(',').map(Number));
@@ -73,8 +79,12 @@ const { child, url } = await startPhri();
 console.log('phri serves ' + url.replace(/token=.*/, 'token=…'));
 const browser = await puppeteer.launch({
   executablePath: chromium, headless: true,
-  args: ['--no-sandbox', '--enable-unsafe-swiftshader', '--use-angle=swiftshader', '--window-size=1400,1300'],
+  // WebGL through SwiftShader (no GPU here); 2-D canvases (the plots) in software: SwiftShader's
+  // accelerated 2-D canvas stalled the page for 0.5 s at a time on this 2-core machine.
+  args: ['--no-sandbox', '--enable-unsafe-swiftshader', '--use-angle=swiftshader', '--disable-accelerated-2d-canvas',
+         '--window-size=1400,1300'],
 });
+spawnSync('renice', ['-n', '15', '-g', String(browser.process().pid)], { stdio: 'ignore' });
 try {
   const page = await browser.newPage();
   await page.setViewport({ width: 1400, height: 1300 });

@@ -7,7 +7,10 @@
 
 #include <httplib.h>
 
+#include <algorithm>
 #include <array>
+#include <cerrno>
+#include <functional>
 #include <chrono>
 #include <csignal>
 #include <filesystem>
@@ -17,8 +20,36 @@
 #include <sstream>
 #include <string_view>
 
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+
 namespace phri {
 namespace {
+
+// The server's threads yield to the control loop: on a busy machine a page load or a hundred
+// streams must not delay a cycle (Linux: a thread's nice value is its own).
+constexpr int kServerNiceOffset = 10;
+
+void lower_this_thread(int base_nice) {
+  const auto tid = static_cast<id_t>(::syscall(SYS_gettid));
+  ::setpriority(PRIO_PROCESS, tid, std::min(base_nice + kServerNiceOffset, 19));
+}
+
+// httplib's thread pool, each task run at the server's lower priority.
+class NiceThreadPool final : public httplib::ThreadPool {
+public:
+  NiceThreadPool(std::size_t threads, int base_nice) : httplib::ThreadPool(threads), base_nice_(base_nice) {}
+  void enqueue(std::function<void()> fn) override {
+    httplib::ThreadPool::enqueue([fn = std::move(fn), base = base_nice_] {
+      lower_this_thread(base);
+      fn();
+    });
+  }
+
+private:
+  int base_nice_;
+};
 
 // The files the page may load, and only those: URL path -> file under the web root, MIME type.
 struct StaticFile {
@@ -229,15 +260,27 @@ void DashboardServer::Impl::serve_stream(httplib::Response& res) {
 }
 
 void DashboardServer::Impl::serve_log(httplib::Response& res) {
-  if (settings.log_path.empty()) {
+  std::error_code ec;
+  const auto size = settings.log_path.empty() ? 0 : std::filesystem::file_size(settings.log_path, ec);
+  if (settings.log_path.empty() || ec) {
     res.status = 404;
-    res.set_content(error_json("this run keeps no log"), "application/json");
+    res.set_content(error_json(settings.log_path.empty() ? "this run keeps no log" : "the log is not there yet"),
+                    "application/json");
     return;
   }
-  // The writer thread flushes every few milliseconds: the file is the log up to about now.
+  // The writer thread flushes every few milliseconds: the file up to now, sent in pieces (a long
+  // run's log is hundreds of MB; it is never held in memory whole).
   res.set_header("Content-Disposition", "attachment; filename=\"" +
                                             std::filesystem::path(settings.log_path).filename().string() + "\"");
-  res.set_content(read_file(settings.log_path), "text/csv");
+  auto file = std::make_shared<std::ifstream>(settings.log_path, std::ios::binary);
+  res.set_content_provider(static_cast<std::size_t>(size), "text/csv",
+                           [file](std::size_t offset, std::size_t length, httplib::DataSink& sink) {
+                             std::array<char, 65536> buffer;
+                             file->seekg(static_cast<std::streamoff>(offset));
+                             file->read(buffer.data(), static_cast<std::streamsize>(std::min(length, buffer.size())));
+                             const auto got = static_cast<std::size_t>(file->gcount());
+                             return got > 0 && sink.write(buffer.data(), got);
+                           });
 }
 
 void DashboardServer::Impl::serve_command(const httplib::Request& req, httplib::Response& res) {
@@ -313,15 +356,23 @@ DashboardServer::DashboardServer(LiveChannel& channel, const Controller& control
   s.server.set_tcp_nodelay(true);  // a frame goes out when written (Nagle would batch the stream's small writes)
   // One thread per open stream plus a few for the page's requests.
   const std::size_t threads = static_cast<std::size_t>(settings.max_streams) + 8;
-  s.server.new_task_queue = [threads] { return new httplib::ThreadPool(threads); };
+  errno = 0;
+  const int base_nice = ::getpriority(PRIO_PROCESS, 0);
+  s.server.new_task_queue = [threads, base_nice] { return new NiceThreadPool(threads, base_nice); };
   s.routes();
   port_ = settings.port == 0 ? s.server.bind_to_any_port(settings.bind_address)
                              : (s.server.bind_to_port(settings.bind_address, settings.port) ? settings.port : -1);
   if (port_ <= 0) {
     throw IoError(settings.bind_address + ":" + std::to_string(settings.port), "cannot listen there (in use, or no such address)");
   }
-  s.listener = std::thread([&s] { s.server.listen_after_bind(); });
-  s.pumper = std::thread([&s] { s.pump(); });
+  s.listener = std::thread([&s, base_nice] {
+    lower_this_thread(base_nice);
+    s.server.listen_after_bind();
+  });
+  s.pumper = std::thread([&s, base_nice] {
+    lower_this_thread(base_nice);
+    s.pump();
+  });
 }
 
 DashboardServer::~DashboardServer() { stop(); }
