@@ -9,7 +9,7 @@ import uPlot from 'uplot';
 const token = new URLSearchParams(location.search).get('token') || '';
 const WINDOW_S = 10;          // plots show the last 10 s of robot time
 const PLOT_PERIOD_MS = 12;    // plots redrawn with every frame, up to ~80 Hz (frames come at ~60 Hz)
-const PUSH_STIFFNESS = 200;   // N per m between the grabbed point and the pointer (a spring: the arm follows)
+const PUSH_N_PER_M = 300;     // push force per metre of drag from where the link was grabbed
 const PUSH_RENEW_MS = 150;    // a held push is re-sent (the server ends a push 0.5 s after its last)
 
 const $ = (id) => document.getElementById(id);
@@ -237,10 +237,11 @@ function pointerRay(event) {
                                             -((event.clientY - r.top) / r.height) * 2 + 1), camera);
 }
 
-// The push: a spring from the grabbed point (as the arm moves it) to the pointer, capped.
+// The push: proportional to the drag from where the link was grabbed, capped. Not a spring to the
+// moving link: with the stream's and the requests' latency (tens of ms) a spring on a compliant
+// arm is a delayed feedback loop, and it made the arm swing.
 function pushForce() {
-  const point = view.bodies[drag.body].localToWorld(drag.local.clone());
-  const force = drag.hand.clone().sub(point).multiplyScalar(PUSH_STIFFNESS);
+  const force = drag.hand.clone().sub(drag.grabbed).multiplyScalar(PUSH_N_PER_M);
   const max = phri.model.push_max_N;
   if (force.length() > max) force.setLength(max);
   return force;
@@ -265,6 +266,7 @@ renderer.domElement.addEventListener('pointerdown', (event) => {
   Object.assign(drag, { active: true, body: hit.object.userData.body });
   drag.local = view.bodies[drag.body].worldToLocal(hit.point.clone());
   drag.hand.copy(hit.point);
+  drag.grabbed = hit.point.clone();
   drag.plane.setFromNormalAndCoplanarPoint(camera.getWorldDirection(new THREE.Vector3()), hit.point);
   $('push-readout').classList.add('active');
   sendPush();

@@ -161,7 +161,7 @@ try {
 
   // Stop from the page: phri brakes, holds and exits.
   await page.click('#event-stop');
-  const code = await Promise.race([new Promise((r) => child.on('exit', r)), sleep(20000).then(() => 'timeout')]);
+  const code = await Promise.race([new Promise((r) => child.on('exit', r)), sleep(60000).then(() => 'timeout')]);
   check(code === 0, `the stop button ended the run (exit status ${code})`);
 } catch (e) {
   check(false, 'exception: ' + (e.stack || e));
