@@ -99,18 +99,19 @@ void draw_demo_figure(const std::string& log_path, const std::string& png, const
   }
 }
 
-// Where the dashboard's page is: --web-root, else web/ here or in the source tree (scripts/setup
-// put the npm packages there), else the installed copy beside the program (cmake --install).
+// Where the dashboard's page is: --web-root, else web/ here, else the installed copy beside the
+// program (cmake --install), else the source tree's (scripts/setup put the npm packages there).
 std::string dashboard_web_root(const std::string& given) {
   if (!given.empty()) return given;
-  std::vector<std::filesystem::path> candidates = {"web", std::filesystem::path(PHRI_SOURCE_DIR) / "web"};
+  std::vector<std::filesystem::path> candidates = {"web"};
   std::error_code ec;
   const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
   if (!ec) candidates.push_back(exe.parent_path().parent_path() / PHRI_INSTALL_DATADIR / "phri" / "web");
+  candidates.push_back(std::filesystem::path(PHRI_SOURCE_DIR) / "web");
   for (const auto& dir : candidates) {
     if (std::filesystem::exists(dir / "index.html") && std::filesystem::exists(dir / "node_modules")) return dir.string();
   }
-  return candidates[1].string();
+  return candidates.back().string();
 }
 
 struct DashboardArguments {
