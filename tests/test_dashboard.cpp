@@ -18,6 +18,7 @@
 #include <phri/dashboard/stream_clients.hpp>
 #include <phri/sim/sim_robot.hpp>
 
+#include "allocation_counter.hpp"
 #include "gen3_settings.hpp"
 
 #include <gtest/gtest.h>
@@ -332,6 +333,44 @@ TEST(DashboardLoop, ADraggedLinkMovesTheSimulatedArmAndLettingGoEndsThePush) {
   ASSERT_EQ(client.Post("/api/run", token, "", "application/json")->status, 200);
   loop.join();
   EXPECT_LT(std::abs(run.robot.truth().sensor_position_m.y() - y0), 0.5 * (y1 - y0)) << "released, the arm goes back";
+}
+
+// The loop's side of the hand-off allocates nothing: a session's allocations (all made before and
+// after its cycles) do not depend on how many cycles it runs, with the page's commands taken and
+// a snapshot published every 16 cycles.
+TEST(DashboardLoop, TheLoopSideOfTheHandOffAllocatesNothingPerCycle) {
+  if (!phri::test::counts_malloc()) GTEST_SKIP() << "allocations are not counted under the sanitizer";
+  auto allocations = [](double duration_s) {
+    const phri::Config config = LiveRun::load();
+    phri::SimRobot robot(config.plant);
+    phri::Controller controller(config.controller);
+    phri::Fsm fsm(config.fsm, controller);
+    phri::LiveChannel channel;
+    phri::LiveCommand c;
+    c.kind = phri::LiveCommand::Kind::kEvent;
+    c.event = phri::Event::kFullBodyCompliance;
+    channel.send(c);
+    c.kind = phri::LiveCommand::Kind::kGain;
+    c.gain = {phri::LiveGain::kStiffnessScale, 2.0};
+    channel.send(c);
+    c.kind = phri::LiveCommand::Kind::kPush;
+    c.push.body = 6;
+    c.push.force_world = Eigen::Vector3d(0, 20, 0);
+    channel.send(c);
+    phri::RunOptions options;
+    options.duration_s = duration_s;
+    options.status_line = false;
+    options.live = &channel;
+    std::ostringstream out;
+    const phri::test::AllocationCounter count;
+    const phri::RunSummary summary = phri::run_session(robot, controller, fsm, nullptr, nullptr, options, out);
+    const std::size_t n = count.allocations();
+    EXPECT_EQ(controller.compliance().mode(), phri::ComplianceMode::kFullBody);
+    EXPECT_GT(channel.published(), 0u);
+    EXPECT_FALSE(summary.safe_hold);
+    return n;
+  };
+  EXPECT_EQ(allocations(1.0), allocations(3.0));
 }
 
 TEST(DashboardLoop, HundredClientsComeAndGoWhileTheLoopRunsWithoutMemoryGrowth) {

@@ -72,6 +72,10 @@ public:
   }
 
   RunSummary run() {
+    const RealTimePriorityScope priority(options_.real_time);
+    if (options_.real_time && !priority.granted()) {
+      out_ << "phri: note: no real-time scheduling priority (SCHED_FIFO) for the loop; a busy machine may make it overrun\n";
+    }
     const auto wall_start = std::chrono::steady_clock::now();
     std::size_t k = 0;
     for (; k < max_cycles_; ++k) {

@@ -30,7 +30,7 @@ struct PhaseMark {
 
 struct RunOptions {
   double duration_s = 30.0;
-  bool real_time = false;           ///< false: lockstep
+  bool real_time = false;           ///< false: lockstep; true: also SCHED_FIFO where allowed (RealTimePriorityScope)
   bool status_line = true;          ///< a refreshed line on a terminal, progress lines otherwise
   std::vector<PhaseMark> phases;    ///< sorted by start; empty: one phase "run"
   /// A live front end (the dashboard), or null. Its commands are taken at the start of each
