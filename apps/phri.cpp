@@ -1,6 +1,8 @@
 // phri: the command-line entry point.
 //   phri run --config FILE [--lockstep|--realtime] [--duration S] [--out DIR]
-//                                              a session: simulated arm, FSM, gamepad, log, figure
+//            [--dashboard [--port P] [--bind ADDR] [--push-max N]]
+//                                              a session: simulated arm, FSM, gamepad, log, figure,
+//                                              and the live dashboard in a browser
 //   phri info --urdf FILE                      model summary of a robot description
 //   phri identify-friction [options]           the paper's friction identification (simulated arm)
 //   phri experiment torque-tracking [options]  the paper's torque-tracking comparison
@@ -9,6 +11,7 @@
 //   phri experiment dynamic-tracking [options] the dynamic scenario with the four low-level loops
 //   phri experiment dual-compliance [options]  guiding the end effector by hand, release, drift
 //   phri evaluate [--out DIR] [--quick]        all five of the paper's evaluations and report.md/.html
+//   phri experiment dashboard-load [options]   loop cycle time with vs without the dashboard and its clients
 // Every bad argument or file, and every failure of a run or an experiment (phri::Error: ConfigError,
 // IoError, ExperimentError), gives one line on stderr naming what is wrong and a non-zero exit status.
 #include <phri/app/config.hpp>
@@ -21,6 +24,8 @@
 #include <phri/experiments/drop_test.hpp>
 #include <phri/experiments/dual_compliance.hpp>
 #include <phri/experiments/evaluation.hpp>
+#include <phri/dashboard/dashboard_load.hpp>
+#include <phri/dashboard/dashboard_server.hpp>
 #include <phri/experiments/experiment_files.hpp>
 #include <phri/experiments/friction_identification.hpp>
 #include <phri/experiments/safety_fuzz.hpp>
@@ -101,7 +106,50 @@ void draw_demo_figure(const std::string& log_path, const std::string& png, const
   }
 }
 
+// Where the dashboard's page is: --web-root, else web/ here, else the installed copy beside the
+// program (cmake --install), else the source tree's (scripts/setup put the npm packages there).
+std::string dashboard_web_root(const std::string& given) {
+  if (!given.empty()) return given;
+  std::vector<std::filesystem::path> candidates = {"web"};
+  std::error_code ec;
+  const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+  if (!ec) candidates.push_back(exe.parent_path().parent_path() / PHRI_INSTALL_DATADIR / "phri" / "web");
+  candidates.push_back(std::filesystem::path(PHRI_SOURCE_DIR) / "web");
+  for (const auto& dir : candidates) {
+    if (std::filesystem::exists(dir / "index.html") && std::filesystem::exists(dir / "node_modules")) return dir.string();
+  }
+  return candidates.back().string();
+}
+
+struct DashboardArguments {
+  bool enabled = false;
+  int port = 8080;
+  std::string bind = "127.0.0.1";
+  double push_max_N = 100.0;
+  std::string web_root;
+};
+
+// Binds the server (an address in use fails here, before the run) and prints the page's address.
+std::unique_ptr<phri::DashboardServer> start_dashboard(const DashboardArguments& args, const phri::Config& config,
+                                                       const phri::Controller& cycle, phri::LiveChannel& live) {
+  phri::DashboardSettings settings;
+  settings.bind_address = args.bind;
+  settings.port = args.port;
+  settings.push_max_N = args.push_max_N;
+  settings.web_root = dashboard_web_root(args.web_root);
+  if (config.logging_enabled) settings.log_path = config.logging.path;
+  if (args.bind != "127.0.0.1" && args.bind != "localhost") {
+    std::fprintf(stderr, "phri: warning: the dashboard listens on %s, not only on this machine: whoever reaches it with "
+                 "the token moves the arm\n", args.bind.c_str());
+  }
+  auto server = std::make_unique<phri::DashboardServer>(live, cycle, settings);
+  std::printf("phri dashboard: %s\n", server->url().c_str());
+  std::fflush(stdout);
+  return server;
+}
+
 struct RunArguments {
+  DashboardArguments dashboard;
   std::string config_path;
   bool lockstep = false;
   bool real_time = false;
@@ -133,14 +181,19 @@ int run_command(const RunArguments& args) {
   }
   std::optional<phri::Logger> logger;
   if (config.logging_enabled) logger.emplace(config.logging);
+  phri::LiveChannel live;
+  std::unique_ptr<phri::DashboardServer> dashboard;
+  if (args.dashboard.enabled) dashboard = start_dashboard(args.dashboard, config, cycle, live);
 
   phri::RunOptions options;
+  if (dashboard) options.live = &live;
   options.duration_s = config.run.duration_s;
   options.real_time = config.run.pacing == phri::LoopClock::Pacing::kRealTime;
   options.phases.push_back({0.0, "startup"});
   for (const phri::TimedEvent& e : config.fsm.timeline) options.phases.push_back({e.time_s, std::string(phri::to_string(e.event))});
   const phri::RunSummary summary = phri::run_session(robot, cycle, fsm, gamepad.get(), logger ? &*logger : nullptr, options, std::cout);
   if (gamepad) gamepad->stop();
+  if (dashboard) dashboard->stop();
   std::printf("\n");
   phri::print_run_summary(summary, std::cout);
   std::ostringstream md;
@@ -191,6 +244,17 @@ CLI::App* add_run_command(CLI::App& app, RunArguments& args) {
       ->check(duration_seconds());
   run->add_option("--out", args.out_dir, "output folder (log, summary, figure)")->capture_default_str();
   run->add_flag("!--no-figure", args.figure, "skip the figure");
+  auto* dashboard = run->add_flag("--dashboard", args.dashboard.enabled,
+                                  "serve the live dashboard (3-D view, plots, buttons, sliders, drag-to-push) on "
+                                  "127.0.0.1; its address, with a random token, is printed at start");
+  run->add_option("--port", args.dashboard.port, "dashboard port (0: any free one)")
+      ->check(CLI::Range(0, 65535))->needs(dashboard)->capture_default_str();
+  run->add_option("--bind", args.dashboard.bind, "dashboard address to listen on (another than 127.0.0.1: a warning)")
+      ->needs(dashboard)->capture_default_str();
+  run->add_option("--push-max", args.dashboard.push_max_N, "drag-to-push force cap [N]")
+      ->check(CLI::Range(1.0, 1000.0))->needs(dashboard)->capture_default_str();
+  run->add_option("--web-root", args.dashboard.web_root, "folder of the dashboard's page (default: web/)")
+      ->needs(dashboard)->check(CLI::ExistingDirectory);
   return run;
 }
 
@@ -287,6 +351,18 @@ CLI::App* add_safety_fuzz_command(CLI::App& experiment, SafetyFuzzArguments& arg
   fuzz->add_option("--plant", o.plant_config_path, "plant configuration")->check(CLI::ExistingFile);
   fuzz->add_flag("--fail-on-violation", args.fail_on_violation, "exit with status 1 when a controller failure was found");
   return fuzz;
+}
+
+CLI::App* add_dashboard_load_command(CLI::App& experiment, phri::DashboardLoadOptions& o) {
+  auto* load = experiment.add_subcommand(
+      "dashboard-load", "The loop's p99.9 cycle time without and with the dashboard serving many clients (same run)");
+  load->add_option("--config", o.config_path, "run configuration")->check(CLI::ExistingFile)->capture_default_str();
+  load->add_option("--segment-s", o.segment_s, "robot time of each segment [s]")->check(CLI::Range(2.0, 600.0))->capture_default_str();
+  load->add_option("--repeats", o.repeats, "segment pairs (without, with), interleaved")->check(CLI::Range(1, 50))->capture_default_str();
+  load->add_option("--clients", o.clients, "stream clients connecting and leaving in each segment with the dashboard")
+      ->check(CLI::Range(0, 10000))->capture_default_str();
+  load->add_option("--web-root", o.web_root, "folder of the dashboard's page (default: web/)")->check(CLI::ExistingDirectory);
+  return load;
 }
 
 int safety_fuzz_command(SafetyFuzzArguments& args) {
@@ -445,6 +521,7 @@ int main(int argc, char** argv) {
   phri::TorqueTrackingOptions dynamic_options = phri::dynamic_tracking_options();
   phri::DualComplianceOptions dual_options;
   phri::EvaluationOptions evaluation;
+  phri::DashboardLoadOptions load_args;
   const CLI::App* run = add_run_command(app, run_args);
   const CLI::App* info = add_info_command(app, info_args);
   const CLI::App* identify = add_identify_command(app, friction);
@@ -452,6 +529,7 @@ int main(int argc, char** argv) {
   experiment->require_subcommand(1);
   const CLI::App* tracking = add_torque_tracking_command(*experiment, tracking_args);
   const CLI::App* fuzz = add_safety_fuzz_command(*experiment, fuzz_args);
+  const CLI::App* load = add_dashboard_load_command(*experiment, load_args);
   auto* friction_alias = experiment->add_subcommand("friction-identification", "Same as 'phri identify-friction'");
   friction_alias->add_option("--out", friction.output_dir, "output folder");
   friction_alias->add_option("--seed", friction.seed, "seed");
@@ -484,6 +562,11 @@ int main(int argc, char** argv) {
     if (dynamic->parsed()) return dynamic_tracking_command(dynamic_options);
     if (dual->parsed()) return dual_compliance_command(dual_options);
     if (evaluate->parsed()) return evaluate_command(evaluation);
+    if (load->parsed()) {
+      load_args.config_path = locate(load_args.config_path);
+      load_args.web_root = dashboard_web_root(load_args.web_root);
+      return phri::run_dashboard_load_command(load_args, std::cout);
+    }
   } catch (const phri::Error& e) {
     return print_error(e.what());
   } catch (const std::exception& e) {  // from a library below (yaml-cpp, the standard library)

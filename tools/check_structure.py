@@ -33,6 +33,7 @@ MODULE_DEPENDENCIES = {
     "sim": ["robot"],
     "app": ["control", "trajectory", "sim"],
     "experiments": ["app", "control", "sim"],
+    "dashboard": ["app"],
 }
 
 INCLUDE = re.compile(r'^\s*#\s*include\s*[<"]phri/([A-Za-z0-9_]+)/', re.M)

@@ -40,7 +40,7 @@ void bind_fsm(py::module_& m) {
   py::class_<Fsm>(m, "Fsm", "The demo's state machine: events in, ControllerTargets out, once per period.")
       .def(py::init<const FsmSettings&, const Controller&>(), py::arg("settings"), py::arg("controller"),
            py::keep_alive<1, 3>(), "`controller`: the one this FSM drives (kept alive with it).")
-      .def("post", &Fsm::post, py::arg("event"), "Queues an event for the next update (False when the queue is full).")
+      .def("post", py::overload_cast<Event>(&Fsm::post), py::arg("event"), "Queues an event for the next update (False when the queue is full).")
       .def("update", &Fsm::update, py::arg("time_s"), py::arg("state"), py::arg("controller"),
            py::return_value_policy::reference_internal, "This period's targets (before controller.step).")
       .def_property_readonly("targets", &Fsm::targets, py::return_value_policy::reference_internal)

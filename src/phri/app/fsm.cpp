@@ -72,6 +72,7 @@ Fsm::Fsm(const FsmSettings& settings, const Controller& cycle)
       data_(model_),
       ee_frame_(cycle.end_effector_frame()),
       queue_(settings.queue_capacity),
+      gain_queue_(settings.queue_capacity),
       targets_(model_.nv()),
       after_startup_(settings.first_scenario),
       torque_loop_(settings.torque_loop),
@@ -96,6 +97,12 @@ Fsm::Fsm(const FsmSettings& settings, const Controller& cycle)
 
 bool Fsm::post(Event event) noexcept {
   if (queue_.try_push(event)) return true;
+  ++events_dropped_;
+  return false;
+}
+
+bool Fsm::post(const GainRequest& request) noexcept {
+  if (gain_queue_.try_push(request)) return true;
   ++events_dropped_;
   return false;
 }
@@ -140,6 +147,7 @@ const ControllerTargets& Fsm::update(double t, const RobotState& state, const Co
   }
   Event event;
   while (queue_.try_pop(event)) handle(event, t, state, cycle);
+  for (GainRequest gain; gain_queue_.try_pop(gain);) apply(gain, targets_);
 
   if (state_ == FsmState::kStartup && motion_ == Motion::kHold) {
     joint_move_.difference(state.q_rad, home_q_, scratch_);

@@ -38,6 +38,7 @@
 // update() allocates nothing and never throws; construction checks the settings (ConfigError).
 #include <phri/control/controller.hpp>
 #include <phri/app/event.hpp>
+#include <phri/app/live_gain.hpp>
 #include <phri/app/scenario.hpp>
 #include <phri/core/spsc_ring.hpp>
 #include <phri/model/data.hpp>
@@ -88,6 +89,9 @@ public:
 
   /// Queues an event for the next update (one producer thread; false when the queue is full).
   bool post(Event event) noexcept;
+  /// Queues a live gain change (the dashboard's sliders) for the next update, which writes it
+  /// into the targets; same thread rule and refusal as post(Event).
+  bool post(const GainRequest& request) noexcept;
   /// Once per period, before controller.step(state, targets, ...). `time_s`: robot time (the
   /// timeline's clock). Returns this period's targets (also targets()).
   const ControllerTargets& update(double time_s, const RobotState& state, const Controller& controller);
@@ -139,6 +143,7 @@ private:
   Data data_;  // forward kinematics of joint references (start-up)
   int ee_frame_;
   SpscRing<Event> queue_;
+  SpscRing<GainRequest> gain_queue_;
   ControllerTargets targets_;
   std::size_t next_timed_ = 0;
 

@@ -2,6 +2,9 @@
 
 #include <thread>
 
+#include <pthread.h>
+#include <sched.h>
+
 namespace phri {
 
 LoopClock::LoopClock(double period_s, Pacing pacing) : period_s_(period_s), pacing_(pacing) {}
@@ -26,6 +29,23 @@ double LoopClock::wait_next() {
   std::this_thread::sleep_until(next_);
   next_ += period;
   return 0.0;
+}
+
+RealTimePriorityScope::RealTimePriorityScope(bool wanted, int priority) {
+  if (!wanted) return;
+  sched_param old{};
+  if (pthread_getschedparam(pthread_self(), &old_policy_, &old) != 0) return;
+  old_priority_ = old.sched_priority;
+  sched_param p{};
+  p.sched_priority = priority;
+  granted_ = pthread_setschedparam(pthread_self(), SCHED_FIFO, &p) == 0;
+}
+
+RealTimePriorityScope::~RealTimePriorityScope() {
+  if (!granted_) return;
+  sched_param old{};
+  old.sched_priority = old_priority_;
+  pthread_setschedparam(pthread_self(), old_policy_, &old);
 }
 
 }  // namespace phri

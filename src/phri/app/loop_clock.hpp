@@ -39,4 +39,23 @@ private:
   std::uint64_t overruns_ = 0;
 };
 
+/// Real-time pacing's scheduling: for its lifetime the calling thread runs under SCHED_FIFO (a
+/// 1 kHz loop that sleeps most of each period, so it never starves the machine), as a controller
+/// on a real-time kernel would; a busy machine (a browser rendering the dashboard, builds) then
+/// cannot preempt a cycle past its period. Where the OS refuses (no CAP_SYS_NICE / RLIMIT_RTPRIO)
+/// the thread stays as it was and granted() says so. The destructor restores the old policy.
+class RealTimePriorityScope {
+public:
+  explicit RealTimePriorityScope(bool wanted, int priority = 80);
+  ~RealTimePriorityScope();
+  RealTimePriorityScope(const RealTimePriorityScope&) = delete;
+  RealTimePriorityScope& operator=(const RealTimePriorityScope&) = delete;
+  bool granted() const { return granted_; }
+
+private:
+  bool granted_ = false;
+  int old_policy_ = 0;
+  int old_priority_ = 0;
+};
+
 }  // namespace phri

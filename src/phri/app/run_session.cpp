@@ -3,6 +3,7 @@
 #include <phri/app/log_row.hpp>
 #include <phri/app/loop_clock.hpp>
 #include <phri/core/statistics.hpp>
+#include <phri/sim/sim_robot.hpp>
 
 #include <algorithm>
 #include <chrono>
@@ -12,6 +13,7 @@
 #include <ostream>
 #include <string>
 #include <string_view>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -21,6 +23,7 @@ namespace phri {
 namespace {
 
 constexpr std::uint64_t kMaxPrintedTransitions = 20;
+constexpr int kMaxSteps = 1 << 30;  // single steps asked and not yet run (they add up)
 
 // The sums of one phase, for its row of the summary table.
 struct PhaseAccumulator {
@@ -62,12 +65,21 @@ public:
         clock_(period_, options.real_time ? LoopClock::Pacing::kRealTime : LoopClock::Pacing::kLockstep),
         last_mode_(cycle.compliance().mode()),
         last_touches_(cycle.compliance().touch_count()),
-        last_loop_switches_(cycle.low_level().switch_count()) {}
+        last_loop_switches_(cycle.low_level().switch_count()),
+        live_(options.live),
+        sim_(dynamic_cast<SimRobot*>(&robot)) {
+    if (live_ && sim_) sim_bodies_ = simulated_bodies(cycle.model(), *sim_);
+  }
 
   RunSummary run() {
+    const RealTimePriorityScope priority(options_.real_time);
+    if (options_.real_time && !priority.granted()) {
+      out_ << "phri: note: no real-time scheduling priority (SCHED_FIFO) for the loop; a busy machine may make it overrun\n";
+    }
     const auto wall_start = std::chrono::steady_clock::now();
     std::size_t k = 0;
     for (; k < max_cycles_; ++k) {
+      if (live_) take_live_commands();
       const RobotState& state = robot_.read();
       const double t = state.time_s;
       enter_phases(t, k);
@@ -76,6 +88,7 @@ public:
       check_safety(status);
       check_overruns(clock_.wait_next(), t);
       print_status(t, pos, micros_[k]);
+      if (live_) publish_live(k);
       if (fsm_.finished()) {
         ++k;
         break;
@@ -114,12 +127,94 @@ private:
       ++summary_.refused_writes;
       cycle_.report_fault(SafetyFault::kWriteRefused, state.time_s);
     }
-    if (logger_) {
+    if (logger_ || live_) {
       fill_log_row(row_, state, cycle_, fsm_);
       row_.cycle_time_s = 1e-6 * us;
-      logger_->push(row_);
     }
+    if (logger_) logger_->push(row_);
     return status;
+  }
+
+  // The simulator's body of each model body (by link name), found before the loop.
+  static std::vector<int> simulated_bodies(const Model& model, const SimRobot& sim) {
+    std::vector<int> bodies(static_cast<std::size_t>(model.num_bodies()), -1);
+    for (const Frame& f : model.frames()) {
+      if (f.type == FrameType::kLink && f.body >= 0 && f.placement.isApprox(Eigen::Isometry3d::Identity()) &&
+          bodies[static_cast<std::size_t>(f.body)] < 0) {
+        bodies[static_cast<std::size_t>(f.body)] = sim.body_id(f.name);
+      }
+    }
+    return bodies;
+  }
+
+  // Takes the front end's commands; while paused, waits here (between two cycles) until it runs
+  // again or asks for steps. The wait restarts the real-time schedule: a pause is no overrun.
+  void take_live_commands() {
+    for (LiveCommand c; live_->receive(c);) handle_live(c);
+    if (!paused_) return;
+    bool waited = false, shown = row_.time_s <= 0.0;
+    while (paused_ && steps_ == 0) {
+      // The page learns it is paused, and sees the last cycle (retried: the queue may be full
+      // of the snapshots of a burst of steps).
+      if (!shown) shown = publish_snapshot();
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+      for (LiveCommand c; live_->receive(c);) handle_live(c);
+      waited = true;
+    }
+    if (steps_ > 0) --steps_;
+    if (waited) clock_.start();
+  }
+
+  void handle_live(const LiveCommand& c) {
+    switch (c.kind) {
+      case LiveCommand::Kind::kEvent: fsm_.post(c.event); break;
+      case LiveCommand::Kind::kGain: fsm_.post(c.gain); break;
+      case LiveCommand::Kind::kPush: start_push(c.push); break;
+      case LiveCommand::Kind::kRelease: end_push(); break;
+      case LiveCommand::Kind::kRun: paused_ = false; steps_ = 0; break;
+      case LiveCommand::Kind::kPause: paused_ = true; steps_ = 0; break;
+      case LiveCommand::Kind::kStep: paused_ = true; steps_ = std::min(steps_ + std::max(1, c.steps), kMaxSteps); break;
+    }
+  }
+
+  // A push on the simulated arm from the next read() on, for push_hold_s unless renewed.
+  void start_push(const LivePush& push) {
+    if (!sim_ || push.body < 0 || push.body >= static_cast<int>(sim_bodies_.size()) ||
+        sim_bodies_[static_cast<std::size_t>(push.body)] < 0) {
+      return;
+    }
+    push_force_.point_m = push.point_local;
+    push_force_.frame = ExternalForce::Frame::kWorld;
+    push_force_.force_N = push.force_world;
+    push_force_.profile = ExternalForce::Profile::kStep;
+    push_force_.start_s = sim_->state().time_s;
+    push_force_.duration_s = live_->settings().push_hold_s;
+    sim_->set_live_disturbance(sim_bodies_[static_cast<std::size_t>(push.body)], push_force_);
+    push_ = push;
+  }
+
+  void end_push() {
+    if (sim_) sim_->set_live_disturbance(-1, push_force_);
+    push_.body = -1;
+  }
+
+  void publish_live(std::size_t k) {
+    if (paused_ || live_->due(k)) publish_snapshot();
+  }
+
+  // The last cycle's row and what the loop knows beside it; false when the queue was full.
+  bool publish_snapshot() {
+    if (push_.body >= 0 && push_force_.scale_at(row_.time_s) == 0.0) push_.body = -1;  // ran out unrenewed
+    snapshot_.row = row_;
+    snapshot_.dof = robot_.dof();
+    snapshot_.push = push_;
+    snapshot_.paused = paused_;
+    const ComplianceController& compliance = cycle_.compliance();
+    snapshot_.ee_gamma_override = compliance.ee_gamma_override();
+    snapshot_.posture_gamma_override = compliance.posture_gamma_override();
+    snapshot_.posture_stiffness = compliance.posture_stiffness();
+    snapshot_.overruns = clock_.overruns();
+    return live_->publish(snapshot_);
   }
 
   // Adds the cycle to its phase's sums; returns the end-effector position error [mm].
@@ -256,6 +351,15 @@ private:
   int last_touches_;
   int last_loop_switches_;
   RunSummary summary_;
+  // live front end
+  LiveChannel* live_;
+  SimRobot* sim_;
+  std::vector<int> sim_bodies_;
+  ExternalForce push_force_;
+  LivePush push_;
+  LiveSnapshot snapshot_;
+  bool paused_ = false;
+  int steps_ = 0;
 };
 
 }  // namespace

@@ -13,6 +13,7 @@
 #include <phri/control/controller.hpp>
 #include <phri/app/fsm.hpp>
 #include <phri/app/gamepad.hpp>
+#include <phri/app/live_channel.hpp>
 #include <phri/app/logger.hpp>
 #include <phri/robot/robot_interface.hpp>
 
@@ -29,9 +30,14 @@ struct PhaseMark {
 
 struct RunOptions {
   double duration_s = 30.0;
-  bool real_time = false;           ///< false: lockstep
+  bool real_time = false;           ///< false: lockstep; true: also SCHED_FIFO where allowed (RealTimePriorityScope)
   bool status_line = true;          ///< a refreshed line on a terminal, progress lines otherwise
   std::vector<PhaseMark> phases;    ///< sorted by start; empty: one phase "run"
+  /// A live front end (the dashboard), or null. Its commands are taken at the start of each
+  /// cycle (events and gains go to the FSM like the gamepad's; pushes to a simulated robot), its
+  /// snapshots published every `decimation` cycles. While paused the loop holds between two
+  /// cycles (the simulation and the controller stop together) and polls the channel every 1 ms.
+  LiveChannel* live = nullptr;
 };
 
 struct PhaseSummary {

@@ -7,7 +7,8 @@
 
 namespace phri {
 
-ComplianceController::ComplianceController(const ComplianceSettings& settings) : settings_(settings) {
+ComplianceController::ComplianceController(const ComplianceSettings& settings)
+    : settings_(settings), posture_stiffness_(settings.posture_stiffness) {
   auto fail = [](const std::string& key, const std::string& reason) { throw ConfigError("ComplianceSettings", key, reason); };
   if (!(settings.release_threshold >= 0 && settings.release_threshold < settings.touch_threshold)) {
     fail("release_threshold", "need 0 <= release_threshold < touch_threshold");
@@ -27,8 +28,10 @@ void ComplianceController::apply(WholeBodyQp& qp) {
   EndEffectorTask& ee = qp.end_effector();
   PostureTask& posture = qp.posture();
   const bool ee_free = mode_ == ComplianceMode::kDual && touched_;
-  const double gamma_ee = (mode_ == ComplianceMode::kFullBody || ee_free) ? 1.0 : 0.0;
-  const double gamma_posture = mode_ == ComplianceMode::kStiff ? 0.0 : 1.0;
+  const double mode_gamma_ee = (mode_ == ComplianceMode::kFullBody || ee_free) ? 1.0 : 0.0;
+  const double mode_gamma_posture = mode_ == ComplianceMode::kStiff ? 0.0 : 1.0;
+  const double gamma_ee = ee_gamma_override_ >= 0.0 ? ee_gamma_override_ : mode_gamma_ee;
+  const double gamma_posture = posture_gamma_override_ >= 0.0 ? posture_gamma_override_ : mode_gamma_posture;
   Vector6d stiffness;
   if (ee_free) {
     stiffness.setZero();
@@ -46,7 +49,7 @@ void ComplianceController::apply(WholeBodyQp& qp) {
   }
   ee.set_weight(settings_.ee_weight);
   ee.set_gamma(Vector6d::Constant(gamma_ee));
-  posture.set_stiffness(settings_.posture_stiffness);
+  posture.set_stiffness(posture_stiffness_);
   posture.set_damping(ee_free ? settings_.touched_posture_damping : settings_.posture_damping);
   posture.set_weight(settings_.posture_weight);
   posture.set_gamma(gamma_posture);
@@ -78,6 +81,18 @@ void ComplianceController::set_mode(ComplianceMode mode, WholeBodyQp& qp, const 
 
 void ComplianceController::set_stiffness_scale(double scale, WholeBodyQp& qp) {
   stiffness_scale_ = clamped_stiffness_scale(scale);
+  apply(qp);
+}
+
+void ComplianceController::set_live_gains(std::optional<double> ee_gamma, std::optional<double> posture_gamma,
+                                          std::optional<double> posture_stiffness, WholeBodyQp& qp) {
+  // A gamma outside [0, 1] is not a partial compliance: negative ends the override, above 1 is 1.
+  auto gamma = [](double g) { return g < 0.0 ? -1.0 : std::min(g, 1.0); };
+  if (ee_gamma && std::isfinite(*ee_gamma)) ee_gamma_override_ = gamma(*ee_gamma);
+  if (posture_gamma && std::isfinite(*posture_gamma)) posture_gamma_override_ = gamma(*posture_gamma);
+  if (posture_stiffness && std::isfinite(*posture_stiffness)) {
+    posture_stiffness_ = std::clamp(*posture_stiffness, 0.0, kMaxPostureStiffness);
+  }
   apply(qp);
 }
 

@@ -12,6 +12,7 @@
 #include <phri/control/whole_body_qp.hpp>
 
 #include <algorithm>
+#include <optional>
 
 namespace phri {
 
@@ -67,6 +68,16 @@ public:
   /// The scale set_stiffness_scale keeps: clamped to [0.1, 4].
   static double clamped_stiffness_scale(double scale) { return std::clamp(scale, 0.1, 4.0); }
   double stiffness_scale() const { return stiffness_scale_; }
+  /// Live gains (ControllerTargets: ee_gamma, posture_gamma, posture_stiffness); an empty optional
+  /// leaves that gain as it is. A gamma in [0, 1] overrides the mode's, a negative one ends the
+  /// override; the posture stiffness is clamped to [0, kMaxPostureStiffness].
+  void set_live_gains(std::optional<double> ee_gamma, std::optional<double> posture_gamma,
+                      std::optional<double> posture_stiffness, WholeBodyQp& qp);
+  static constexpr double kMaxPostureStiffness = 400.0;
+  /// The gamma override of each task, negative when the mode decides.
+  double ee_gamma_override() const { return ee_gamma_override_; }
+  double posture_gamma_override() const { return posture_gamma_override_; }
+  double posture_stiffness() const { return posture_stiffness_; }
 
 private:
   void apply(WholeBodyQp& qp);
@@ -76,6 +87,9 @@ private:
   bool touched_ = false;
   int touch_count_ = 0;
   double stiffness_scale_ = 1.0;
+  double ee_gamma_override_ = -1.0;
+  double posture_gamma_override_ = -1.0;
+  double posture_stiffness_;
 };
 
 }  // namespace phri

@@ -187,6 +187,12 @@ bool Controller::apply(const ControllerTargets& targets) {
   if (targets.stiffness_scale && accept(*targets.stiffness_scale > 0.0 && std::isfinite(*targets.stiffness_scale))) {
     compliance_.set_stiffness_scale(*targets.stiffness_scale, qp_);
   }
+  auto finite_or_empty = [](const std::optional<double>& v) { return !v || std::isfinite(*v); };
+  if ((targets.ee_gamma || targets.posture_gamma || targets.posture_stiffness) &&
+      accept(finite_or_empty(targets.ee_gamma) && finite_or_empty(targets.posture_gamma) &&
+             finite_or_empty(targets.posture_stiffness))) {
+    compliance_.set_live_gains(targets.ee_gamma, targets.posture_gamma, targets.posture_stiffness, qp_);
+  }
   if (targets.has_posture && accept(usable(targets.posture, model_.nv()))) {
     qp_.posture().set_target(targets.posture.q, targets.posture.qd, targets.posture.qdd);
   }

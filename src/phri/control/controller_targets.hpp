@@ -41,6 +41,12 @@ struct ControllerTargets {
   std::optional<ComplianceMode> compliance_mode;  ///< switch to this compliance mode
   std::optional<LowLevelMode> low_level_mode;     ///< switch to this loop (bumpless)
   std::optional<double> stiffness_scale;          ///< end-effector stiffness factor, clamped to [0.1, 4]
+  // Live gains (the dashboard's sliders), clamped where they enter (ComplianceController). A
+  // gamma in [0, 1] replaces the compliance mode's gamma of that task; a negative one gives the
+  // task back to its mode.
+  std::optional<double> ee_gamma;
+  std::optional<double> posture_gamma;
+  std::optional<double> posture_stiffness;        ///< posture task stiffness [1/s^2], clamped to [0, 400]
   bool has_pose = false;     ///< `pose` is the end-effector task's new reference
   PoseReference pose;
   bool has_posture = false;  ///< `posture` is the posture task's new reference
@@ -51,6 +57,9 @@ struct ControllerTargets {
     compliance_mode.reset();
     low_level_mode.reset();
     stiffness_scale.reset();
+    ee_gamma.reset();
+    posture_gamma.reset();
+    posture_stiffness.reset();
     has_pose = false;
     has_posture = false;
   }
