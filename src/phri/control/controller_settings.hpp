@@ -55,8 +55,9 @@ struct SafetySettings {
   /// guard_fraction x the drive's velocity limit, damping rate x (M_ii + I_r) x the excess.
   double velocity_guard_fraction = 0.9;
   /// [1/s] Replaying the runs of safety-fuzz seeds 4242 and 2026 with controller failures (17
-  /// overspeed windows at 200): 4 left at 300, 3 at 400; at 600 and 800 the custom loop's torque
-  /// chattered (refused writes, limits crossed). 300 keeps a gain margin of 2 to that.
+  /// overspeed windows at 200): 5 left at 300; 400 (measured beside a check since removed) left 3;
+  /// at 600 and 800 the custom loop's torque chattered (refused writes, limits crossed). 300 keeps
+  /// a gain margin of 2 to that.
   double velocity_guard_rate = 300.0;
   /// Limit guard: beyond the damper's safety distance d_s, an outward torque of the joint's static
   /// friction plus stiffness x the depth, so that a joint leaves the band against its stiction.
