@@ -297,9 +297,10 @@ bool run_push(Rig& rig, const Shared& s, const PushSpec& p, const Eigen::VectorX
     if (scale > 0.0) rig.monitor().push_torque_ratio(p.body, p.point_local, scale * p.force_N, p.local_frame, m);
     int joint = -1;
     const double from_reference = rig.monitor().deviation(rig.q(), q_ref, joint);
-    const double deviation = dual && rig.speed() < th.rest_speed_rad_s ? 0.0 : from_reference;
+    const bool rests_where_left = dual && rig.speed() < th.rest_speed_rad_s;
+    const double deviation = rests_where_left ? 0.0 : from_reference;
     m.final_deviation_rad = deviation;
-    m.final_deviation_joint = joint;
+    m.final_deviation_joint = rests_where_left ? -1 : joint;  // no joint is "off" when the arm may rest there
     if (t >= start + p.duration_s) m.max_deviation_rad = std::max(m.max_deviation_rad, deviation);
     m.final_speed_rad_s = rig.speed();
     tracker.sample(t, deviation, rig.speed(), rig.safe_stop_time());
