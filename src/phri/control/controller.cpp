@@ -84,7 +84,13 @@ const ControllerSettings& checked(const ControllerSettings& settings) {
 // What the drives and sensors can report: the URDF range, the drives' limits.
 SensorRanges sensor_ranges(const Model& model, const ActuatorTable& actuators) {
   const int n = model.nv();
-  SensorRanges r{model.lower_limits(), model.upper_limits(), Eigen::VectorXd(n), Eigen::VectorXd(n), Eigen::VectorXd(n)};
+  SensorRanges r;
+  r.q_lower = model.lower_limits();
+  r.q_upper = model.upper_limits();
+  for (Eigen::VectorXd* v : {&r.velocity_limit, &r.torque_range, &r.current_range, &r.torque_per_amp, &r.reflected_inertia,
+                             &r.friction_static, &r.friction_coulomb, &r.friction_viscous, &r.transmission_compliance}) {
+    v->resize(n);
+  }
   for (int i = 0; i < n; ++i) {
     if (!model.joint(i).has_position_limits()) {
       r.q_lower[i] = -std::numeric_limits<double>::infinity();
@@ -93,6 +99,15 @@ SensorRanges sensor_ranges(const Model& model, const ActuatorTable& actuators) {
     r.velocity_limit[i] = actuators[i].velocity_limit_rad_s;
     r.torque_range[i] = std::max(actuators[i].max_motor_torque_Nm(), actuators[i].torque_limit_Nm);
     r.current_range[i] = actuators[i].current_limit_A;
+  }
+  for (int i = 0; i < n; ++i) {
+    const ActuatorParameters& a = actuators[i];
+    r.torque_per_amp[i] = a.torque_per_amp();
+    r.reflected_inertia[i] = a.reflected_inertia_kgm2;
+    r.friction_static[i] = a.friction.static_Nm;
+    r.friction_coulomb[i] = a.friction.coulomb_Nm;
+    r.friction_viscous[i] = a.friction.viscous_Nms_per_rad;
+    r.transmission_compliance[i] = a.transmission_stiffness_Nm_per_rad > 0 ? 1.0 / a.transmission_stiffness_Nm_per_rad : 0.0;
   }
   return r;
 }

@@ -19,6 +19,8 @@ struct ActuatorParameters {
   double current_limit_A = 0.0;           ///< motor current saturation
   double torque_limit_Nm = 0.0;           ///< joint torque bound for the controller (QP)
   double velocity_limit_rad_s = 0.0;      ///< joint velocity bound for the controller (QP)
+  /// Torsional stiffness between rotor and torque sensor (harmonic drive) [N.m/rad]; 0: rigid.
+  double transmission_stiffness_Nm_per_rad = 0.0;
   FrictionParameters friction;
 
   /// Joint torque per motor ampere, K_T G_r [N.m/A]: tau_joint = K_T G_r i.

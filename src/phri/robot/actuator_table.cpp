@@ -62,7 +62,7 @@ void parse_limits(const YamlReader& j, ActuatorParameters& a) {
 
 ActuatorParameters parse_joint(const YamlReader& j) {
   j.allow_keys({"name", "size", "gear_ratio", "torque_constant_Nm_per_A", "rotor_inertia_kgm2", "reflected_inertia_kgm2",
-                "current_limit_A", "torque_limit_Nm", "velocity_limit_rad_s", "friction"});
+                "current_limit_A", "torque_limit_Nm", "velocity_limit_rad_s", "transmission_stiffness_Nm_per_rad", "friction"});
   ActuatorParameters a;
   a.joint_name = j.text("name");
   a.size = j.choice("size", {"large", "small"}) == "large" ? ActuatorSize::kLarge : ActuatorSize::kSmall;
@@ -75,6 +75,10 @@ ActuatorParameters parse_joint(const YamlReader& j) {
     throw j.error("reflected_inertia_kgm2", "differs from rotor_inertia_kgm2 * gear_ratio^2 = " + std::to_string(computed));
   }
   parse_limits(j, a);
+  // Optional: 0 (rigid) when absent. Harmonic drives are 1e3..1e6 N.m/rad.
+  if (j.has("transmission_stiffness_Nm_per_rad")) {
+    a.transmission_stiffness_Nm_per_rad = j.number("transmission_stiffness_Nm_per_rad", 10.0, 1e8);
+  }
   parse_friction(j.at("friction"), a, a.friction);
   return a;
 }

@@ -24,6 +24,20 @@ int first_beyond(const Eigen::VectorXd& v, const Eigen::VectorXd& range, double 
   return -1;
 }
 
+// Faults found after the sample's sequence and stamp passed (its stamp can be the next reference).
+bool stamp_checked(SafetyFault f) {
+  switch (f) {
+    case SafetyFault::kNone: case SafetyFault::kPositionRange: case SafetyFault::kPositionJump:
+    case SafetyFault::kVelocityRange: case SafetyFault::kVelocityMismatch: case SafetyFault::kTorqueRange:
+    case SafetyFault::kCurrentRange: case SafetyFault::kTorqueCurrentMismatch: case SafetyFault::kFrozenValues:
+      return true;
+    default:
+      return false;
+  }
+}
+
+double median_of_three(double a, double b, double c) { return std::max(std::min(a, b), std::min(std::max(a, b), c)); }
+
 bool identical(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
   return a.size() == b.size() && (a.array() == b.array()).all();
 }
@@ -37,6 +51,20 @@ void check_settings(const SensorRanges& r, const SupervisorSettings& s) {
   if (!((r.velocity_limit.array() > 0).all() && (r.torque_range.array() > 0).all() &&
         (r.current_range.array() > 0).all() && (r.q_lower.array() < r.q_upper.array()).all())) {
     throw ConfigError(kWhere, "ranges", "limits must be > 0 and lower < upper");
+  }
+  const long compared = r.torque_per_amp.size();
+  for (const Eigen::VectorXd* v : {&r.torque_per_amp, &r.reflected_inertia, &r.friction_static, &r.friction_coulomb,
+                                   &r.friction_viscous, &r.transmission_compliance}) {
+    if (v->size() != compared || (compared != 0 && v->size() != n) || !v->allFinite() || !(v->array() >= 0).all()) {
+      throw ConfigError(kWhere, "ranges",
+                        "torque_per_amp, reflected_inertia, friction_*, transmission_compliance: none, or one finite value >= 0 per joint");
+    }
+  }
+  if (!(s.torque_current_filter_s >= 0) || !(s.torque_current_friction_relative >= 0) || !(s.torque_current_moving_rad_s >= 0) || !(s.torque_current_relative >= 0) ||
+      !(s.torque_current_margin_Nm > 0) || !(s.torque_current_inertia_relative >= 0) || !(s.motor_acceleration_clamp_rad_s2 >= 0) ||
+      !std::isfinite(s.torque_current_filter_s + s.torque_current_friction_relative + s.torque_current_moving_rad_s + s.torque_current_relative +
+                     s.torque_current_margin_Nm + s.motor_acceleration_clamp_rad_s2 + s.torque_current_inertia_relative)) {
+    throw ConfigError(kWhere, "settings", "the torque-current tolerances must be finite (>= 0, margin > 0)");
   }
   if (!(s.period_s > 0) || !(s.position_margin_rad >= 0) || !(s.velocity_bound_factor >= 1) ||
       !(s.position_step_factor >= 1) || !(s.position_step_slack_rad >= 0) || !(s.velocity_consistency_rad_s > 0) || !(s.encoder_quantum_rad >= 0) || !(s.torque_range_factor >= 1) ||
@@ -52,12 +80,18 @@ StateSupervisor::StateSupervisor(const SensorRanges& ranges, const SupervisorSet
   check_settings(ranges_, settings_);
   last_good_ = RobotState(n_);
   previous_ = RobotState(n_);
+  torque_residual_ = Eigen::VectorXd::Zero(n_);
+  residual_qd_ = Eigen::VectorXd::Zero(n_);
+  residual_tau_[0] = residual_tau_[1] = Eigen::VectorXd::Zero(n_);
+  raw_residual_[0] = raw_residual_[1] = Eigen::VectorXd::Zero(n_);
+  rotor_acceleration_size_ = Eigen::VectorXd::Zero(n_);
 }
 
 void StateSupervisor::reset() {
   state_ = SupervisorState::kNormal;
   has_good_ = has_previous_ = has_sequence_ = false;
   frozen_since_s_ = -1.0;
+  residual_updates_ = 0;
   good_in_row_ = bad_in_row_ = 0;
   fault_budget_ = 0.0;
   sample_fault_ = SafetyFault::kNone;
@@ -145,9 +179,59 @@ bool StateSupervisor::frozen(const RobotState& s) {
   return s.joints.stamp_s - frozen_since_s_ >= settings_.frozen_s;
 }
 
+// The first joint whose τ_s the motor current cannot explain (-1: none, or nothing to compare).
+// Runs on samples that passed every other check; the residual's filter advances on each of them,
+// also while it flags, so that it recovers when the fault ends.
+int StateSupervisor::first_torque_current_mismatch(const RobotState& s) {
+  if (ranges_.torque_per_amp.size() != n_ || !s.current.valid) return -1;
+  const SupervisorSettings& c = settings_;
+  // q̈, τ̈_s and the filter's step from the last samples that came this far (not only good ones).
+  const double dt = std::max(s.joints.stamp_s - residual_stamp_s_, c.period_s);
+  if (residual_updates_ > 0 && dt > c.max_degraded_s) residual_updates_ = 0;  // a gap: start again
+  const double alpha = residual_updates_ == 0 ? 1.0 : dt / (c.torque_current_filter_s + dt);
+  int culprit = -1;
+  for (int i = 0; i < n_; ++i) {
+    const double motor = ranges_.torque_per_amp[i] * s.current_A[i];
+    double rotor_acceleration = 0.0;
+    if (residual_updates_ >= 1) rotor_acceleration = (s.qd_rad_s[i] - residual_qd_[i]) / dt;
+    if (residual_updates_ >= 2) {
+      const double tau_dd = (s.tau_sensor_Nm[i] - 2.0 * residual_tau_[0][i] + residual_tau_[1][i]) / (dt * dt);
+      rotor_acceleration += ranges_.transmission_compliance[i] * tau_dd;
+    }
+    rotor_acceleration = std::clamp(rotor_acceleration, -c.motor_acceleration_clamp_rad_s2, c.motor_acceleration_clamp_rad_s2);
+    // Kinetic friction as modelled while the joint moves; stiction (unknown sign) in the tolerance.
+    const double speed = std::abs(s.qd_rad_s[i]);
+    const double kinetic = speed > c.torque_current_moving_rad_s
+                               ? std::copysign(ranges_.friction_coulomb[i] + ranges_.friction_viscous[i] * speed, s.qd_rad_s[i])
+                               : 0.0;
+    const double residual = motor - s.tau_sensor_Nm[i] - ranges_.reflected_inertia[i] * rotor_acceleration - kinetic;
+    // Median of the last three raw residuals: an impact (a hard stop, a step push) aliases into one
+    // or two samples of ~100 N.m between a 1 kHz q̈ and the sensor's instant; a fault persists.
+    const double median = residual_updates_ >= 2 ? median_of_three(residual, raw_residual_[0][i], raw_residual_[1][i]) : residual;
+    raw_residual_[1][i] = raw_residual_[0][i];
+    raw_residual_[0][i] = residual;
+    torque_residual_[i] += alpha * (median - torque_residual_[i]);
+    rotor_acceleration_size_[i] += alpha * (std::abs(rotor_acceleration) - rotor_acceleration_size_[i]);
+    const double tolerance = ranges_.friction_static[i] + c.torque_current_friction_relative * std::abs(kinetic) +
+                             c.torque_current_relative * std::min(std::abs(s.tau_sensor_Nm[i]), std::abs(motor)) +
+                             c.torque_current_inertia_relative * ranges_.reflected_inertia[i] * rotor_acceleration_size_[i] +
+                             c.torque_current_margin_Nm;
+    if (culprit < 0 && ranges_.torque_per_amp[i] > 0.0 && std::abs(torque_residual_[i]) > tolerance) culprit = i;
+  }
+  residual_qd_ = s.qd_rad_s;
+  residual_tau_[1] = residual_tau_[0];
+  residual_tau_[0] = s.tau_sensor_Nm;
+  residual_stamp_s_ = s.joints.stamp_s;
+  residual_updates_ = std::min(residual_updates_ + 1, 2);
+  return culprit;
+}
+
 bool StateSupervisor::check(const RobotState& s) {
   int joint = -1;
   SafetyFault fault = classify(s, joint);
+  if (fault == SafetyFault::kNone && (joint = first_torque_current_mismatch(s)) >= 0) {
+    fault = SafetyFault::kTorqueCurrentMismatch;
+  }
   if (s.q_rad.size() == n_ && s.qd_rad_s.size() == n_ && s.tau_sensor_Nm.size() == n_) {
     if (fault == SafetyFault::kNone && frozen(s)) fault = SafetyFault::kFrozenValues;
     if (fault != SafetyFault::kStale) {
@@ -160,7 +244,7 @@ bool StateSupervisor::check(const RobotState& s) {
   }
   if (fault != SafetyFault::kStale && fault != SafetyFault::kSize) {
     last_sequence_ = s.joints.sequence;
-    if (fault == SafetyFault::kNone) last_stamp_ = s.joints.stamp_s;
+    if (stamp_checked(fault)) last_stamp_ = s.joints.stamp_s;
     has_sequence_ = true;
   }
   if (fault == SafetyFault::kNone) {
@@ -203,8 +287,11 @@ void StateSupervisor::reject(const RobotState& s, SafetyFault fault, int joint) 
   // Robot time of this cycle: the sample's if it is believable, else the last good one's.
   const double t = std::isfinite(s.time_s) && s.time_s >= last_good_.time_s ? s.time_s : last_good_.time_s;
   if (state_ == SupervisorState::kSafeStop) return;
-  if (fault == SafetyFault::kRobotFault) {
-    transition(SupervisorState::kSafeStop, fault, joint, t);  // the robot itself stopped obeying
+  // The robot itself stopped obeying; or τ_s and the current disagree over the residual's filter
+  // time: a persistent fault, and holding the previous torque command would repeat the phantom
+  // push it cancelled.
+  if (fault == SafetyFault::kRobotFault || fault == SafetyFault::kTorqueCurrentMismatch) {
+    transition(SupervisorState::kSafeStop, fault, joint, t);
     return;
   }
   if (state_ == SupervisorState::kNormal) transition(SupervisorState::kDegraded, fault, joint, t);
