@@ -104,7 +104,7 @@ void absolutize_robot(YAML::Node plant, const std::string& dir) {
   const YAML::Node& view = plant;
   if (!view.IsMap() || !view["robot"] || !view["robot"].IsMap()) return;
   YAML::Node robot = plant["robot"];
-  for (const char* key : {"mjcf", "actuators"}) {
+  for (const char* key : {"mjcf", "urdf", "actuators"}) {
     const YAML::Node& robot_view = robot;
     if (robot_view[key] && robot_view[key].IsScalar()) {
       robot[key] = resolve_path(dir, robot_view[key].Scalar(), kInputPaths);

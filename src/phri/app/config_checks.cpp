@@ -21,13 +21,18 @@ std::string range_text(double lower, double upper) {
   return "[" + format_general(lower, 6) + ", " + format_general(upper, 6) + "]";
 }
 
+std::string joint_type_name(JointType type) { return type == JointType::kRevolute ? "revolute" : "continuous"; }
+
 // One joint of the controller's URDF against the same joint of the plant's MJCF.
 void check_joint_matches_plant(const Joint& joint, const SimScene::ArmJoint& plant, const std::string& urdf,
                                const std::string& mjcf) {
   const std::string where = "joint '" + joint.name + "'";
-  if (!plant.hinge) throw ConfigError(mjcf, joint.name, "the plant's joint is not a hinge (phri simulates revolute arms)");
-  if (joint.type == JointType::kPrismatic) {
+  // Revolute/continuous joints are hinges in the plant, prismatic ones slides.
+  if (joint.type == JointType::kPrismatic && plant.hinge) {
     throw ConfigError(urdf, where, "prismatic in the URDF but a hinge in the plant (" + mjcf + ")");
+  }
+  if (joint.type != JointType::kPrismatic && !plant.hinge) {
+    throw ConfigError(urdf, where, joint_type_name(joint.type) + " in the URDF but a slide in the plant (" + mjcf + ")");
   }
   if (joint.type == JointType::kContinuous || !joint.has_position_limits()) {
     if (plant.limited) {
@@ -54,7 +59,7 @@ void check_urdf_matches_plant(const Model& model, const Config& config) {
     if (match == nullptr) {
       throw ConfigError(urdf, "joint '" + joint.name + "'", "not a joint of the plant (" + config.plant.actuators_path + ")");
     }
-    check_joint_matches_plant(joint, *match, urdf, config.plant.mjcf_path);
+    check_joint_matches_plant(joint, *match, urdf, config.plant.arm_file());
   }
 }
 
