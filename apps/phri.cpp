@@ -1,5 +1,5 @@
 // phri: the command-line entry point.
-//   phri run --config FILE [--lockstep|--realtime] [--duration S] [--out DIR]
+//   phri run --config FILE [--robot DIR] [--lockstep|--realtime] [--duration S] [--out DIR]
 //            [--dashboard [--port P] [--bind ADDR] [--push-max N]]
 //                                              a session: simulated arm, FSM, gamepad, log, figure,
 //                                              and the live dashboard in a browser
@@ -56,6 +56,7 @@ int print_model_summary(const std::string& urdf_path, const std::string& tip, co
   const phri::Model model = phri::Model::from_urdf_file(urdf_path, options);
   phri::Data data(model);
   std::printf("model '%s' from %s\n", model.name().c_str(), urdf_path.c_str());
+  for (const std::string& warning : model.warnings()) std::printf("warning: %s\n", warning.c_str());
   std::printf("chain %s -> %s: %d joints, %d frames, moving mass %.4f kg\n\n", model.base_link().c_str(),
               model.tip_link().c_str(), model.nq(), model.num_frames(), model.total_mass());
   std::printf("%-3s %-10s %-11s %10s %10s %10s %10s %9s\n", "#", "joint", "type", "lower", "upper",
@@ -151,6 +152,7 @@ std::unique_ptr<phri::DashboardServer> start_dashboard(const DashboardArguments&
 struct RunArguments {
   DashboardArguments dashboard;
   std::string config_path;
+  std::string robot_folder;  ///< robots/<robot>: replaces the configuration's robot
   bool lockstep = false;
   bool real_time = false;
   double duration_s = -1.0;
@@ -160,7 +162,7 @@ struct RunArguments {
 
 // `phri run`: loads the configuration, runs the session, writes the log, summary and figure.
 int run_command(const RunArguments& args) {
-  phri::Config config = phri::Config::from_yaml_file(args.config_path);
+  phri::Config config = phri::Config::from_yaml_file(args.config_path, args.robot_folder);
   if (args.lockstep) config.run.pacing = phri::LoopClock::Pacing::kLockstep;
   if (args.real_time) config.run.pacing = phri::LoopClock::Pacing::kRealTime;
   if (args.duration_s > 0.0) config.run.duration_s = args.duration_s;
@@ -171,6 +173,8 @@ int run_command(const RunArguments& args) {
   // Everything that can refuse the configuration is built before the first line of output.
   phri::SimRobot robot(config.plant);
   phri::Controller cycle(config.controller);
+  // What the URDF loader accepted but the user should know (one line each, naming the link).
+  for (const std::string& warning : cycle.model().warnings()) std::fprintf(stderr, "phri: warning: %s\n", warning.c_str());
   phri::Fsm fsm(config.fsm, cycle);
   std::printf("phri run: %s, %.1f s, %s\n", args.config_path.c_str(), config.run.duration_s,
               config.run.pacing == phri::LoopClock::Pacing::kLockstep ? "lockstep" : "real time");
@@ -238,6 +242,9 @@ CLI::App* add_run_command(CLI::App& app, RunArguments& args) {
   run->add_option("--config", args.config_path, "configuration YAML (e.g. configs/demo.yaml)")
       ->required()
       ->check(CLI::ExistingFile);
+  run->add_option("--robot", args.robot_folder, "robot bundle folder with its robot.yaml (e.g. robots/kinova_gen3), "
+                  "in place of the configuration's robot")
+      ->check(CLI::ExistingDirectory);
   auto* lockstep = run->add_flag("--lockstep", args.lockstep, "as fast as possible (same code path)");
   run->add_flag("--realtime", args.real_time, "paced by the 1 ms real-time clock")->excludes(lockstep);
   run->add_option("--duration", args.duration_s, "robot time to run [s], at most 3600")

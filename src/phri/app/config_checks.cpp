@@ -115,7 +115,11 @@ void check_config_against_robot(const Config& config) {
   const ControllerSettings& settings = config.controller;
   {
     // The plain URDF first: the frame the options hang the F/T sensor and payloads on must be right.
-    const Model plain = Model::from_urdf_file(settings.urdf_path);
+    ModelOptions chain_only;  // the chain of the settings, without the F/T frame and the payloads
+    chain_only.base_link = settings.base_link;
+    chain_only.tip_link = settings.tip_link;
+    chain_only.locked_joints = settings.locked_joints;
+    const Model plain = Model::from_urdf_file(settings.urdf_path, chain_only);
     check_end_effector_frame(plain, config);
   }
   const Model model = Model::from_urdf_file(settings.urdf_path, Controller::model_options(settings));

@@ -11,6 +11,9 @@ namespace phri {
 
 ModelOptions Controller::model_options(const ControllerSettings& settings) {
   ModelOptions options;
+  options.base_link = settings.base_link;
+  options.tip_link = settings.tip_link;
+  options.locked_joints = settings.locked_joints;
   ExtraFrame sensor;
   sensor.name = "ft_sensor";
   sensor.parent_frame = settings.end_effector_frame;

@@ -72,6 +72,11 @@ struct ControllerSettings {
   std::string actuators_path;  ///< actuators.yaml: limits, rotor inertia, friction model
   std::string collision_path;  ///< collision.yaml; empty: no self-collision constraint
   std::string end_effector_frame = "end_effector_link";
+  /// The controlled chain (ModelOptions): base and tip links ('' : the URDF's root, the end of its
+  /// only moving branch) and the URDF joints held at 0 (e.g. a gripper's fingers).
+  std::string base_link;
+  std::string tip_link;
+  std::vector<std::string> locked_joints;
   /// F/T sensor measuring frame on the end-effector frame: offset along its z axis (paper setup,
   /// robot/paper_end_of_arm.hpp).
   double ft_sensor_offset_m = PaperEndOfArm::kSensorOffset_m;

@@ -1,0 +1,154 @@
+// How the cost grows with the arm (issue 16): the model terms and the whole controller cycle on
+// generated serial chains of 6, 7, 14 and 30 DoF (tests/support/random_chain.hpp: random axes,
+// offsets, rotated inertials, fixed links between, one in four joints prismatic on average), and
+// the capsule distances with their derivatives for 10, 50 and 200 pairs on the 30-DoF chain.
+//   build/release/bench/phri_bench --benchmark_filter=Scaling --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
+// The whole cycle: phri::Controller::step on a fixed-rate stream of states of a generated chain at
+// rest (position loop, null-space compliance, no collision model), the model loaded as the Gen3's is.
+#include <phri/control/controller.hpp>
+#include <phri/model/algorithms.hpp>
+#include <phri/model/collision_model.hpp>
+#include <phri/model/model.hpp>
+
+#include "../tests/support/random_chain.hpp"
+
+#include <benchmark/benchmark.h>
+
+#include <random>
+#include <sstream>
+
+namespace {
+
+struct Chain {
+  explicit Chain(int dof) : chain(make(dof)), model(phri::Model::from_urdf_string(chain.urdf)), data(model) {
+    std::mt19937 rng(static_cast<unsigned>(dof));
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    q.resize(dof);
+    qd.resize(dof);
+    qdd.resize(dof);
+    for (int i = 0; i < dof; ++i) {
+      q[i] = u(rng);
+      qd[i] = u(rng);
+      qdd[i] = 5.0 * u(rng);
+    }
+    phri::compute_all_terms(model, data, q, qd);
+  }
+  static phri::test::RandomChain make(int dof) {
+    std::mt19937 rng(static_cast<unsigned>(1000 + dof));
+    return phri::test::make_random_chain(dof, rng);
+  }
+  phri::test::RandomChain chain;
+  phri::Model model;
+  phri::Data data;
+  Eigen::VectorXd q, qd, qdd;
+};
+
+void ScalingAllTerms(benchmark::State& state) {
+  Chain c(static_cast<int>(state.range(0)));
+  for (auto _ : state) benchmark::DoNotOptimize(phri::compute_all_terms(c.model, c.data, c.q, c.qd));
+}
+BENCHMARK(ScalingAllTerms)->Arg(6)->Arg(7)->Arg(14)->Arg(30);
+
+void ScalingCrba(benchmark::State& state) {
+  Chain c(static_cast<int>(state.range(0)));
+  for (auto _ : state) benchmark::DoNotOptimize(phri::crba(c.model, c.data, c.q).data());
+}
+BENCHMARK(ScalingCrba)->Arg(6)->Arg(7)->Arg(14)->Arg(30);
+
+void ScalingRnea(benchmark::State& state) {
+  Chain c(static_cast<int>(state.range(0)));
+  for (auto _ : state) benchmark::DoNotOptimize(phri::rnea(c.model, c.data, c.q, c.qd, c.qdd).data());
+}
+BENCHMARK(ScalingRnea)->Arg(6)->Arg(7)->Arg(14)->Arg(30);
+
+void ScalingTipJacobian(benchmark::State& state) {
+  Chain c(static_cast<int>(state.range(0)));
+  const int tip = c.model.frame_id(c.chain.tip_link);
+  Eigen::MatrixXd jacobian(6, c.model.nv());
+  for (auto _ : state) {
+    phri::frame_jacobian(c.model, c.data, tip, phri::ReferenceFrame::kLocalWorldAligned, jacobian);
+    benchmark::DoNotOptimize(jacobian.data());
+  }
+}
+BENCHMARK(ScalingTipJacobian)->Arg(6)->Arg(7)->Arg(14)->Arg(30);
+
+// Capsules on every moving link of the 30-DoF chain; the first `pairs` non-adjacent pairs.
+std::string capsules_yaml(const phri::test::RandomChain& chain, int pairs) {
+  std::ostringstream yaml;
+  yaml << "capsules:\n";
+  std::vector<std::string> links;
+  for (const std::string& link : chain.link_names) {
+    if (link.rfind("link_", 0) != 0) continue;
+    links.push_back(link);
+    yaml << "  - {link: " << link << ", p0: [0, 0, 0], p1: [0, 0, 0.1], radius: 0.02}\n";
+  }
+  yaml << "pairs:\n";
+  int written = 0;
+  for (std::size_t i = 0; i < links.size() && written < pairs; ++i) {
+    for (std::size_t j = i + 2; j < links.size() && written < pairs; ++j, ++written) {
+      yaml << "  - [" << links[i] << ", " << links[j] << "]\n";
+    }
+  }
+  return yaml.str();
+}
+
+void ScalingCapsulePairs(benchmark::State& state) {
+  Chain c(30);
+  const phri::CollisionModel collision =
+      phri::CollisionModel::from_yaml_string(capsules_yaml(c.chain, static_cast<int>(state.range(0))), c.model);
+  if (collision.num_pairs() != state.range(0)) state.SkipWithError("not enough capsule pairs");
+  phri::CollisionData out(c.model, collision);
+  for (auto _ : state) {
+    phri::compute_collision_distances(c.model, c.data, collision, out, true);
+    benchmark::DoNotOptimize(out.distance.data());
+  }
+}
+BENCHMARK(ScalingCapsulePairs)->Arg(10)->Arg(50)->Arg(200);
+
+// A drive table for the generated chain: the same drive on every joint, limits within the URDF's
+// (effort 50, velocity 2 in random_chain.hpp).
+phri::ActuatorTable generic_drives(const phri::Model& model) {
+  std::vector<phri::ActuatorParameters> joints;
+  for (const phri::Joint& joint : model.joints()) {
+    phri::ActuatorParameters a;
+    a.joint_name = joint.name;
+    a.gear_ratio = 100.0;
+    a.torque_constant_Nm_per_A = 0.1;
+    a.rotor_inertia_kgm2 = 3e-6;
+    a.reflected_inertia_kgm2 = 0.03;
+    a.current_limit_A = 5.0;
+    a.torque_limit_Nm = 40.0;
+    a.velocity_limit_rad_s = 1.5;
+    joints.push_back(a);
+  }
+  return phri::ActuatorTable(std::move(joints));
+}
+
+void ScalingControllerCycle(benchmark::State& state) {
+  Chain c(static_cast<int>(state.range(0)));
+  phri::ControllerSettings settings;
+  settings.end_effector_frame = c.chain.tip_link;
+  settings.payloads.clear();
+  settings.initial_loop = phri::LowLevelMode::kPosition;
+  phri::Model model = phri::Model::from_urdf_string(c.chain.urdf, phri::Controller::model_options(settings));
+  const int n = model.nq();
+  phri::Controller cycle(std::move(model), generic_drives(c.model), std::nullopt, settings);
+  phri::RobotState s(n);
+  for (int i = 0; i < n; ++i) s.q_rad[i] = 0.1 * c.q[i];
+  s.tau_sensor_Nm = phri::compute_gravity(c.model, c.data, s.q_rad);
+  for (phri::SignalStatus* signal : {&s.joints, &s.torque, &s.current, &s.wrench}) signal->valid = true;
+  phri::RobotCommand command(n);
+  for (auto _ : state) {
+    s.time_s += 1e-3;
+    ++s.cycle;
+    for (phri::SignalStatus* signal : {&s.joints, &s.torque, &s.current, &s.wrench}) {
+      ++signal->sequence;
+      signal->stamp_s = s.time_s;
+    }
+    cycle.step(s, command);
+    benchmark::DoNotOptimize(command.q_rad.data());
+  }
+}
+BENCHMARK(ScalingControllerCycle)->Arg(6)->Arg(7)->Arg(14)->Arg(30);
+
+}  // namespace

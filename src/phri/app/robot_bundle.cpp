@@ -1,0 +1,149 @@
+#include <phri/app/robot_bundle.hpp>
+
+#include <phri/core/yaml_reader.hpp>
+#include <phri/robot/actuator_table.hpp>
+
+#include <filesystem>
+
+namespace phri {
+namespace {
+
+// What an arm carries at its flange: at most 20 kg (5x the Gen3's rated 4 kg; above, a unit
+// mistake), inertia at most 1 kg.m^2, COM within 0.5 m of its frame, an adapter not a boom (0.5 m).
+constexpr double kMaxCarried_kg = 20.0;
+constexpr double kMaxCarriedInertia_kgm2 = 1.0;
+// A dead band hides model error (~1 N.m), not a push: 10 N.m is already a firm push at the wrist.
+constexpr double kMaxDeadband_Nm = 10.0;
+// A joint position beyond one turn each way is a typo (degrees for radians), not a posture.
+constexpr double kMaxJointAngle_rad = 2.0 * 3.14159265358979323846;
+
+std::string input_file(const YamlReader& r, std::string_view key, const std::string& folder) {
+  const std::string text = r.text(key);
+  if (text.empty()) throw r.error(key, "empty file name");
+  const std::string path = resolve_path(folder, text, PathForm::kAbsolute);
+  if (!std::filesystem::is_regular_file(path)) throw r.error(key, "file not found: " + path);
+  return path;
+}
+
+std::vector<std::string> names(const YamlReader& r, std::string_view key) {
+  std::vector<std::string> out;
+  if (!r.has(key)) return out;
+  const YamlReader list = r.at(key);
+  list.expect_sequence();
+  for (std::size_t i = 0; i < list.size(); ++i) out.push_back(list.at(i).as_text());
+  return out;
+}
+
+RigidBodyData rigid_body(const YamlReader& r) {
+  r.allow_keys({"mass_kg", "com_m", "inertia_kgm2"});
+  RigidBodyData body;
+  body.mass_kg = r.number("mass_kg", 0.0, kMaxCarried_kg);
+  if (!(body.mass_kg > 0.0)) throw r.error("mass_kg", "must be > 0");
+  body.com_m = r.vector3("com_m", -0.5, 0.5);
+  body.principal_inertia_kgm2 = r.vector3("inertia_kgm2", 1e-9, kMaxCarriedInertia_kgm2);
+  const Eigen::Vector3d& i = body.principal_inertia_kgm2;
+  if (i[0] + i[1] < i[2] || i[0] + i[2] < i[1] || i[1] + i[2] < i[0]) {
+    throw r.error("inertia_kgm2", "principal moments must satisfy the triangle inequality (a rigid body)");
+  }
+  return body;
+}
+
+void parse_frames(const YamlReader& f, RobotBundle& b) {
+  f.allow_keys({"base", "tip", "end_effector"});
+  b.base_link = f.text_or("base", "");
+  b.tip_link = f.text_or("tip", "");
+  b.end_effector_frame = f.text("end_effector");
+}
+
+void parse_end_of_arm(const YamlReader& e, RobotBundle& b) {
+  e.allow_keys({"ft_sensor", "tool"});
+  const YamlReader sensor = e.at("ft_sensor");
+  sensor.allow_keys({"offset_m", "flange_side"});
+  b.end_of_arm.sensor_offset_m = sensor.number("offset_m", 0.0, 0.5);
+  b.end_of_arm.flange_side = rigid_body(sensor.at("flange_side"));
+  b.end_of_arm.tool = rigid_body(e.at("tool"));
+}
+
+void parse_plant(const YamlReader& p, const std::string& folder, RobotBundle& b) {
+  p.allow_keys({"mjcf", "flange_site", "balance_inertia"});
+  if (p.has("mjcf")) b.plant.mjcf_path = input_file(p, "mjcf", folder);
+  // A generated plant has a site at every link frame: the end-effector frame's by default.
+  b.plant.flange_site = p.has("mjcf") ? p.text("flange_site") : p.text_or("flange_site", b.end_effector_frame);
+  b.plant.balance_inertia = p.boolean_or("balance_inertia", false);
+  if (p.has("mjcf") && p.has("balance_inertia")) {
+    throw p.error("balance_inertia", "applies to a plant generated from the URDF only (no 'mjcf')");
+  }
+}
+
+RobotBundle parse(const YamlReader& r, const std::string& folder) {
+  r.allow_keys({"name", "urdf", "actuators", "collision", "frames", "locked_joints", "home_q_rad",
+                "compliance_deadband_Nm", "drive", "end_of_arm", "plant"});
+  RobotBundle b;
+  b.source = r.file();
+  b.name = r.text("name");
+  b.urdf_path = input_file(r, "urdf", folder);
+  b.actuators_path = input_file(r, "actuators", folder);
+  b.collision_path = r.has("collision") ? input_file(r, "collision", folder) : "";
+  parse_frames(r.at("frames"), b);
+  b.locked_joints = names(r, "locked_joints");
+  const int dof = ActuatorTable::from_yaml_file(b.actuators_path).size();
+  b.home_q_rad = r.per_joint<std::vector<double>>("home_q_rad", dof, -kMaxJointAngle_rad, kMaxJointAngle_rad);
+  b.compliance_deadband_Nm = r.per_joint<Eigen::VectorXd>("compliance_deadband_Nm", dof, 0.0, kMaxDeadband_Nm);
+  // Only Kinova's actuator loops are emulated so far; a generic drive is future work (issue 16).
+  (void)r.choice("drive", {"kinova"});
+  parse_end_of_arm(r.at("end_of_arm"), b);
+  parse_plant(r.has("plant") ? r.at("plant") : YamlReader(YAML::Node(YAML::NodeType::Map), r.file(), "plant"), folder, b);
+  return b;
+}
+
+}  // namespace
+
+RobotBundle RobotBundle::from_folder(const std::string& folder) {
+  const std::string file = (std::filesystem::path(folder) / "robot.yaml").string();
+  if (!std::filesystem::is_regular_file(file)) throw ConfigError(file, "", "no robot.yaml in the robot folder");
+  return parse(YamlReader::load_file(file), std::filesystem::absolute(folder).string());
+}
+
+void RobotBundle::apply_to(ControllerSettings& s) const {
+  s.urdf_path = urdf_path;
+  s.actuators_path = actuators_path;
+  s.collision_path = collision_path;
+  s.base_link = base_link;
+  s.tip_link = tip_link;
+  s.end_effector_frame = end_effector_frame;
+  s.locked_joints = locked_joints;
+  s.qp.compliance_deadband = compliance_deadband_Nm;
+  s.ft_sensor_offset_m = end_of_arm.sensor_offset_m;
+  // In the end-effector frame: the adapter as given, the tool shifted by the sensor's offset.
+  auto payload = [](const char* name, const RigidBodyData& body, double offset_z_m) {
+    Payload p{name, "", {}};
+    p.inertia.mass = body.mass_kg;
+    p.inertia.com = body.com_m + Eigen::Vector3d(0.0, 0.0, offset_z_m);
+    p.inertia.inertia_com = body.principal_inertia_kgm2.asDiagonal();
+    return p;
+  };
+  s.payloads = {payload("ft_adapter_and_sensor", end_of_arm.flange_side, 0.0),
+                payload("tool", end_of_arm.tool, end_of_arm.sensor_offset_m)};
+  s.wrench.tool_mass_kg = end_of_arm.tool.mass_kg;
+  s.wrench.tool_com_m = end_of_arm.tool.com_m;
+}
+
+void RobotBundle::apply_to(SimRobotConfig& c) const {
+  c.mjcf_path = plant.mjcf_path;
+  c.urdf_path = plant.mjcf_path.empty() ? urdf_path : "";
+  c.locked_joints = plant.mjcf_path.empty() ? locked_joints : std::vector<std::string>{};
+  c.balance_inertia = plant.balance_inertia;
+  c.actuators_path = actuators_path;
+  c.actuators = ActuatorTable::from_yaml_file(actuators_path);
+  if (c.initial_q_rad.size() != home_q_rad.size()) c.initial_q_rad = home_q_rad;
+  c.ft_sensor.flange_site = plant.flange_site;
+  c.ft_sensor.sensor_offset_m = end_of_arm.sensor_offset_m;
+  c.ft_sensor.flange_side_mass_kg = end_of_arm.flange_side.mass_kg;
+  c.ft_sensor.flange_side_com_m = end_of_arm.flange_side.com_m;
+  c.ft_sensor.flange_side_inertia_kgm2 = end_of_arm.flange_side.principal_inertia_kgm2;
+  c.tool.mass_kg = end_of_arm.tool.mass_kg;
+  c.tool.com_m = end_of_arm.tool.com_m;
+  c.tool.inertia_kgm2 = end_of_arm.tool.principal_inertia_kgm2;
+}
+
+}  // namespace phri
