@@ -4,6 +4,7 @@
 //                                              a session: simulated arm, FSM, gamepad, log, figure,
 //                                              and the live dashboard in a browser
 //   phri info --urdf FILE                      model summary of a robot description
+//   phri fit-collision --robot DIR [--out FILE] self-collision capsules fitted from the robot's URDF
 //   phri identify-friction [options]           the paper's friction identification (simulated arm)
 //   phri experiment torque-tracking [options]  the paper's torque-tracking comparison
 //   phri experiment safety-fuzz [options]      seeded pushes and sensor faults against the safety stage
@@ -15,6 +16,8 @@
 // Every bad argument or file, and every failure of a run or an experiment (phri::Error: ConfigError,
 // IoError, ExperimentError), gives one line on stderr naming what is wrong and a non-zero exit status.
 #include <phri/app/config.hpp>
+#include <phri/app/robot_bundle.hpp>
+#include <phri/model/capsule_fit.hpp>
 #include <phri/app/run_session.hpp>
 #include <phri/core/error.hpp>
 #include <phri/core/format.hpp>
@@ -40,6 +43,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <sstream>
 #include <iostream>
 #include <memory>
@@ -275,6 +279,46 @@ CLI::App* add_info_command(CLI::App& app, InfoArguments& args) {
   info->add_option("--tip", args.tip, "tip link of the chain (default: end of the movable chain)");
   info->add_option("--frame", args.frame, "frame whose position is printed (default: the tip)");
   return info;
+}
+
+struct FitCollisionArguments {
+  std::string robot_folder, out_path;
+  phri::CapsuleFitOptions options;
+};
+
+CLI::App* add_fit_collision_command(CLI::App& app, FitCollisionArguments& args) {
+  auto* fit = app.add_subcommand("fit-collision", "Fit self-collision capsules from a robot bundle's URDF (a collision.yaml)");
+  fit->add_option("--robot", args.robot_folder, "robot bundle folder (robots/<robot>)")->required()->check(CLI::ExistingDirectory);
+  fit->add_option("--out", args.out_path, "collision.yaml to write (default: standard output)");
+  fit->add_option("--radius", args.options.link_frame_radius_m, "capsule radius of links without collision geometry [m]")
+      ->check(CLI::Range(0.001, 0.5))->capture_default_str();
+  fit->add_option("--clearance", args.options.clearance_m, "pairs closer at the home posture are left out [m]")
+      ->check(CLI::Range(0.0, 0.5))->capture_default_str();
+  return fit;
+}
+
+// `phri fit-collision`: the bundle's model at its home posture; notes on stderr, the YAML out.
+int fit_collision_command(const FitCollisionArguments& args) {
+  const phri::RobotBundle robot = phri::RobotBundle::from_folder(args.robot_folder);
+  phri::ControllerSettings settings;
+  robot.apply_to(settings);
+  settings.payloads.clear();
+  const phri::Model model = phri::Model::from_urdf_file(robot.urdf_path, phri::Controller::model_options(settings));
+  std::ifstream file(robot.urdf_path);
+  std::stringstream urdf;
+  urdf << file.rdbuf();
+  const Eigen::VectorXd home = Eigen::Map<const Eigen::VectorXd>(robot.home_q_rad.data(), model.nq());
+  const phri::CapsuleFit fit = phri::fit_capsules(urdf.str(), model, home, args.options);
+  for (const std::string& note : fit.notes) std::fprintf(stderr, "phri fit-collision: %s\n", note.c_str());
+  if (args.out_path.empty()) {
+    std::cout << fit.yaml;
+    return 0;
+  }
+  std::ofstream out(args.out_path);
+  out << fit.yaml;
+  if (!out) throw phri::IoError(args.out_path, "cannot write");
+  std::printf("phri fit-collision: %d capsules, %d pairs -> %s\n", fit.capsules, fit.pairs, args.out_path.c_str());
+  return 0;
 }
 
 CLI::App* add_identify_command(CLI::App& app, phri::FrictionIdentificationOptions& friction) {
@@ -552,6 +596,8 @@ int main(int argc, char** argv) {
   evaluate->add_option("--out", evaluation.output_dir, "output folder")->capture_default_str();
   evaluate->add_flag("--quick", evaluation.quick, "short protocols (a smoke test; not the paper's numbers)");
   evaluate->add_option("--jobs", evaluation.jobs, "threads for the drops")->check(CLI::Range(1, 64))->capture_default_str();
+  FitCollisionArguments fit_args;
+  const CLI::App* fit_collision = add_fit_collision_command(app, fit_args);
 
   if (const std::string error = command_word_error(app, argc, argv); !error.empty()) return print_error(error.c_str());
   try {
@@ -562,6 +608,7 @@ int main(int argc, char** argv) {
   try {
     if (run->parsed()) return run_command(run_args);
     if (info->parsed()) return print_model_summary(info_args.urdf_path, info_args.tip, info_args.frame);
+    if (fit_collision->parsed()) return fit_collision_command(fit_args);
     if (identify->parsed() || friction_alias->parsed()) return friction_identification_command(friction);
     if (tracking->parsed()) return torque_tracking_command(tracking_args);
     if (fuzz->parsed()) return safety_fuzz_command(fuzz_args);
