@@ -23,6 +23,7 @@
 #include <phri/core/format.hpp>
 #include <phri/core/process.hpp>
 #include <phri/sim/sim_robot.hpp>
+#include <phri/sim/urdf_plant.hpp>
 #include <phri/core/version.hpp>
 #include <phri/experiments/drop_test.hpp>
 #include <phri/experiments/dual_compliance.hpp>
@@ -164,6 +165,16 @@ struct RunArguments {
   bool figure = true;
 };
 
+// The generated plant's warnings (none for a hand-written MJCF).
+std::vector<std::string> generated_plant_warnings(const phri::SimRobotConfig& plant) {
+  if (plant.urdf_path.empty()) return {};
+  phri::UrdfPlantOptions options;
+  options.urdf_path = plant.urdf_path;
+  options.locked_joints = plant.locked_joints;
+  options.balance_inertia = plant.balance_inertia;
+  return phri::UrdfPlant::generate(options).warnings;
+}
+
 // `phri run`: loads the configuration, runs the session, writes the log, summary and figure.
 int run_command(const RunArguments& args) {
   phri::Config config = phri::Config::from_yaml_file(args.config_path, args.robot_folder);
@@ -177,8 +188,10 @@ int run_command(const RunArguments& args) {
   // Everything that can refuse the configuration is built before the first line of output.
   phri::SimRobot robot(config.plant);
   phri::Controller cycle(config.controller);
-  // What the URDF loader accepted but the user should know (one line each, naming the link).
+  // What the URDF loader and the plant generator accepted but the user should know (one line each,
+  // naming the link): odd inertias, a base inertial ignored, inertias MuJoCo balanced.
   for (const std::string& warning : cycle.model().warnings()) std::fprintf(stderr, "phri: warning: %s\n", warning.c_str());
+  for (const std::string& warning : generated_plant_warnings(config.plant)) std::fprintf(stderr, "phri: warning: %s\n", warning.c_str());
   phri::Fsm fsm(config.fsm, cycle);
   std::printf("phri run: %s, %.1f s, %s\n", args.config_path.c_str(), config.run.duration_s,
               config.run.pacing == phri::LoopClock::Pacing::kLockstep ? "lockstep" : "real time");

@@ -7,6 +7,8 @@
 // the first half of the joints, small ones after), renamed.
 #include <phri/robot/actuator_table.hpp>
 
+#include <Eigen/Core>
+
 #include <cmath>
 #include <random>
 #include <sstream>

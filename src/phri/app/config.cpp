@@ -127,7 +127,24 @@ void merge(YAML::Node base, const YAML::Node& over) {
   }
 }
 
-SimRobotConfig parse_plant(const YamlReader& r, const std::string& base_dir) {
+// With a robot bundle, the plant section need not name the arm or its start posture: the bundle's
+// files and home posture fill `robot` and `initial` when absent (apply_to then sets its end of arm).
+void fill_from_bundle(YAML::Node plant, const RobotBundle& bundle) {
+  const YAML::Node& view = plant;
+  if (!view["robot"]) {
+    YAML::Node robot;
+    if (bundle.plant.mjcf_path.empty()) {
+      robot["urdf"] = bundle.urdf_path;
+    } else {
+      robot["mjcf"] = bundle.plant.mjcf_path;
+    }
+    robot["actuators"] = bundle.actuators_path;
+    plant["robot"] = robot;
+  }
+  if (!view["initial"]) plant["initial"]["q_rad"] = bundle.home_q_rad;
+}
+
+SimRobotConfig parse_plant(const YamlReader& r, const std::string& base_dir, const RobotBundle* bundle) {
   r.expect_map();
   const YAML::Node& raw = r.node();
   YAML::Node plant;
@@ -148,6 +165,7 @@ SimRobotConfig parse_plant(const YamlReader& r, const std::string& base_dir) {
     plant = YAML::Clone(raw);
     absolutize_robot(plant, base_dir);
   }
+  if (bundle != nullptr) fill_from_bundle(plant, *bundle);
   YAML::Node document;
   document["plant"] = plant;
   YAML::Emitter out;
@@ -475,7 +493,7 @@ Config parse(const YamlReader& root, const std::string& base_dir, const std::str
   if (bundle && !root.has("plant")) {
     c.plant.source = source;
   } else {
-    c.plant = parse_plant(root.at("plant"), base_dir);
+    c.plant = parse_plant(root.at("plant"), base_dir, bundle ? &*bundle : nullptr);
   }
   if (bundle) bundle->apply_to(c.plant);
   if (c.plant.dof() != dof) {
