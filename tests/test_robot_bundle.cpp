@@ -140,10 +140,18 @@ TEST(RobotBundle, MistakesNameRobotYamlAndTheKeyPath) {
                       {.element = "robot", .mentions = {"robot.yaml"}});
 }
 
-// A frame the URDF lacks is caught by the run's checks against the model.
-TEST(RobotBundle, AnUnknownEndEffectorFrameIsRefusedByTheRun) {
+// Checked against the URDF's model at load, named at the robot.yaml key that causes them.
+TEST(RobotBundle, FramesChainDrivesAndHomeAreCheckedAgainstTheUrdf) {
+  expect_bundle_error("  end_effector: end_effector_link", "  end_effector: hand_link", "frames.end_effector", {"hand_link"});
+  expect_bundle_error("  tip: bracelet_link", "  tip: nowhere", "frames.tip", {"nowhere"});
+  expect_bundle_error("  base: base_link", "  base: end_effector_link", "frames.tip", {"not below base"});
+  // A shorter chain is a valid choice, but then the drives no longer match it.
+  expect_bundle_error("  base: base_link", "  base: forearm_link", "actuators", {"joint_5"});
+  expect_bundle_error("locked_joints: []", "locked_joints: [joint_9]", "locked_joints", {"joint_9"});
+  expect_bundle_error("home_q_rad: [0.0, 0.26179939,", "home_q_rad: [0.0, 2.5,", "home_q_rad[1]", {"joint_2", "2.24"});
+  // A run through the CLI's path gets the same error.
   const std::string folder = gen3_bundle_with("  end_effector: end_effector_link", "  end_effector: hand_link");
-  expect_config_error([&] { (void)phri::Config::from_yaml_file(kDemo, folder); }, {.mentions = {"hand_link"}});
+  expect_config_error([&] { (void)phri::Config::from_yaml_file(kDemo, folder); }, {.element = "frames.end_effector"});
 }
 
 // ----------------------------------------------------------------------------- a generated arm

@@ -1,9 +1,12 @@
 #include <phri/app/robot_bundle.hpp>
 
+#include <phri/core/format.hpp>
 #include <phri/core/yaml_reader.hpp>
+#include <phri/model/model.hpp>
 #include <phri/robot/actuator_table.hpp>
 
 #include <filesystem>
+#include <optional>
 
 namespace phri {
 namespace {
@@ -96,12 +99,61 @@ RobotBundle parse(const YamlReader& r, const std::string& folder) {
   return b;
 }
 
+// The chain's problems named at the robot.yaml key that causes them (the loader names ModelOptions).
+[[noreturn]] void rethrow_at_key(const RobotBundle& b, const ConfigError& e) {
+  const std::string& element = e.element();
+  const std::string what = e.reason() + " (" + e.file() + ")";
+  if (element.find("tip_link") != std::string::npos) throw ConfigError(b.source, "frames.tip", what);
+  if (element.find("base_link") != std::string::npos) throw ConfigError(b.source, "frames.base", what);
+  if (element.find("locked_joints") != std::string::npos || e.reason().find("locked_joints") != std::string::npos) {
+    throw ConfigError(b.source, "locked_joints", element + ": " + what);
+  }
+  throw e;
+}
+
+// The frames, the chain, the drives and the home posture against the URDF's model.
+void check_against_model(const RobotBundle& b) {
+  ModelOptions chain;
+  chain.base_link = b.base_link;
+  chain.tip_link = b.tip_link;
+  chain.locked_joints = b.locked_joints;
+  std::optional<Model> loaded;
+  try {
+    loaded.emplace(Model::from_urdf_file(b.urdf_path, chain));
+  } catch (const ConfigError& e) {
+    rethrow_at_key(b, e);
+  }
+  const Model& model = *loaded;
+  if (!model.has_frame(b.end_effector_frame)) {
+    throw ConfigError(b.source, "frames.end_effector", "no frame '" + b.end_effector_frame + "' in " + b.urdf_path);
+  }
+  const ActuatorTable drives = ActuatorTable::from_yaml_file(b.actuators_path);
+  for (int i = 0; i < model.nq(); ++i) {
+    if (i >= drives.size() || drives[i].joint_name != model.joint(i).name) {
+      throw ConfigError(b.source, "actuators", "entry " + std::to_string(i + 1) + " must be the chain's joint '" +
+                                                   model.joint(i).name + "' (" + b.actuators_path + ")");
+    }
+    const double q = b.home_q_rad[static_cast<std::size_t>(i)];
+    if (q < model.joint(i).lower || q > model.joint(i).upper) {
+      throw ConfigError(b.source, "home_q_rad[" + std::to_string(i) + "]",
+                        format_general(q, 6) + " is beyond " + model.joint(i).name + "'s limits [" +
+                            format_general(model.joint(i).lower, 6) + ", " + format_general(model.joint(i).upper, 6) + "]");
+    }
+  }
+  if (drives.size() != model.nq()) {
+    throw ConfigError(b.source, "actuators", std::to_string(drives.size()) + " drives for the chain's " +
+                                                 std::to_string(model.nq()) + " joints");
+  }
+}
+
 }  // namespace
 
 RobotBundle RobotBundle::from_folder(const std::string& folder) {
   const std::string file = (std::filesystem::path(folder) / "robot.yaml").string();
   if (!std::filesystem::is_regular_file(file)) throw ConfigError(file, "", "no robot.yaml in the robot folder");
-  return parse(YamlReader::load_file(file), std::filesystem::absolute(folder).string());
+  RobotBundle bundle = parse(YamlReader::load_file(file), std::filesystem::absolute(folder).string());
+  check_against_model(bundle);
+  return bundle;
 }
 
 void RobotBundle::apply_to(ControllerSettings& s) const {
