@@ -19,9 +19,11 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <fstream>
 #include <random>
 #include <sstream>
+#include <thread>
 
 namespace {
 
@@ -244,6 +246,33 @@ TEST(UrdfPlant, LoopsTyposAndUnsupportedJointsAreOneLineErrors) {
   missing.urdf_path = "/nonexistent.urdf";
   expect_config_error([&] { (void)phri::UrdfPlant::generate(missing); },
                       {.mentions = {"/nonexistent.urdf"}});
+}
+
+// The parser's message handler is process-wide: the controller's model and the plant generator
+// loading at once on two threads must each get their own parse error (and never crash).
+TEST(UrdfPlant, ConcurrentLoadsKeepTheirOwnParserMessages) {
+  const std::string model_typo = gen3_with("<mass value=\"1.3773\"", "<mass value=\"1.3773kg\"");
+  const std::string plant_typo = gen3_with("<mass value=\"0.364\"", "<mass value=\"0.364g\"");
+  std::atomic<int> model_right{0}, plant_right{0};
+  std::thread model_thread([&] {
+    for (int k = 0; k < 200; ++k) {
+      try {
+        (void)phri::Model::from_urdf_string(model_typo);
+      } catch (const phri::ConfigError& e) {
+        model_right += std::string(e.what()).find("1.3773kg") != std::string::npos;
+      }
+    }
+  });
+  for (int k = 0; k < 200; ++k) {
+    try {
+      (void)phri::UrdfPlant::generate_from_string(plant_typo, {}, "plant.urdf");
+    } catch (const phri::ConfigError& e) {
+      plant_right += std::string(e.what()).find("0.364g") != std::string::npos;
+    }
+  }
+  model_thread.join();
+  EXPECT_EQ(model_right.load(), 200);
+  EXPECT_EQ(plant_right.load(), 200);
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 
 #include <phri/core/error.hpp>
 #include <phri/core/format.hpp>
+#include <phri/core/parser_lock.hpp>
 #include <phri/model/algorithms.hpp>
 #include <phri/model/collision_model.hpp>
 
@@ -198,7 +199,13 @@ CapsuleFit fit_capsules(const std::string& urdf, const Model& model, const Eigen
     throw ConfigError(model.name(), "home_q", "has " + std::to_string(home_q.size()) + " values for " +
                                                   std::to_string(model.nq()) + " joints");
   }
-  const urdf::ModelInterfaceSharedPtr parsed = urdf::parseURDF(urdf);
+  urdf::ModelInterfaceSharedPtr parsed;
+  {
+    // The model of the same text loaded already: nothing to capture; the lock keeps the parser's
+    // messages out of another thread's capture.
+    std::lock_guard<std::mutex> lock(urdf_parser_mutex());
+    parsed = urdf::parseURDF(urdf);
+  }
   if (!parsed) throw ConfigError(model.name(), "", "not a valid URDF");
   CapsuleFit fit;
   const std::vector<FittedCapsule> capsules = fit_links(*parsed, model, options, fit.notes);

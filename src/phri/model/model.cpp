@@ -3,6 +3,7 @@
 
 #include <phri/core/error.hpp>
 #include <phri/core/format.hpp>
+#include <phri/core/parser_lock.hpp>
 
 #include <console_bridge/console.h>
 #include <urdf_parser/urdf_parser.h>
@@ -49,7 +50,7 @@ namespace {
 // Captures urdfdom's console_bridge messages. urdfdom 3 logs some failures and still returns a
 // model: a mass written "0.73kg" logs "Could not parse inertial element for Link [...]" and leaves
 // the mass at 0, so an error-level message is a load error even when parsing "succeeded".
-// console_bridge's handler is global: serialise loads.
+// console_bridge's handler is global: loads hold urdf_parser_mutex().
 class CapturingOutput : public console_bridge::OutputHandler {
 public:
   void log(const std::string& text, console_bridge::LogLevel level, const char*, int) override {
@@ -63,7 +64,6 @@ public:
   std::string errors;
   std::vector<std::string> warnings;
 };
-std::mutex g_parse_mutex;
 
 bool finite(double x) { return std::isfinite(x); }
 
@@ -469,7 +469,7 @@ Model Model::from_urdf_string(const std::string& urdf, const ModelOptions& optio
   urdf::ModelInterfaceSharedPtr parsed;
   CapturingOutput capture;
   {
-    std::lock_guard<std::mutex> lock(g_parse_mutex);
+    std::lock_guard<std::mutex> lock(urdf_parser_mutex());
     console_bridge::useOutputHandler(&capture);
     try {
       parsed = urdf::parseURDF(urdf);

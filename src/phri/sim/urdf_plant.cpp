@@ -2,6 +2,7 @@
 
 #include <phri/core/error.hpp>
 #include <phri/core/format.hpp>
+#include <phri/core/parser_lock.hpp>
 
 #include <console_bridge/console.h>
 #include <urdf_parser/urdf_parser.h>
@@ -20,7 +21,7 @@ namespace phri {
 namespace {
 
 // urdfdom logs some failures (an unparsable mass) and returns a model with the value zeroed: an
-// error-level message is a load error. The handler is global: serialise the parses.
+// error-level message is a load error. The handler is global: parses hold urdf_parser_mutex().
 class ParserMessages : public console_bridge::OutputHandler {
 public:
   void log(const std::string& text, console_bridge::LogLevel level, const char*, int) override {
@@ -30,7 +31,6 @@ public:
   }
   std::string errors;
 };
-std::mutex g_urdf_parse_mutex;
 
 // Digits that write a double back exactly.
 std::string num(double v) { return format_general(v, 17); }
@@ -51,7 +51,7 @@ urdf::ModelInterfaceSharedPtr parse(const std::string& urdf, const std::string& 
   urdf::ModelInterfaceSharedPtr parsed;
   ParserMessages messages;
   {
-    std::lock_guard<std::mutex> lock(g_urdf_parse_mutex);
+    std::lock_guard<std::mutex> lock(urdf_parser_mutex());
     console_bridge::useOutputHandler(&messages);
     try {
       parsed = urdf::parseURDF(urdf);
