@@ -413,6 +413,8 @@ CLI::App* add_safety_fuzz_command(CLI::App& experiment, SafetyFuzzArguments& arg
   fuzz->add_option("--trace", o.trace_path, "with --replay: the run's every cycle as CSV (plant truth, command, push)")
       ->needs("--replay");
   fuzz->add_option("--plant", o.plant_config_path, "plant configuration")->check(CLI::ExistingFile);
+  fuzz->add_option("--robot", o.robot_folder, "robot bundle (robots/<robot>) in place of the Gen3's files")
+      ->check(CLI::ExistingDirectory);
   fuzz->add_flag("--fail-on-violation", args.fail_on_violation, "exit with status 1 when a controller failure was found");
   return fuzz;
 }
