@@ -470,7 +470,8 @@ std::optional<RobotBundle> parse_robot_section(const YamlReader& root, const std
       parse_robot(robot, base_dir, c);
       return bundle;
     }
-    const std::string folder = resolve_path(base_dir, robot.as_text(), kInputPaths);
+    std::string folder = resolve_path(base_dir, robot.as_text(), kInputPaths);
+    if (std::filesystem::path(folder).filename() == "robot.yaml") folder = std::filesystem::path(folder).parent_path().string();
     if (!std::filesystem::is_regular_file(std::filesystem::path(folder) / "robot.yaml")) {
       throw robot.error("", "no robot.yaml in the robot folder " + folder);
     }
