@@ -6,6 +6,7 @@
 #include <phri/app/config.hpp>
 #include <phri/app/robot_bundle.hpp>
 #include <phri/control/controller.hpp>
+#include <phri/model/algorithms.hpp>
 #include <phri/sim/sim_robot.hpp>
 
 #include "config_error.hpp"
@@ -152,6 +153,32 @@ TEST(RobotBundle, FramesChainDrivesAndHomeAreCheckedAgainstTheUrdf) {
   // A run through the CLI's path gets the same error.
   const std::string folder = gen3_bundle_with("  end_effector: end_effector_link", "  end_effector: hand_link");
   expect_config_error([&] { (void)phri::Config::from_yaml_file(kDemo, folder); }, {.element = "frames.end_effector"});
+}
+
+// `collision: fitted` (robots/example_6dof): the controller gets capsules fitted from the URDF, no
+// pair on adjacent bodies, none within the damper's influence distance at the home posture.
+TEST(RobotBundle, FittedCollisionCapsulesReachTheController) {
+  const phri::RobotBundle bundle = phri::RobotBundle::from_folder(kRoot + "/robots/example_6dof");
+  EXPECT_TRUE(bundle.collision_path.empty());
+  ASSERT_FALSE(bundle.collision_yaml.empty());
+  phri::ControllerSettings settings;
+  bundle.apply_to(settings);
+  const phri::Controller cycle(settings);
+  const std::optional<phri::CollisionModel> collision = phri::Controller::collision_model(settings, cycle.model());
+  ASSERT_TRUE(collision);
+  EXPECT_GT(collision->num_pairs(), 0);
+  phri::Data data(cycle.model());
+  const Eigen::VectorXd home = Eigen::Map<const Eigen::VectorXd>(bundle.home_q_rad.data(), 6);
+  phri::forward_kinematics(cycle.model(), data, home);
+  phri::CollisionData distances(cycle.model(), *collision);
+  phri::compute_collision_distances(cycle.model(), data, *collision, distances, false);
+  for (int k = 0; k < collision->num_pairs(); ++k) {
+    const auto& pair = collision->pairs()[static_cast<std::size_t>(k)];
+    EXPECT_GT(std::abs(collision->capsules()[static_cast<std::size_t>(pair.first)].body -
+                       collision->capsules()[static_cast<std::size_t>(pair.second)].body), 1);
+    EXPECT_GE(distances.distance[k], phri::WholeBodyQpSettings{}.collision.influence_distance);
+  }
+  std::printf("example_6dof: %zu fitted capsules, %d pairs\n", collision->capsules().size(), collision->num_pairs());
 }
 
 // ----------------------------------------------------------------------------- a generated arm

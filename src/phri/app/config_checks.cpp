@@ -129,8 +129,9 @@ void check_config_against_robot(const Config& config) {
       {"fsm.startup.home_q_rad", &config.fsm.startup.home_q_rad},
       {"fsm.static.posture_q_rad", &config.fsm.static_scenario.posture_q_rad}};
   for (const auto& [key, q] : postures) check_within_limits(model, *q, config.source, key);
-  if (settings.collision_path.empty()) return;
-  const CollisionModel collision = CollisionModel::from_yaml_file(settings.collision_path, model);
+  const std::optional<CollisionModel> fitted_or_file = Controller::collision_model(settings, model);
+  if (!fitted_or_file) return;
+  const CollisionModel& collision = *fitted_or_file;
   for (const auto& [key, q] : postures) {
     if (static_cast<int>(q->size()) != model.nq()) continue;  // sizes: checked where they are read
     check_clear_of_collision(model, collision, *q, settings.qp.collision.safety_distance, config.source, key);

@@ -2,11 +2,15 @@
 
 #include <phri/core/format.hpp>
 #include <phri/core/yaml_reader.hpp>
+#include <phri/control/controller.hpp>
+#include <phri/model/capsule_fit.hpp>
 #include <phri/model/model.hpp>
 #include <phri/robot/actuator_table.hpp>
 
 #include <filesystem>
+#include <fstream>
 #include <optional>
+#include <sstream>
 
 namespace phri {
 namespace {
@@ -86,7 +90,9 @@ RobotBundle parse(const YamlReader& r, const std::string& folder) {
   b.name = r.text("name");
   b.urdf_path = input_file(r, "urdf", folder);
   b.actuators_path = input_file(r, "actuators", folder);
-  b.collision_path = r.has("collision") ? input_file(r, "collision", folder) : "";
+  const bool fitted = r.has("collision") && r.text("collision") == "fitted";
+  b.collision_path = r.has("collision") && !fitted ? input_file(r, "collision", folder) : "";
+  if (fitted) b.collision_yaml = "fitted";  // fitted once the model is checked (check_against_model)
   parse_frames(r.at("frames"), b);
   b.locked_joints = names(r, "locked_joints");
   const int dof = ActuatorTable::from_yaml_file(b.actuators_path).size();
@@ -146,6 +152,21 @@ void check_against_model(const RobotBundle& b) {
   }
 }
 
+// `collision: fitted`: the capsules on the controller's model (chain and payload frames).
+std::string fitted_capsules(const RobotBundle& b) {
+  ControllerSettings settings;
+  b.apply_to(settings);
+  const Model model = Model::from_urdf_file(b.urdf_path, Controller::model_options(settings));
+  std::ifstream file(b.urdf_path);
+  std::stringstream urdf;
+  urdf << file.rdbuf();
+  const Eigen::VectorXd home = Eigen::Map<const Eigen::VectorXd>(b.home_q_rad.data(), model.nq());
+  // Pairs within the self-collision damper's influence distance at home would be held apart at rest.
+  CapsuleFitOptions options;
+  options.clearance_m = WholeBodyQpSettings{}.collision.influence_distance;
+  return fit_capsules(urdf.str(), model, home, options).yaml;
+}
+
 }  // namespace
 
 RobotBundle RobotBundle::from_folder(const std::string& folder) {
@@ -153,6 +174,7 @@ RobotBundle RobotBundle::from_folder(const std::string& folder) {
   if (!std::filesystem::is_regular_file(file)) throw ConfigError(file, "", "no robot.yaml in the robot folder");
   RobotBundle bundle = parse(YamlReader::load_file(file), std::filesystem::absolute(folder).string());
   check_against_model(bundle);
+  if (!bundle.collision_yaml.empty()) bundle.collision_yaml = fitted_capsules(bundle);
   return bundle;
 }
 
@@ -160,6 +182,7 @@ void RobotBundle::apply_to(ControllerSettings& s) const {
   s.urdf_path = urdf_path;
   s.actuators_path = actuators_path;
   s.collision_path = collision_path;
+  s.collision_yaml = collision_yaml;
   s.base_link = base_link;
   s.tip_link = tip_link;
   s.end_effector_frame = end_effector_frame;

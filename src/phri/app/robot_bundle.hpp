@@ -9,6 +9,10 @@
 //   robot.apply_to(controller_settings);   // model files, chain, frames, payloads, dead band
 //   robot.apply_to(plant_config);          // arm description, drives, F/T sensor and tool
 //
+// `collision:` names a collision.yaml, or says `fitted`: capsules fitted from the URDF at load
+// (link-frame radius 0.04 m; pairs closer than 0.03 m at the home posture, the self-collision
+// damper's influence distance, left out). Absent: no self-collision constraint.
+//
 // A run YAML names a bundle with `robot: ../robots/kinova_gen3` (relative to the YAML), and
 // `phri run --robot DIR` replaces whatever robot the YAML names. Errors are phri::ConfigError
 // naming robot.yaml and the key path (e.g. "end_of_arm.tool.mass_kg").
@@ -33,6 +37,9 @@ struct RobotBundle {
   std::string source;  ///< robot.yaml
   std::string name;
   std::string urdf_path, actuators_path, collision_path;  ///< absolute; collision_path '' for none
+  /// `collision: fitted`: capsules fitted from the URDF at the home posture (model/capsule_fit.hpp),
+  /// as a collision.yaml's text; '' otherwise.
+  std::string collision_yaml;
   std::string base_link, tip_link, end_effector_frame;
   std::vector<std::string> locked_joints;
   std::vector<double> home_q_rad;

@@ -26,6 +26,12 @@ ModelOptions Controller::model_options(const ControllerSettings& settings) {
   return options;
 }
 
+std::optional<CollisionModel> Controller::collision_model(const ControllerSettings& settings, const Model& model) {
+  if (!settings.collision_yaml.empty()) return CollisionModel::from_yaml_string(settings.collision_yaml, model, "fitted capsules");
+  if (settings.collision_path.empty()) return std::nullopt;
+  return CollisionModel::from_yaml_file(settings.collision_path, model);
+}
+
 WholeBodyQpSettings Controller::qp_settings(const ControllerSettings& settings, const ActuatorTable& actuators) {
   WholeBodyQpSettings qp = settings.qp;
   qp.end_effector_frame = settings.end_effector_frame;
@@ -118,7 +124,7 @@ Controller::LoadedRobot Controller::load(const ControllerSettings& settings) {
   Model model = Model::from_urdf_file(settings.urdf_path, model_options(settings));
   ActuatorTable actuators = ActuatorTable::from_yaml_file(settings.actuators_path);
   std::optional<CollisionModel> collision;
-  if (!settings.collision_path.empty()) collision = CollisionModel::from_yaml_file(settings.collision_path, model);
+  collision = collision_model(settings, model);
   return {std::move(model), std::move(actuators), std::move(collision), settings.actuators_path};
 }
 

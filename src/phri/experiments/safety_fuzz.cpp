@@ -106,7 +106,7 @@ RobotUnderTest robot_under_test(const SafetyFuzzOptions& o) {
   bundle.apply_to(r.settings);
   r.urdf_path = bundle.urdf_path;
   r.start_q = bundle.home_q_rad;
-  r.fit_capsules = bundle.collision_path.empty();
+  r.fit_capsules = bundle.collision_path.empty() && bundle.collision_yaml.empty();
   return r;
 }
 
@@ -119,8 +119,7 @@ std::optional<CollisionModel> robot_collision(const RobotUnderTest& r, const Mod
     return CollisionModel::from_yaml_string(fit_capsules(urdf.str(), model, home, {.link_frame_radius_m = 0.04, .clearance_m = 0.02}).yaml,
                                             model, "capsules fitted from " + r.urdf_path);
   }
-  if (r.settings.collision_path.empty()) return std::nullopt;
-  return CollisionModel::from_yaml_file(r.settings.collision_path, model);
+  return Controller::collision_model(r.settings, model);
 }
 
 std::unique_ptr<Shared> load_shared(const SafetyFuzzOptions& o) {
