@@ -65,6 +65,7 @@ void bind_settings(py::module_& m) {
       .def_readwrite("base_link", &S::base_link, "Empty: the URDF's root.")
       .def_readwrite("tip_link", &S::tip_link, "Empty: the end of the only moving branch.")
       .def_readwrite("locked_joints", &S::locked_joints, "URDF joints held at 0 (gripper fingers).")
+      .def_readwrite("collision_yaml", &S::collision_yaml, "A collision model's text, in place of collision_path when set.")
       .def_readwrite("ft_sensor_offset_m", &S::ft_sensor_offset_m)
       .def_readwrite("payloads", &S::payloads)
       .def_readwrite("period_s", &S::period_s)
