@@ -6,6 +6,7 @@
 #include <phri/app/config.hpp>
 #include <phri/app/robot_bundle.hpp>
 #include <phri/control/controller.hpp>
+#include <phri/lowlevel/custom_torque_controller.hpp>
 #include <phri/model/algorithms.hpp>
 #include <phri/sim/sim_robot.hpp>
 
@@ -135,6 +136,14 @@ TEST(RobotBundle, MistakesNameRobotYamlAndTheKeyPath) {
   expect_bundle_error("drive: kinova", "drive: franka", "drive", {"kinova"});
   expect_bundle_error("  mjcf: gen3_plant.xml", "  mjcf: gen3_plant.xml\n  balance_inertia: true", "plant.balance_inertia");
   expect_bundle_error("locked_joints: []", "locked_joints: {a: 1}", "locked_joints");
+  // H(z) of the custom loop: a pole on or outside the unit circle, a missing half, a0 = 0.
+  expect_bundle_error("denominator: [1.0, -1.975063, 0.97518]", "denominator: [1.0, -2.0, 1.0]",
+                      "custom_loop_filter.denominator", {"unit circle"});
+  expect_bundle_error("denominator: [1.0, -1.975063, 0.97518]", "denominator: [1.0, 0.5, -1.2]",
+                      "custom_loop_filter.denominator", {"unit circle"});
+  expect_bundle_error("  denominator: [1.0, -1.975063, 0.97518]", "", "custom_loop_filter.denominator");
+  expect_bundle_error("denominator: [1.0, -1.975063, 0.97518]", "denominator: [0.0, 1.0]", "custom_loop_filter.denominator",
+                      {"a0"});
   expect_config_error([] { (void)phri::RobotBundle::from_folder("/nonexistent"); }, {.mentions = {"robot.yaml"}});
   // Through a run YAML: a folder without robot.yaml names the key `robot`.
   expect_config_error([] { (void)phri::Config::from_yaml_string(demo_with_robot("../robots"), "t.yaml", kRoot + "/configs"); },
@@ -153,6 +162,30 @@ TEST(RobotBundle, FramesChainDrivesAndHomeAreCheckedAgainstTheUrdf) {
   // A run through the CLI's path gets the same error.
   const std::string folder = gen3_bundle_with("  end_effector: end_effector_link", "  end_effector: hand_link");
   expect_config_error([&] { (void)phri::Config::from_yaml_file(kDemo, folder); }, {.element = "frames.end_effector"});
+}
+
+// The bundle's H(z) reaches the custom torque loop: with H = 1 the filter term is lambda e on the
+// first update; with the Gen3 bundle's (Kinova's) it is lambda b0 e, as with the library's default.
+TEST(RobotBundle, TheCustomLoopFilterComesFromTheBundle) {
+  const phri::RobotBundle gen3 = phri::RobotBundle::from_folder(kGen3);
+  phri::ControllerSettings settings;
+  gen3.apply_to(settings);
+  const phri::ActuatorTable drives = phri::ActuatorTable::from_yaml_file(gen3.actuators_path);
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(7), error = Eigen::VectorXd::Constant(7, 2.0);
+  auto first_filter_term = [&](const phri::CustomTorqueSettings& custom) {
+    phri::CustomTorqueController loop(drives, custom);
+    loop.reset(zero, zero, zero, zero, zero);
+    return loop.update(error, zero, zero, zero), Eigen::VectorXd(loop.filter_term());
+  };
+  const double lambda = settings.custom_torque.transfer_gain;
+  EXPECT_EQ(first_filter_term(settings.custom_torque), first_filter_term(phri::CustomTorqueSettings{}));
+  EXPECT_NEAR(first_filter_term(settings.custom_torque)[0], lambda * 0.020175 * 2.0, 1e-12);
+  phri::CustomTorqueSettings identity = settings.custom_torque;
+  identity.filter_numerator = {1.0};
+  identity.filter_denominator = {1.0};
+  EXPECT_NEAR(first_filter_term(identity)[3], lambda * 2.0, 1e-12);
+  identity.filter_denominator.clear();
+  EXPECT_THROW(phri::CustomTorqueController(drives, identity), phri::ConfigError);
 }
 
 // `collision: fitted` (robots/example_6dof): the controller gets capsules fitted from the URDF, no

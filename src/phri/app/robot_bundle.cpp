@@ -7,6 +7,8 @@
 #include <phri/model/model.hpp>
 #include <phri/robot/actuator_table.hpp>
 
+#include <Eigen/Eigenvalues>
+
 #include <filesystem>
 #include <fstream>
 #include <optional>
@@ -82,9 +84,34 @@ void parse_plant(const YamlReader& p, const std::string& folder, RobotBundle& b)
   }
 }
 
+// H(z) = b(z^-1) / a(z^-1): finite, a0 != 0, order at most 5, every pole inside the unit circle
+// (the loop runs it on the torque error every period: an unstable filter would run away).
+void parse_custom_loop_filter(const YamlReader& f, RobotBundle& b) {
+  f.allow_keys({"numerator", "denominator"});
+  for (const char* key : {"numerator", "denominator"}) {
+    const YamlReader list = f.at(key);
+    list.expect_sequence();
+    if (list.size() < 1 || list.size() > 6) throw f.error(key, "1 to 6 coefficients (order at most 5)");
+    auto& out = std::string(key) == "numerator" ? b.custom_loop_numerator : b.custom_loop_denominator;
+    for (std::size_t i = 0; i < list.size(); ++i) out.push_back(list.at(i).as_number(-1e6, 1e6));
+  }
+  const std::vector<double>& a = b.custom_loop_denominator;
+  if (a[0] == 0.0) throw f.error("denominator", "a0 must be non-zero");
+  const int order = static_cast<int>(a.size()) - 1;
+  if (order == 0) return;
+  Eigen::MatrixXd companion = Eigen::MatrixXd::Zero(order, order);  // poles: its eigenvalues
+  for (int k = 0; k < order; ++k) companion(0, k) = -a[static_cast<std::size_t>(k + 1)] / a[0];
+  for (int k = 1; k < order; ++k) companion(k, k - 1) = 1.0;
+  const double largest = Eigen::EigenSolver<Eigen::MatrixXd>(companion, false).eigenvalues().cwiseAbs().maxCoeff();
+  // A margin for the eigenvalues' rounding: a double pole at z = 1 comes out within ~1e-8 of it.
+  if (!(largest < 1.0 - 1e-6)) {
+    throw f.error("denominator", "a pole at |z| = " + format_general(largest, 6) + ": every pole must lie inside the unit circle");
+  }
+}
+
 RobotBundle parse(const YamlReader& r, const std::string& folder) {
   r.allow_keys({"name", "urdf", "actuators", "collision", "frames", "locked_joints", "home_q_rad",
-                "compliance_deadband_Nm", "drive", "end_of_arm", "plant"});
+                "compliance_deadband_Nm", "drive", "custom_loop_filter", "end_of_arm", "plant"});
   RobotBundle b;
   b.source = r.file();
   b.name = r.text("name");
@@ -100,6 +127,7 @@ RobotBundle parse(const YamlReader& r, const std::string& folder) {
   b.compliance_deadband_Nm = r.per_joint<Eigen::VectorXd>("compliance_deadband_Nm", dof, 0.0, kMaxDeadband_Nm);
   // Only Kinova's actuator loops are emulated so far; a generic drive is future work (issue 16).
   (void)r.choice("drive", {"kinova"});
+  if (r.has("custom_loop_filter")) parse_custom_loop_filter(r.at("custom_loop_filter"), b);
   parse_end_of_arm(r.at("end_of_arm"), b);
   parse_plant(r.has("plant") ? r.at("plant") : YamlReader(YAML::Node(YAML::NodeType::Map), r.file(), "plant"), folder, b);
   return b;
@@ -199,6 +227,8 @@ void RobotBundle::apply_to(ControllerSettings& s) const {
   };
   s.payloads = {payload("ft_adapter_and_sensor", end_of_arm.flange_side, 0.0),
                 payload("tool", end_of_arm.tool, end_of_arm.sensor_offset_m)};
+  s.custom_torque.filter_numerator = custom_loop_numerator;
+  s.custom_torque.filter_denominator = custom_loop_denominator;
   s.wrench.tool_mass_kg = end_of_arm.tool.mass_kg;
   s.wrench.tool_com_m = end_of_arm.tool.com_m;
 }

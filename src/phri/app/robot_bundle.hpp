@@ -45,6 +45,8 @@ struct RobotBundle {
   std::vector<double> home_q_rad;
   Eigen::VectorXd compliance_deadband_Nm;  ///< per joint
   enum class Drive { kKinova } drive = Drive::kKinova;
+  /// The custom torque loop's H(z) (b, a in powers of z^-1); both empty: Kinova's (the library's).
+  std::vector<double> custom_loop_numerator, custom_loop_denominator;
 
   struct EndOfArm {
     double sensor_offset_m = 0.0;  ///< flange -> F/T measuring frame, along the flange's z
