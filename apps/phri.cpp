@@ -1,9 +1,10 @@
 // phri: the command-line entry point.
-//   phri run --config FILE [--lockstep|--realtime] [--duration S] [--out DIR]
+//   phri run --config FILE [--robot DIR] [--lockstep|--realtime] [--duration S] [--out DIR]
 //            [--dashboard [--port P] [--bind ADDR] [--push-max N]]
 //                                              a session: simulated arm, FSM, gamepad, log, figure,
 //                                              and the live dashboard in a browser
 //   phri info --urdf FILE                      model summary of a robot description
+//   phri fit-collision --robot DIR [--out FILE] self-collision capsules fitted from the robot's URDF
 //   phri identify-friction [options]           the paper's friction identification (simulated arm)
 //   phri experiment torque-tracking [options]  the paper's torque-tracking comparison
 //   phri experiment safety-fuzz [options]      seeded pushes and sensor faults against the safety stage
@@ -15,11 +16,14 @@
 // Every bad argument or file, and every failure of a run or an experiment (phri::Error: ConfigError,
 // IoError, ExperimentError), gives one line on stderr naming what is wrong and a non-zero exit status.
 #include <phri/app/config.hpp>
+#include <phri/app/robot_bundle.hpp>
+#include <phri/model/capsule_fit.hpp>
 #include <phri/app/run_session.hpp>
 #include <phri/core/error.hpp>
 #include <phri/core/format.hpp>
 #include <phri/core/process.hpp>
 #include <phri/sim/sim_robot.hpp>
+#include <phri/sim/urdf_plant.hpp>
 #include <phri/core/version.hpp>
 #include <phri/experiments/drop_test.hpp>
 #include <phri/experiments/dual_compliance.hpp>
@@ -40,6 +44,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <sstream>
 #include <iostream>
 #include <memory>
@@ -56,6 +61,7 @@ int print_model_summary(const std::string& urdf_path, const std::string& tip, co
   const phri::Model model = phri::Model::from_urdf_file(urdf_path, options);
   phri::Data data(model);
   std::printf("model '%s' from %s\n", model.name().c_str(), urdf_path.c_str());
+  for (const std::string& warning : model.warnings()) std::printf("warning: %s\n", warning.c_str());
   std::printf("chain %s -> %s: %d joints, %d frames, moving mass %.4f kg\n\n", model.base_link().c_str(),
               model.tip_link().c_str(), model.nq(), model.num_frames(), model.total_mass());
   std::printf("%-3s %-10s %-11s %10s %10s %10s %10s %9s\n", "#", "joint", "type", "lower", "upper",
@@ -151,6 +157,7 @@ std::unique_ptr<phri::DashboardServer> start_dashboard(const DashboardArguments&
 struct RunArguments {
   DashboardArguments dashboard;
   std::string config_path;
+  std::string robot_folder;  ///< robots/<robot>: replaces the configuration's robot
   bool lockstep = false;
   bool real_time = false;
   double duration_s = -1.0;
@@ -158,9 +165,19 @@ struct RunArguments {
   bool figure = true;
 };
 
+// The generated plant's warnings (none for a hand-written MJCF).
+std::vector<std::string> generated_plant_warnings(const phri::SimRobotConfig& plant) {
+  if (plant.urdf_path.empty()) return {};
+  phri::UrdfPlantOptions options;
+  options.urdf_path = plant.urdf_path;
+  options.locked_joints = plant.locked_joints;
+  options.balance_inertia = plant.balance_inertia;
+  return phri::UrdfPlant::generate(options).warnings;
+}
+
 // `phri run`: loads the configuration, runs the session, writes the log, summary and figure.
 int run_command(const RunArguments& args) {
-  phri::Config config = phri::Config::from_yaml_file(args.config_path);
+  phri::Config config = phri::Config::from_yaml_file(args.config_path, args.robot_folder);
   if (args.lockstep) config.run.pacing = phri::LoopClock::Pacing::kLockstep;
   if (args.real_time) config.run.pacing = phri::LoopClock::Pacing::kRealTime;
   if (args.duration_s > 0.0) config.run.duration_s = args.duration_s;
@@ -171,6 +188,10 @@ int run_command(const RunArguments& args) {
   // Everything that can refuse the configuration is built before the first line of output.
   phri::SimRobot robot(config.plant);
   phri::Controller cycle(config.controller);
+  // What the URDF loader and the plant generator accepted but the user should know (one line each,
+  // naming the link): odd inertias, a base inertial ignored, inertias MuJoCo balanced.
+  for (const std::string& warning : cycle.model().warnings()) std::fprintf(stderr, "phri: warning: %s\n", warning.c_str());
+  for (const std::string& warning : generated_plant_warnings(config.plant)) std::fprintf(stderr, "phri: warning: %s\n", warning.c_str());
   phri::Fsm fsm(config.fsm, cycle);
   std::printf("phri run: %s, %.1f s, %s\n", args.config_path.c_str(), config.run.duration_s,
               config.run.pacing == phri::LoopClock::Pacing::kLockstep ? "lockstep" : "real time");
@@ -238,6 +259,9 @@ CLI::App* add_run_command(CLI::App& app, RunArguments& args) {
   run->add_option("--config", args.config_path, "configuration YAML (e.g. configs/demo.yaml)")
       ->required()
       ->check(CLI::ExistingFile);
+  run->add_option("--robot", args.robot_folder, "robot bundle folder with its robot.yaml (e.g. robots/kinova_gen3), "
+                  "in place of the configuration's robot")
+      ->check(CLI::ExistingDirectory);
   auto* lockstep = run->add_flag("--lockstep", args.lockstep, "as fast as possible (same code path)");
   run->add_flag("--realtime", args.real_time, "paced by the 1 ms real-time clock")->excludes(lockstep);
   run->add_option("--duration", args.duration_s, "robot time to run [s], at most 3600")
@@ -268,6 +292,46 @@ CLI::App* add_info_command(CLI::App& app, InfoArguments& args) {
   info->add_option("--tip", args.tip, "tip link of the chain (default: end of the movable chain)");
   info->add_option("--frame", args.frame, "frame whose position is printed (default: the tip)");
   return info;
+}
+
+struct FitCollisionArguments {
+  std::string robot_folder, out_path;
+  phri::CapsuleFitOptions options;
+};
+
+CLI::App* add_fit_collision_command(CLI::App& app, FitCollisionArguments& args) {
+  auto* fit = app.add_subcommand("fit-collision", "Fit self-collision capsules from a robot bundle's URDF (a collision.yaml)");
+  fit->add_option("--robot", args.robot_folder, "robot bundle folder (robots/<robot>)")->required()->check(CLI::ExistingDirectory);
+  fit->add_option("--out", args.out_path, "collision.yaml to write (default: standard output)");
+  fit->add_option("--radius", args.options.link_frame_radius_m, "capsule radius of links without collision geometry [m]")
+      ->check(CLI::Range(0.001, 0.5))->capture_default_str();
+  fit->add_option("--clearance", args.options.clearance_m, "pairs closer at the home posture are left out [m]")
+      ->check(CLI::Range(0.0, 0.5))->capture_default_str();
+  return fit;
+}
+
+// `phri fit-collision`: the bundle's model at its home posture; notes on stderr, the YAML out.
+int fit_collision_command(const FitCollisionArguments& args) {
+  const phri::RobotBundle robot = phri::RobotBundle::from_folder(args.robot_folder);
+  phri::ControllerSettings settings;
+  robot.apply_to(settings);
+  settings.payloads.clear();
+  const phri::Model model = phri::Model::from_urdf_file(robot.urdf_path, phri::Controller::model_options(settings));
+  std::ifstream file(robot.urdf_path);
+  std::stringstream urdf;
+  urdf << file.rdbuf();
+  const Eigen::VectorXd home = Eigen::Map<const Eigen::VectorXd>(robot.home_q_rad.data(), model.nq());
+  const phri::CapsuleFit fit = phri::fit_capsules(urdf.str(), model, home, args.options);
+  for (const std::string& note : fit.notes) std::fprintf(stderr, "phri fit-collision: %s\n", note.c_str());
+  if (args.out_path.empty()) {
+    std::cout << fit.yaml;
+    return 0;
+  }
+  std::ofstream out(args.out_path);
+  out << fit.yaml;
+  if (!out) throw phri::IoError(args.out_path, "cannot write");
+  std::printf("phri fit-collision: %d capsules, %d pairs -> %s\n", fit.capsules, fit.pairs, args.out_path.c_str());
+  return 0;
 }
 
 CLI::App* add_identify_command(CLI::App& app, phri::FrictionIdentificationOptions& friction) {
@@ -349,6 +413,8 @@ CLI::App* add_safety_fuzz_command(CLI::App& experiment, SafetyFuzzArguments& arg
   fuzz->add_option("--trace", o.trace_path, "with --replay: the run's every cycle as CSV (plant truth, command, push)")
       ->needs("--replay");
   fuzz->add_option("--plant", o.plant_config_path, "plant configuration")->check(CLI::ExistingFile);
+  fuzz->add_option("--robot", o.robot_folder, "robot bundle (robots/<robot>) in place of the Gen3's files")
+      ->check(CLI::ExistingDirectory);
   fuzz->add_flag("--fail-on-violation", args.fail_on_violation, "exit with status 1 when a controller failure was found");
   return fuzz;
 }
@@ -545,6 +611,8 @@ int main(int argc, char** argv) {
   evaluate->add_option("--out", evaluation.output_dir, "output folder")->capture_default_str();
   evaluate->add_flag("--quick", evaluation.quick, "short protocols (a smoke test; not the paper's numbers)");
   evaluate->add_option("--jobs", evaluation.jobs, "threads for the drops")->check(CLI::Range(1, 64))->capture_default_str();
+  FitCollisionArguments fit_args;
+  const CLI::App* fit_collision = add_fit_collision_command(app, fit_args);
 
   if (const std::string error = command_word_error(app, argc, argv); !error.empty()) return print_error(error.c_str());
   try {
@@ -555,6 +623,7 @@ int main(int argc, char** argv) {
   try {
     if (run->parsed()) return run_command(run_args);
     if (info->parsed()) return print_model_summary(info_args.urdf_path, info_args.tip, info_args.frame);
+    if (fit_collision->parsed()) return fit_collision_command(fit_args);
     if (identify->parsed() || friction_alias->parsed()) return friction_identification_command(friction);
     if (tracking->parsed()) return torque_tracking_command(tracking_args);
     if (fuzz->parsed()) return safety_fuzz_command(fuzz_args);

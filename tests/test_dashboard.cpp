@@ -367,7 +367,7 @@ TEST(DashboardLoop, TheLoopSideOfTheHandOffAllocatesNothingPerCycle) {
     const std::size_t n = count.allocations();
     EXPECT_EQ(controller.compliance().mode(), phri::ComplianceMode::kFullBody);
     EXPECT_GT(channel.published(), 0u);
-    EXPECT_FALSE(summary.safe_hold);
+    EXPECT_FALSE(summary.safe_hold) << out.str();
     return n;
   };
   EXPECT_EQ(allocations(1.0), allocations(3.0));

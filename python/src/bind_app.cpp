@@ -85,7 +85,9 @@ void bind_config(py::module_& m) {
       .def_readwrite("duration_s", &RunSettings::duration_s)
       .def_readwrite("pacing", &RunSettings::pacing);
   py::class_<Config>(m, "Config", "ONE YAML per run (configs/demo.yaml documents every key), as the settings of each piece.")
-      .def_static("from_yaml_file", &Config::from_yaml_file, py::arg("path"), "ConfigError naming the file and the key path.")
+      .def_static("from_yaml_file", [](const std::string& path, const std::string& robot) { return Config::from_yaml_file(path, robot); },
+                  py::arg("path"), py::arg("robot") = std::string(),
+                  "ConfigError naming the file and the key path; robot: a robot bundle's folder in place of the file's robot.")
       .def_static("from_yaml_string", &Config::from_yaml_string, py::arg("yaml"), py::arg("source_name"), py::arg("base_dir"))
       .def_readwrite("source", &Config::source)
       .def_readwrite("controller", &Config::controller)

@@ -64,9 +64,11 @@ CASES = [
     ("urdf_inertia_negative", URDF, ("xml", "link[@name='shoulder_link']/inertial/inertia", "ixx", "-0.01"),
      ["link 'shoulder_link' <inertial>", "positive definite"]),
     ("urdf_inertia_nan", URDF, ("xml", "link[@name='shoulder_link']/inertial/inertia", "iyy", "nan"),
-     ["link 'shoulder_link' <inertial>", "finite"]),
-    ("urdf_inertia_triangle", URDF, ("xml", "link[@name='half_arm_1_link']/inertial/inertia", "iyy", "0.05"),
-     ["link 'half_arm_1_link' <inertial>", "triangle inequality"]),
+     ["link 'shoulder_link' <inertial>", "iyy"]),
+    # urdfdom logs "Could not parse inertial element" and zeroes the mass; phri refuses it (issue 16).
+    # (An inertia that breaks the triangle inequality is accepted with a warning since issue 16.)
+    ("urdf_link_mass_with_unit", URDF, ("xml", "link[@name='forearm_link']/inertial/mass", "value", "0.9302kg"),
+     ["link 'forearm_link' <inertial>", "0.9302kg"]),
     ("urdf_inertia_absurd", URDF, ("xml", "link[@name='bracelet_link']/inertial/inertia", "ixx iyy izz", "5000"),
      ["link 'bracelet_link' <inertial>", "radius of gyration"]),
     # -- URDF joints against the hinge plant

@@ -1,6 +1,7 @@
 #include <phri/app/config.hpp>
 
 #include <phri/app/config_checks.hpp>
+#include <phri/app/robot_bundle.hpp>
 
 #include <phri/core/format.hpp>
 #include <phri/core/yaml_reader.hpp>
@@ -8,6 +9,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <optional>
 
 namespace phri {
 namespace {
@@ -104,7 +106,7 @@ void absolutize_robot(YAML::Node plant, const std::string& dir) {
   const YAML::Node& view = plant;
   if (!view.IsMap() || !view["robot"] || !view["robot"].IsMap()) return;
   YAML::Node robot = plant["robot"];
-  for (const char* key : {"mjcf", "actuators"}) {
+  for (const char* key : {"mjcf", "urdf", "actuators"}) {
     const YAML::Node& robot_view = robot;
     if (robot_view[key] && robot_view[key].IsScalar()) {
       robot[key] = resolve_path(dir, robot_view[key].Scalar(), kInputPaths);
@@ -125,7 +127,24 @@ void merge(YAML::Node base, const YAML::Node& over) {
   }
 }
 
-SimRobotConfig parse_plant(const YamlReader& r, const std::string& base_dir) {
+// With a robot bundle, the plant section need not name the arm or its start posture: the bundle's
+// files and home posture fill `robot` and `initial` when absent (apply_to then sets its end of arm).
+void fill_from_bundle(YAML::Node plant, const RobotBundle& bundle) {
+  const YAML::Node& view = plant;
+  if (!view["robot"]) {
+    YAML::Node robot;
+    if (bundle.plant.mjcf_path.empty()) {
+      robot["urdf"] = bundle.urdf_path;
+    } else {
+      robot["mjcf"] = bundle.plant.mjcf_path;
+    }
+    robot["actuators"] = bundle.actuators_path;
+    plant["robot"] = robot;
+  }
+  if (!view["initial"]) plant["initial"]["q_rad"] = bundle.home_q_rad;
+}
+
+SimRobotConfig parse_plant(const YamlReader& r, const std::string& base_dir, const RobotBundle* bundle) {
   r.expect_map();
   const YAML::Node& raw = r.node();
   YAML::Node plant;
@@ -146,6 +165,7 @@ SimRobotConfig parse_plant(const YamlReader& r, const std::string& base_dir) {
     plant = YAML::Clone(raw);
     absolutize_robot(plant, base_dir);
   }
+  if (bundle != nullptr) fill_from_bundle(plant, *bundle);
   YAML::Node document;
   document["plant"] = plant;
   YAML::Emitter out;
@@ -438,18 +458,45 @@ void parse_run(const YamlReader& r, RunSettings& s) {
   }
 }
 
-Config parse(const YamlReader& root, const std::string& base_dir) {
+// The robot: a bundle's folder (a scalar, or `robot_folder` from the command line), or the map of files.
+std::optional<RobotBundle> parse_robot_section(const YamlReader& root, const std::string& base_dir,
+                                               const std::string& robot_folder, ControllerSettings& c) {
+  std::optional<RobotBundle> bundle;
+  if (!robot_folder.empty()) {
+    bundle = RobotBundle::from_folder(robot_folder);
+  } else {
+    const YamlReader robot = root.at("robot");
+    if (!robot.node().IsScalar()) {
+      parse_robot(robot, base_dir, c);
+      return bundle;
+    }
+    std::string folder = resolve_path(base_dir, robot.as_text(), kInputPaths);
+    if (std::filesystem::path(folder).filename() == "robot.yaml") folder = std::filesystem::path(folder).parent_path().string();
+    if (!std::filesystem::is_regular_file(std::filesystem::path(folder) / "robot.yaml")) {
+      throw robot.error("", "no robot.yaml in the robot folder " + folder);
+    }
+    bundle = RobotBundle::from_folder(folder);
+  }
+  bundle->apply_to(c);
+  return bundle;
+}
+
+Config parse(const YamlReader& root, const std::string& base_dir, const std::string& robot_folder = "") {
   const std::string& source = root.file();
   root.allow_keys({"robot", "plant", "controller", "low_level", "fsm", "events", "logging", "gamepad", "run"});
   Config c;
   c.source = source;
 
-  parse_robot(root.at("robot"), base_dir, c.controller);
+  const std::optional<RobotBundle> bundle = parse_robot_section(root, base_dir, robot_folder, c.controller);
   const ActuatorTable drives = ActuatorTable::from_yaml_file(c.controller.actuators_path);
   const int dof = drives.size();
 
-  const YamlReader plant = root.at("plant");
-  c.plant = parse_plant(plant, base_dir);
+  if (bundle && !root.has("plant")) {
+    c.plant.source = source;
+  } else {
+    c.plant = parse_plant(root.at("plant"), base_dir, bundle ? &*bundle : nullptr);
+  }
+  if (bundle) bundle->apply_to(c.plant);
   if (c.plant.dof() != dof) {
     throw ConfigError(source, "plant.robot.actuators",
                       "the plant has " + std::to_string(c.plant.dof()) + " joints, the controller's robot.actuators " +
@@ -462,6 +509,10 @@ Config parse(const YamlReader& root, const std::string& base_dir) {
                       "must equal the plant's control period (plant.timing.control_period_s)");
   }
   if (root.has("low_level")) parse_low_level(root.at("low_level"), c.controller, c.fsm);
+  if (bundle) {  // the FSM's postures default to the robot's home (the library's are the Gen3's)
+    c.fsm.startup.home_q_rad = bundle->home_q_rad;
+    c.fsm.static_scenario.posture_q_rad = bundle->home_q_rad;
+  }
   if (root.has("fsm")) parse_fsm(root.at("fsm"), dof, c.fsm);
   // The FSM's start-up runs in Position; without it the run starts in the torque loop.
   c.controller.initial_loop = c.fsm.startup.enabled ? LowLevelMode::kPosition : c.fsm.torque_loop;
@@ -479,6 +530,10 @@ Config parse(const YamlReader& root, const std::string& base_dir) {
 
 Config Config::from_yaml_file(const std::string& path) {
   return parse(YamlReader::load_file(path), std::filesystem::path(path).parent_path().string());
+}
+
+Config Config::from_yaml_file(const std::string& path, const std::string& robot_folder) {
+  return parse(YamlReader::load_file(path), std::filesystem::path(path).parent_path().string(), robot_folder);
 }
 
 Config Config::from_yaml_string(const std::string& yaml, const std::string& source_name, const std::string& base_dir) {

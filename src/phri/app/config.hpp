@@ -22,8 +22,11 @@
 //
 // Schema (top-level sections; all but `robot` and `plant` optional, absent keys keep the defaults
 // of the settings structs, which follow the paper where it gives a value):
-//   robot:       urdf, actuators, collision ('' for none), end_effector_frame, ft_sensor_offset_m,
+//   robot:       either a robot bundle's folder (robots/<robot>, see app/robot_bundle.hpp), or
+//                urdf, actuators, collision ('' for none), end_effector_frame, ft_sensor_offset_m,
 //                payloads [{name, frame, mass_kg, com_m, inertia_kgm2}]       -> ControllerSettings
+//                (a bundle also sets the plant's arm, drives, F/T sensor and tool; `plant:` may
+//                then be left out, the plant's defaults and the bundle's home posture applying)
 //   plant:       either `file: plant_gen3.yaml` plus any keys of that file's `plant:` section to
 //                override (maps merged key by key, lists replaced), or the whole section inline
 //                                                                             -> SimRobotConfig
@@ -74,6 +77,9 @@ struct RunSettings {
 
 struct Config {
   static Config from_yaml_file(const std::string& path);
+  /// The same with the robot bundle in `robot_folder` (robots/<robot>/robot.yaml) in place of
+  /// whatever robot the file names (`phri run --robot DIR`); empty: the file's own.
+  static Config from_yaml_file(const std::string& path, const std::string& robot_folder);
   /// `base_dir` resolves relative input files; `source_name` stands for the file in errors.
   static Config from_yaml_string(const std::string& yaml, const std::string& source_name, const std::string& base_dir);
 

@@ -21,13 +21,18 @@ std::string range_text(double lower, double upper) {
   return "[" + format_general(lower, 6) + ", " + format_general(upper, 6) + "]";
 }
 
+std::string joint_type_name(JointType type) { return type == JointType::kRevolute ? "revolute" : "continuous"; }
+
 // One joint of the controller's URDF against the same joint of the plant's MJCF.
 void check_joint_matches_plant(const Joint& joint, const SimScene::ArmJoint& plant, const std::string& urdf,
                                const std::string& mjcf) {
   const std::string where = "joint '" + joint.name + "'";
-  if (!plant.hinge) throw ConfigError(mjcf, joint.name, "the plant's joint is not a hinge (phri simulates revolute arms)");
-  if (joint.type == JointType::kPrismatic) {
+  // Revolute/continuous joints are hinges in the plant, prismatic ones slides.
+  if (joint.type == JointType::kPrismatic && plant.hinge) {
     throw ConfigError(urdf, where, "prismatic in the URDF but a hinge in the plant (" + mjcf + ")");
+  }
+  if (joint.type != JointType::kPrismatic && !plant.hinge) {
+    throw ConfigError(urdf, where, joint_type_name(joint.type) + " in the URDF but a slide in the plant (" + mjcf + ")");
   }
   if (joint.type == JointType::kContinuous || !joint.has_position_limits()) {
     if (plant.limited) {
@@ -54,7 +59,7 @@ void check_urdf_matches_plant(const Model& model, const Config& config) {
     if (match == nullptr) {
       throw ConfigError(urdf, "joint '" + joint.name + "'", "not a joint of the plant (" + config.plant.actuators_path + ")");
     }
-    check_joint_matches_plant(joint, *match, urdf, config.plant.mjcf_path);
+    check_joint_matches_plant(joint, *match, urdf, config.plant.arm_file());
   }
 }
 
@@ -110,7 +115,11 @@ void check_config_against_robot(const Config& config) {
   const ControllerSettings& settings = config.controller;
   {
     // The plain URDF first: the frame the options hang the F/T sensor and payloads on must be right.
-    const Model plain = Model::from_urdf_file(settings.urdf_path);
+    ModelOptions chain_only;  // the chain of the settings, without the F/T frame and the payloads
+    chain_only.base_link = settings.base_link;
+    chain_only.tip_link = settings.tip_link;
+    chain_only.locked_joints = settings.locked_joints;
+    const Model plain = Model::from_urdf_file(settings.urdf_path, chain_only);
     check_end_effector_frame(plain, config);
   }
   const Model model = Model::from_urdf_file(settings.urdf_path, Controller::model_options(settings));
@@ -120,8 +129,9 @@ void check_config_against_robot(const Config& config) {
       {"fsm.startup.home_q_rad", &config.fsm.startup.home_q_rad},
       {"fsm.static.posture_q_rad", &config.fsm.static_scenario.posture_q_rad}};
   for (const auto& [key, q] : postures) check_within_limits(model, *q, config.source, key);
-  if (settings.collision_path.empty()) return;
-  const CollisionModel collision = CollisionModel::from_yaml_file(settings.collision_path, model);
+  const std::optional<CollisionModel> fitted_or_file = Controller::collision_model(settings, model);
+  if (!fitted_or_file) return;
+  const CollisionModel& collision = *fitted_or_file;
   for (const auto& [key, q] : postures) {
     if (static_cast<int>(q->size()) != model.nq()) continue;  // sizes: checked where they are read
     check_clear_of_collision(model, collision, *q, settings.qp.collision.safety_distance, config.source, key);

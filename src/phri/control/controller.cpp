@@ -11,6 +11,9 @@ namespace phri {
 
 ModelOptions Controller::model_options(const ControllerSettings& settings) {
   ModelOptions options;
+  options.base_link = settings.base_link;
+  options.tip_link = settings.tip_link;
+  options.locked_joints = settings.locked_joints;
   ExtraFrame sensor;
   sensor.name = "ft_sensor";
   sensor.parent_frame = settings.end_effector_frame;
@@ -21,6 +24,12 @@ ModelOptions Controller::model_options(const ControllerSettings& settings) {
     options.payloads.push_back(payload);
   }
   return options;
+}
+
+std::optional<CollisionModel> Controller::collision_model(const ControllerSettings& settings, const Model& model) {
+  if (!settings.collision_yaml.empty()) return CollisionModel::from_yaml_string(settings.collision_yaml, model, "fitted capsules");
+  if (settings.collision_path.empty()) return std::nullopt;
+  return CollisionModel::from_yaml_file(settings.collision_path, model);
 }
 
 WholeBodyQpSettings Controller::qp_settings(const ControllerSettings& settings, const ActuatorTable& actuators) {
@@ -130,7 +139,7 @@ Controller::LoadedRobot Controller::load(const ControllerSettings& settings) {
   Model model = Model::from_urdf_file(settings.urdf_path, model_options(settings));
   ActuatorTable actuators = ActuatorTable::from_yaml_file(settings.actuators_path);
   std::optional<CollisionModel> collision;
-  if (!settings.collision_path.empty()) collision = CollisionModel::from_yaml_file(settings.collision_path, model);
+  collision = collision_model(settings, model);
   return {std::move(model), std::move(actuators), std::move(collision), settings.actuators_path};
 }
 

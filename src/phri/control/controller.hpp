@@ -72,6 +72,8 @@ public:
              const ControllerSettings& settings);
   /// The model options the controller needs: the F/T sensor frame and the payloads.
   static ModelOptions model_options(const ControllerSettings& settings);
+  /// The settings' collision model on `model`: collision_yaml, else collision_path, else none.
+  static std::optional<CollisionModel> collision_model(const ControllerSettings& settings, const Model& model);
 
   /// One cycle: apply the targets, then estimate, QP, inverse dynamics, low level. The first
   /// usable state becomes the targets (hold where the arm is) before the given ones apply.

@@ -71,7 +71,15 @@ struct ControllerSettings {
   std::string urdf_path;       ///< the controller's (link-side) model
   std::string actuators_path;  ///< actuators.yaml: limits, rotor inertia, friction model
   std::string collision_path;  ///< collision.yaml; empty: no self-collision constraint
+  /// A collision model's text (capsules fitted from the URDF, model/capsule_fit.hpp), used in
+  /// place of collision_path when not empty.
+  std::string collision_yaml;
   std::string end_effector_frame = "end_effector_link";
+  /// The controlled chain (ModelOptions): base and tip links ('' : the URDF's root, the end of its
+  /// only moving branch) and the URDF joints held at 0 (e.g. a gripper's fingers).
+  std::string base_link;
+  std::string tip_link;
+  std::vector<std::string> locked_joints;
   /// F/T sensor measuring frame on the end-effector frame: offset along its z axis (paper setup,
   /// robot/paper_end_of_arm.hpp).
   double ft_sensor_offset_m = PaperEndOfArm::kSensorOffset_m;

@@ -124,9 +124,7 @@ struct DashboardServer::Impl {
   }
 
   static std::optional<CollisionModel> load_collision(const Controller& controller) {
-    const std::string& path = controller.settings().collision_path;
-    if (path.empty()) return std::nullopt;
-    return CollisionModel::from_yaml_file(path, controller.model());
+    return Controller::collision_model(controller.settings(), controller.model());
   }
 
   static StateEncoderSettings encoder_settings(const Controller& controller, const DashboardSettings& s) {

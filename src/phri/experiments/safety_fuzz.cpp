@@ -1,11 +1,13 @@
 #include <phri/experiments/safety_fuzz.hpp>
 
+#include <phri/app/robot_bundle.hpp>
 #include <phri/control/controller.hpp>
 #include <phri/core/error.hpp>
 #include <phri/core/format.hpp>
 #include <phri/experiments/experiment_files.hpp>
 #include <phri/experiments/fault_injecting_robot.hpp>
 #include <phri/model/algorithms.hpp>
+#include <phri/model/capsule_fit.hpp>
 #include <phri/sim/sim_robot.hpp>
 
 #include <algorithm>
@@ -20,6 +22,7 @@
 #include <mutex>
 #include <optional>
 #include <ostream>
+#include <sstream>
 #include <thread>
 
 namespace phri {
@@ -36,6 +39,8 @@ std::mutex& plant_construction_mutex() {
 // controller's robot, the pushes toward the limits and the fault catalogue.
 struct Shared {
   const SafetyFuzzOptions& o;
+  ControllerSettings settings;  // the robot's (chain, frames, payloads); mode and loop set per run
+  std::vector<double> start_q;
   SimRobotConfig plant;
   Model model;
   ActuatorTable actuators;
@@ -46,8 +51,8 @@ struct Shared {
   double dt = 1e-3;
 };
 
-ControllerSettings controller_settings(ComplianceMode mode) {
-  ControllerSettings s;
+ControllerSettings controller_settings(const Shared& shared, ComplianceMode mode) {
+  ControllerSettings s = shared.settings;
   s.initial_compliance = mode;
   s.initial_loop = LowLevelMode::kPosition;
   return s;
@@ -56,7 +61,7 @@ ControllerSettings controller_settings(ComplianceMode mode) {
 // The joint-limit pushes (each limited joint, both ways) and the wrist fold, from the start pose.
 std::vector<PushSpec> targeted_pushes(const Shared& s) {
   Data data(s.model);
-  Eigen::VectorXd q = Eigen::Map<const Eigen::VectorXd>(s.o.start_q_rad.data(), static_cast<Eigen::Index>(s.o.start_q_rad.size()));
+  Eigen::VectorXd q = Eigen::Map<const Eigen::VectorXd>(s.start_q.data(), static_cast<Eigen::Index>(s.start_q.size()));
   forward_kinematics(s.model, data, q);
   update_frame_placements(s.model, data);
   std::vector<PushSpec> pushes;
@@ -74,6 +79,49 @@ std::vector<PushSpec> targeted_pushes(const Shared& s) {
   return pushes;
 }
 
+// The robot under test: the Gen3's files of the options, or a robot bundle's.
+struct RobotUnderTest {
+  SimRobotConfig plant;
+  ControllerSettings settings;
+  std::string urdf_path;
+  std::vector<double> start_q;
+  bool fit_capsules = false;  // the bundle has no collision.yaml
+};
+
+RobotUnderTest robot_under_test(const SafetyFuzzOptions& o) {
+  RobotUnderTest r;
+  r.settings.initial_loop = LowLevelMode::kPosition;
+  if (o.robot_folder.empty()) {
+    r.plant = SimRobotConfig::from_yaml_file(o.plant_config_path);
+    r.settings.urdf_path = r.urdf_path = o.urdf_path;
+    r.settings.actuators_path = o.actuators_path;
+    r.settings.collision_path = o.collision_path;
+    r.start_q = o.start_q_rad;
+    return r;
+  }
+  const RobotBundle bundle = RobotBundle::from_folder(o.robot_folder);
+  r.plant.source = bundle.source;
+  bundle.apply_to(r.plant);
+  r.plant.fill_defaults();
+  bundle.apply_to(r.settings);
+  r.urdf_path = bundle.urdf_path;
+  r.start_q = bundle.home_q_rad;
+  r.fit_capsules = bundle.collision_path.empty() && bundle.collision_yaml.empty();
+  return r;
+}
+
+std::optional<CollisionModel> robot_collision(const RobotUnderTest& r, const Model& model) {
+  if (r.fit_capsules) {
+    std::ifstream file(r.urdf_path);
+    std::stringstream urdf;
+    urdf << file.rdbuf();
+    const Eigen::VectorXd home = Eigen::Map<const Eigen::VectorXd>(r.start_q.data(), static_cast<Eigen::Index>(r.start_q.size()));
+    return CollisionModel::from_yaml_string(fit_capsules(urdf.str(), model, home, {.link_frame_radius_m = 0.04, .clearance_m = 0.02}).yaml,
+                                            model, "capsules fitted from " + r.urdf_path);
+  }
+  return Controller::collision_model(r.settings, model);
+}
+
 std::unique_ptr<Shared> load_shared(const SafetyFuzzOptions& o) {
   const std::string src = "<safety fuzz options>";
   if (o.pushes < 0 || o.pushes_per_run < 1 || o.jobs < 1) {
@@ -81,18 +129,17 @@ std::unique_ptr<Shared> load_shared(const SafetyFuzzOptions& o) {
   }
   if (o.modes.empty() || o.loops.empty()) throw ConfigError(src, "modes/loops", "nothing to run");
   if (!(o.position_phase_s >= 0.3 && o.settle_s >= 0.0)) throw ConfigError(src, "position_phase_s", "must be >= 0.3 s (F/T bias)");
-  SimRobotConfig plant = SimRobotConfig::from_yaml_file(o.plant_config_path);
-  if (static_cast<int>(o.start_q_rad.size()) != plant.dof()) throw ConfigError(src, "start_q_rad", "needs one value per joint");
-  plant.initial_q_rad = o.start_q_rad;
-  plant.mismatch.enabled = o.model_mismatch;
-  const ControllerSettings settings = controller_settings(ComplianceMode::kStiff);
-  Model model = Model::from_urdf_file(o.urdf_path, Controller::model_options(settings));
-  ActuatorTable actuators = ActuatorTable::from_yaml_file(o.actuators_path);
-  std::optional<CollisionModel> collision;
-  if (!o.collision_path.empty()) collision = CollisionModel::from_yaml_file(o.collision_path, model);
+  RobotUnderTest robot = robot_under_test(o);
+  if (robot.start_q.size() != static_cast<std::size_t>(robot.plant.dof())) throw ConfigError(src, "start_q_rad", "needs one value per joint");
+  robot.plant.initial_q_rad = robot.start_q;
+  robot.plant.mismatch.enabled = o.model_mismatch;
+  Model model = Model::from_urdf_file(robot.urdf_path, Controller::model_options(robot.settings));
+  ActuatorTable actuators = ActuatorTable::from_yaml_file(robot.settings.actuators_path);
+  std::optional<CollisionModel> collision = robot_collision(robot, model);
   if (!collision) throw ConfigError(src, "collision_path", "the pushes land on the collision capsules: a collision model is needed");
-  auto s = std::unique_ptr<Shared>(new Shared{o, std::move(plant), std::move(model), std::move(actuators), std::move(collision),
-                                              Eigen::VectorXd(), Eigen::VectorXd(), {}, {}, 1e-3});
+  auto s = std::unique_ptr<Shared>(new Shared{o, robot.settings, robot.start_q, std::move(robot.plant), std::move(model),
+                                              std::move(actuators), std::move(collision), Eigen::VectorXd(), Eigen::VectorXd(),
+                                              {}, {}, 1e-3});
   const int n = s->model.nv();
   s->velocity_limit.resize(n);
   s->torque_limit.resize(n);
@@ -132,7 +179,7 @@ public:
         loop_(loop),
         robot_(make_plant(s, plant_seed)),
         io_(*robot_, fault),
-        cycle_(s.model, s.actuators, s.collision, controller_settings(mode)),
+        cycle_(s.model, s.actuators, s.collision, controller_settings(s, mode)),
         command_(robot_->dof()),
         targets_(robot_->dof()),
         monitor_(s.model, &*s.collision, s.velocity_limit, s.torque_limit) {}

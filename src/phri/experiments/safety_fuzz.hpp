@@ -48,6 +48,10 @@ struct SafetyFuzzOptions {
   std::string urdf_path = "robots/kinova_gen3/gen3.urdf";
   std::string actuators_path = "robots/kinova_gen3/actuators.yaml";
   std::string collision_path = "robots/kinova_gen3/collision.yaml";
+  /// A robot bundle (robots/<robot>) in place of the four files above and of start_q_rad: its
+  /// plant (generated from its URDF, or its MJCF), drives, chain, end of arm and collision.yaml
+  /// (capsules fitted from its URDF when it has none); the start posture is its home. Empty: the files.
+  std::string robot_folder;
   std::string output_dir = "results/safety_fuzz";  ///< empty: no files
   std::string figure_script = "tools/report/safety_fuzz_figure.py";  ///< empty: no figure
 

@@ -63,6 +63,7 @@ std::string what(const FuzzRecord& r) {
 std::string replay_command(const FuzzRecord& r, const SafetyFuzzOptions& o) {
   std::string c = "phri experiment safety-fuzz --seed " + std::to_string(o.seed) + " --pushes " + std::to_string(o.pushes);
   if (o.pushes_per_run != SafetyFuzzOptions{}.pushes_per_run) c += " --pushes-per-run " + std::to_string(o.pushes_per_run);
+  if (!o.robot_folder.empty()) c += " --robot " + o.robot_folder;
   return c + " --replay " + r.run_id;
 }
 
@@ -320,7 +321,8 @@ std::string safety_fuzz_report(const SafetyFuzzResult& result, const SafetyFuzzO
 }
 
 int run_safety_fuzz_command(const SafetyFuzzOptions& options, bool fail_on_violation, std::ostream& out) {
-  out << "safety fuzz: plant " << options.plant_config_path << ", seed " << options.seed << ", " << options.pushes
+  out << "safety fuzz: " << (options.robot_folder.empty() ? "plant " + options.plant_config_path : "robot " + options.robot_folder)
+      << ", seed " << options.seed << ", " << options.pushes
       << " random pushes" << std::endl;
   const SafetyFuzzResult r = run_safety_fuzz(options, &out);
   std::ostringstream summary;

@@ -20,7 +20,13 @@ CustomTorqueController::CustomTorqueController(const ActuatorTable& actuators, c
     fail("integral_limit_fraction", "must be in [0, 1]");
   }
   const int n = static_cast<int>(actuators_.size());
-  filters_.assign(static_cast<std::size_t>(n), DiscreteTransferFunction::kinova_high_velocity());
+  if (settings.filter_numerator.empty() != settings.filter_denominator.empty()) {
+    fail("filter_numerator", "give both the numerator and the denominator of H(z), or neither");
+  }
+  const DiscreteTransferFunction filter = settings.filter_numerator.empty()
+                                              ? DiscreteTransferFunction::kinova_high_velocity()
+                                              : DiscreteTransferFunction(settings.filter_numerator, settings.filter_denominator);
+  filters_.assign(static_cast<std::size_t>(n), filter);
   leak_factor_ = std::exp(-settings.integral_leak * settings.period_s);
   input_factor_ = settings.integral_gain * (1.0 - leak_factor_) / settings.integral_leak;
   integral_limit_.resize(n);

@@ -39,6 +39,10 @@ struct CustomTorqueSettings {
   double integral_limit_fraction = 0.05;  ///< |I| <= fraction * torque limit (paper code: 5 %)
   bool friction_compensation = true;
   bool rotor_inertia_compensation = true;
+  /// H(z) on the torque error, b / a in powers of z^-1 (a robot bundle's custom_loop_filter);
+  /// both empty: Kinova's, the paper's (DiscreteTransferFunction::kinova_high_velocity()).
+  std::vector<double> filter_numerator;
+  std::vector<double> filter_denominator;
 };
 
 class CustomTorqueController {

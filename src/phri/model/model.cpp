@@ -3,6 +3,7 @@
 
 #include <phri/core/error.hpp>
 #include <phri/core/format.hpp>
+#include <phri/core/parser_lock.hpp>
 
 #include <console_bridge/console.h>
 #include <urdf_parser/urdf_parser.h>
@@ -14,6 +15,7 @@
 #include <fstream>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <sstream>
 
 namespace phri {
@@ -45,19 +47,23 @@ Inertia Inertia::transformed(const Eigen::Isometry3d& placement) const {
 // ---------------------------------------------------------------------------------- builder
 namespace {
 
-// Captures urdfdom's console_bridge messages so that a parse failure can be reported with its
-// reason instead of a bare "invalid". console_bridge's handler is global: serialise loads.
+// Captures urdfdom's console_bridge messages. urdfdom 3 logs some failures and still returns a
+// model: a mass written "0.73kg" logs "Could not parse inertial element for Link [...]" and leaves
+// the mass at 0, so an error-level message is a load error even when parsing "succeeded".
+// console_bridge's handler is global: loads hold urdf_parser_mutex().
 class CapturingOutput : public console_bridge::OutputHandler {
 public:
   void log(const std::string& text, console_bridge::LogLevel level, const char*, int) override {
-    if (level >= console_bridge::CONSOLE_BRIDGE_LOG_WARN) {
-      if (!messages.empty()) messages += "; ";
-      messages += text;
+    if (level >= console_bridge::CONSOLE_BRIDGE_LOG_ERROR) {
+      if (!errors.empty()) errors += "; ";
+      errors += text;
+    } else if (level == console_bridge::CONSOLE_BRIDGE_LOG_WARN) {
+      warnings.push_back(text);
     }
   }
-  std::string messages;
+  std::string errors;
+  std::vector<std::string> warnings;
 };
-std::mutex g_parse_mutex;
 
 bool finite(double x) { return std::isfinite(x); }
 
@@ -89,8 +95,11 @@ bool is_movable(const urdf::Joint& joint) { return joint.type != urdf::Joint::FI
 
 class UrdfModelBuilder {
 public:
-  UrdfModelBuilder(const urdf::ModelInterface& urdf, const ModelOptions& options, std::string source)
-      : urdf_(urdf), options_(options), source_(std::move(source)) {}
+  UrdfModelBuilder(const urdf::ModelInterface& urdf, const ModelOptions& options, std::string source,
+                   std::vector<std::string> parser_warnings)
+      : urdf_(urdf), options_(options), source_(std::move(source)) {
+    for (std::string& w : parser_warnings) model_.warnings_.push_back(source_ + ": " + w);
+  }
 
   Model build() {
     model_.name_ = urdf_.getName();
@@ -99,6 +108,7 @@ public:
     if (!options_.gravity.allFinite()) fail("ModelOptions.gravity", "must be finite");
     if (!options_.base_placement.matrix().allFinite()) fail("ModelOptions.base_placement", "must be finite");
 
+    check_tree();
     const urdf::Link* base = resolve_base();
     model_.base_link_ = base->name;
     const urdf::Link* tip = resolve_tip(base);
@@ -126,6 +136,34 @@ public:
 private:
   [[noreturn]] void fail(const std::string& element, const std::string& reason) const {
     throw ConfigError(source_, element, reason);
+  }
+
+  // urdfdom 3 accepts kinematic loops (a link that is the child of two joints, a joint whose parent
+  // is its child, a cycle of joints): the walks below would recurse or loop for ever on them.
+  void check_tree() const {
+    std::map<std::string, std::string> joint_of_child;
+    for (const auto& [name, joint] : urdf_.joints_) {
+      const std::string& child = joint->child_link_name;
+      if (child == joint->parent_link_name) {
+        fail("joint '" + name + "'", "its parent and child are the same link '" + child +
+                                         "': a kinematic loop (a URDF describes a tree)");
+      }
+      const auto [it, inserted] = joint_of_child.emplace(child, name);
+      if (!inserted) {
+        fail("link '" + child + "'", "is the child of two joints ('" + it->second + "' and '" + name +
+                                         "'): a kinematic loop (a URDF describes a tree)");
+      }
+    }
+    // With one parent per link, a loop is a cycle of parents: no walk up may be longer than the tree.
+    for (const auto& [name, link] : urdf_.links_) {
+      std::size_t steps = 0;
+      for (const urdf::Link* up = link.get(); up != nullptr; up = up->getParent().get()) {
+        if (++steps > urdf_.links_.size()) {
+          fail("link '" + name + "'", "its chain of parent joints comes back to itself: a kinematic loop "
+                                      "(a URDF describes a tree)");
+        }
+      }
+    }
   }
 
   const urdf::Link* resolve_base() const {
@@ -266,11 +304,29 @@ private:
 
   void add_link_inertia(const urdf::Link& link, int body, const Eigen::Isometry3d& placement_in_body) {
     if (!link.inertial) return;
-    const urdf::Inertial& in = *link.inertial;
     const std::string where = "link '" + link.name + "' <inertial>";
+    if (body < 0) {
+      // Fixed to the base: it cannot affect the dynamics, so a bad value there is only reported.
+      try {
+        (void)checked_inertia(link, where);
+      } catch (const ConfigError& e) {
+        warn(e.element(), e.reason() + "; ignored: the link is fixed to the base");
+      }
+      return;
+    }
+    const std::optional<Inertia> local = checked_inertia(link, where);
+    if (!local) return;  // a massless frame link
+    const Eigen::Isometry3d inertial_frame = placement_in_body * to_isometry(link.inertial->origin);
+    Inertia& target = model_.bodies_[static_cast<std::size_t>(body)];
+    target = target.combined_with(local->transformed(inertial_frame));
+  }
+
+  // The link's inertial in its inertial frame after the checks; nullopt for a massless link.
+  std::optional<Inertia> checked_inertia(const urdf::Link& link, const std::string& where) {
+    const urdf::Inertial& in = *link.inertial;
     const double values[] = {in.mass, in.ixx, in.ixy, in.ixz, in.iyy, in.iyz, in.izz};
     for (double v : values) {
-      if (!finite(v)) fail(where, "values must be finite");
+      if (!finite(v)) fail(where, "values must be finite (mass or a moment is NaN or infinite)");
     }
     if (!pose_is_finite(in.origin)) fail(where, "origin is not finite");
     Eigen::Matrix3d tensor;
@@ -282,10 +338,10 @@ private:
       fail(where, "mass " + format_general(in.mass, 6) + " kg is above 1000 kg: no arm link weighs that");
     }
     if (in.mass == 0.0) {
-      if (body >= 0 && on_path_.count(link.name) && link.parent_joint && moves(*link.parent_joint)) {
+      if (on_path_.count(link.name) && link.parent_joint && moves(*link.parent_joint)) {
         fail(where, "mass must be positive (got 0) on a link moved by a joint");
       }
-      return;  // a massless frame link
+      return std::nullopt;
     }
     check_inertia_tensor(tensor, where);
     const double largest_moment = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(tensor, Eigen::EigenvaluesOnly).eigenvalues()[2];
@@ -293,17 +349,17 @@ private:
       fail(where, "principal moment " + format_general(largest_moment, 6) + " kg.m^2 is too large for the mass " +
                       format_general(in.mass, 6) + " kg (radius of gyration above 2 m)");
     }
-    if (body < 0) return;  // fixed to the base: no effect on the dynamics
-    const Eigen::Isometry3d inertial_frame = placement_in_body * to_isometry(in.origin);
     Inertia local;
     local.mass = in.mass;
-    local.com = Eigen::Vector3d::Zero();
     local.inertia_com = tensor;
-    Inertia& target = model_.bodies_[static_cast<std::size_t>(body)];
-    target = target.combined_with(local.transformed(inertial_frame));
+    return local;
   }
 
-  void check_inertia_tensor(const Eigen::Matrix3d& tensor, const std::string& where) const {
+  void warn(const std::string& element, const std::string& reason) {
+    model_.warnings_.push_back(ConfigError(source_, element, reason).what());
+  }
+
+  void check_inertia_tensor(const Eigen::Matrix3d& tensor, const std::string& where) {
     const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(tensor, Eigen::EigenvaluesOnly);
     const Eigen::Vector3d ev = eig.eigenvalues();  // ascending
     const double scale = std::max(ev.cwiseAbs().maxCoeff(), 1e-300);
@@ -311,20 +367,37 @@ private:
       fail(where, "inertia tensor is not positive definite (principal moments " + format_general(ev[0], 6) + ", " +
                       format_general(ev[1], 6) + ", " + format_general(ev[2], 6) + ")");
     }
-    // A physical body also satisfies the triangle inequality I1 + I2 >= I3.
+    // A rigid body satisfies I1 + I2 >= I3. Manufacturers' files break it (rounded CAD values);
+    // Pinocchio, KDL and RBDL accept such a tensor, and the dynamics stay well posed while it is
+    // positive definite: a warning, not an error (the plant balances it, see sim/urdf_plant).
     if (ev[0] + ev[1] < ev[2] * (1.0 - 1e-6)) {
-      fail(where, "inertia tensor violates the triangle inequality (principal moments " + format_general(ev[0], 6) +
-                      " + " + format_general(ev[1], 6) + " < " + format_general(ev[2], 6) + ")");
+      warn(where, "inertia tensor violates the triangle inequality (principal moments " + format_general(ev[0], 6) +
+                      " + " + format_general(ev[1], 6) + " < " + format_general(ev[2], 6) +
+                      "); accepted as given (positive definite)");
     }
   }
 
+  // A body without mass: either the URDF omits the inertial of the joint's child link while links
+  // further down still move (name that link), or nothing at all moves below the joint.
   void check_body(int i) const {
     const Inertia& body = model_.bodies_[static_cast<std::size_t>(i)];
     const Joint& joint = model_.joints_[static_cast<std::size_t>(i)];
-    if (body.mass <= 0.0) {
-      fail("joint '" + joint.name + "'",
-           "moves no mass: its child link and the links fixed to it have no <inertial>");
+    if (body.mass > 0.0) return;
+    double mass_below = 0.0;
+    for (std::size_t b = static_cast<std::size_t>(i) + 1; b < model_.bodies_.size(); ++b) mass_below += model_.bodies_[b].mass;
+    const std::string child = child_link_of(joint.name);
+    if (mass_below > 0.0) {
+      fail("link '" + child + "'", "has no <inertial> (nor any link fixed to it), yet joint '" + joint.name +
+                                       "' moves it: give it its mass (the links below it weigh " +
+                                       format_general(mass_below, 4) + " kg, but a moved link needs its own)");
     }
+    fail("joint '" + joint.name + "'",
+         "moves no mass: its child link '" + child + "' and every link below it have no <inertial>");
+  }
+
+  std::string child_link_of(const std::string& joint_name) const {
+    const auto joint = urdf_.getJoint(joint_name);
+    return joint ? joint->child_link_name : std::string("?");
   }
 
   void add_extra_frames() {
@@ -378,27 +451,43 @@ private:
 };
 
 // ---------------------------------------------------------------------------------- Model
+namespace {
+// "Could not parse inertial element for Link [hand]": the link urdfdom names, for the key path.
+std::string link_named_in(const std::string& message) {
+  const std::string marker = "Link [";
+  const auto begin = message.find(marker);
+  if (begin == std::string::npos) return "";
+  const auto end = message.find(']', begin + marker.size());
+  if (end == std::string::npos) return "";
+  const std::string link = "link '" + message.substr(begin + marker.size(), end - begin - marker.size()) + "'";
+  return message.find("inertial") != std::string::npos ? link + " <inertial>" : link;
+}
+}  // namespace
+
 Model Model::from_urdf_string(const std::string& urdf, const ModelOptions& options,
                               const std::string& source_name) {
   urdf::ModelInterfaceSharedPtr parsed;
-  std::string messages;
+  CapturingOutput capture;
   {
-    std::lock_guard<std::mutex> lock(g_parse_mutex);
-    CapturingOutput capture;
+    std::lock_guard<std::mutex> lock(urdf_parser_mutex());
     console_bridge::useOutputHandler(&capture);
     try {
       parsed = urdf::parseURDF(urdf);
     } catch (const std::exception& e) {
-      capture.messages += e.what();
+      capture.errors += e.what();
       parsed.reset();
     }
     console_bridge::restorePreviousOutputHandler();
-    messages = capture.messages;
   }
   if (!parsed) {
-    throw ConfigError(source_name, "", "not a valid URDF" + (messages.empty() ? std::string() : " (" + messages + ")"));
+    throw ConfigError(source_name, "", "not a valid URDF" + (capture.errors.empty() ? std::string() : " (" + capture.errors + ")"));
   }
-  return UrdfModelBuilder(*parsed, options, source_name).build();
+  if (!capture.errors.empty()) {
+    // urdfdom went on after an error, dropping what it could not parse (e.g. a link's mass).
+    throw ConfigError(source_name, link_named_in(capture.errors),
+                      "urdfdom could not parse it and would drop the value (" + capture.errors + ")");
+  }
+  return UrdfModelBuilder(*parsed, options, source_name, std::move(capture.warnings)).build();
 }
 
 Model Model::from_urdf_file(const std::string& path, const ModelOptions& options) {

@@ -126,6 +126,10 @@ public:
   Eigen::VectorXd velocity_limits() const;
   Eigen::VectorXd effort_limits() const;
   double total_mass() const;  ///< of the moving bodies (the base excluded)
+  /// What the loader accepted but the user should know, one line each, naming the link: urdfdom's
+  /// warnings, inertias that violate the triangle inequality, an invalid inertial on a link fixed
+  /// to the base (ignored). Empty for a clean file.
+  const std::vector<std::string>& warnings() const { return warnings_; }
 
 private:
   friend class UrdfModelBuilder;
@@ -139,6 +143,7 @@ private:
   std::vector<Frame> frames_;
   Eigen::Vector3d gravity_ = Eigen::Vector3d(0.0, 0.0, -9.81);
   Eigen::Isometry3d base_placement_ = Eigen::Isometry3d::Identity();
+  std::vector<std::string> warnings_;
 };
 
 }  // namespace phri

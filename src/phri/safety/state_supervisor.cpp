@@ -186,9 +186,15 @@ int StateSupervisor::first_torque_current_mismatch(const RobotState& s) {
   if (ranges_.torque_per_amp.size() != n_ || !s.current.valid) return -1;
   const SupervisorSettings& c = settings_;
   // q̈, τ̈_s and the filter's step from the last samples that came this far (not only good ones).
-  const double dt = std::max(s.joints.stamp_s - residual_stamp_s_, c.period_s);
+  double dt = std::max(s.joints.stamp_s - residual_stamp_s_, c.period_s);
   if (residual_updates_ > 0 && dt > c.max_degraded_s) residual_updates_ = 0;  // a gap: start again
-  const double alpha = residual_updates_ == 0 ? 1.0 : dt / (c.torque_current_filter_s + dt);
+  // The filter starts from zero: a push at the first sample is not a fault, an offset soon is.
+  if (residual_updates_ == 0) {
+    dt = c.period_s;
+    torque_residual_.setZero();
+    rotor_acceleration_size_.setZero();
+  }
+  const double alpha = dt / (c.torque_current_filter_s + dt);
   int culprit = -1;
   for (int i = 0; i < n_; ++i) {
     const double motor = ranges_.torque_per_amp[i] * s.current_A[i];

@@ -76,11 +76,7 @@ void KinovaDriveEmulator::begin_cycle(const RobotCommand& command, bool fresh, c
         }
         q_des_ = command.q_rad;
       } else {
-        // No new set-point (a frame lost or late): a first-order hold whose feed-forward halves
-        // each cycle. Zeroing it instead kicked the servo twice (the D term lost the motion, then
-        // the next set-point's difference doubled it): 42 N.m steps at 1 % frame loss.
-        qd_ff_ *= 0.5;
-        q_des_ += control_period_s_ * qd_ff_;
+        qd_ff_.setZero();  // no new set-point: hold
       }
       break;
     case LowLevelMode::kKinovaTorque:

@@ -2,11 +2,29 @@
 
 #include <mujoco/mujoco.h>
 
+#include <cstring>
+
 namespace phri {
 
 void MjModelDeleter::operator()(mjModel_* model) const noexcept { mj_deleteModel(model); }
 
 void MjDataDeleter::operator()(mjData_* data) const noexcept { mj_deleteData(data); }
+
+MjModelPtr load_mjcf_text(const std::string& xml, std::string& error) {
+  mjVFS vfs;
+  mj_defaultVFS(&vfs);
+  const char* name = "phri_text.xml";
+  if (mj_makeEmptyFileVFS(&vfs, name, static_cast<int>(xml.size())) != 0) {
+    error = "MuJoCo virtual file system is full";
+    return nullptr;
+  }
+  std::memcpy(vfs.filedata[mj_findFileVFS(&vfs, name)], xml.data(), xml.size());
+  char buffer[1024] = "";
+  MjModelPtr m(mj_loadXML(name, &vfs, buffer, sizeof(buffer)));
+  mj_deleteVFS(&vfs);
+  if (!m) error = mujoco_error_line(buffer);
+  return m;
+}
 
 std::string mujoco_error_line(const char* error) {
   const std::string text = error != nullptr ? error : "";

@@ -25,4 +25,8 @@ using MjDataPtr = std::unique_ptr<mjData_, MjDataDeleter>;
 /// as one line for a ConfigError: lines trimmed, empty ones dropped, the rest joined by "; ".
 std::string mujoco_error_line(const char* error);
 
+/// MuJoCo model from MJCF text (through MuJoCo's virtual file system); null on failure, with
+/// MuJoCo's message (as one line) in `error`.
+MjModelPtr load_mjcf_text(const std::string& xml, std::string& error);
+
 }  // namespace phri

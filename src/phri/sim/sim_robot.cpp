@@ -96,7 +96,7 @@ SimRobot::SimRobot(const SimRobotConfig& config)
   ft_decimation_ = static_cast<int>(std::lround(config_.physics_rate_Hz / config_.ft_sensor.rate_Hz));
 
   scene_xml_ = SimScene::build_mjcf(config_);
-  m_ = load_scene(scene_xml_, config_.mjcf_path);
+  m_ = load_scene(scene_xml_, config_.arm_file());
   set_physics_options();
   const std::vector<int> arm_bodies = bind_arm_joints();
   if (config_.mismatch.enabled) perturb_link_inertials(arm_bodies);
@@ -137,8 +137,10 @@ std::vector<int> SimRobot::bind_arm_joints() {
 int SimRobot::bind_joint(int i) {
   const ActuatorParameters& a = plant_actuators_[i];
   const int j = mj_name2id(m_.get(), mjOBJ_JOINT, a.joint_name.c_str());
-  if (j < 0) throw ConfigError(config_.mjcf_path, a.joint_name, "joint of actuators.yaml missing in the MJCF");
-  if (m_->jnt_type[j] != mjJNT_HINGE) throw ConfigError(config_.mjcf_path, a.joint_name, "expected a hinge joint");
+  if (j < 0) throw ConfigError(config_.arm_file(), a.joint_name, "joint of actuators.yaml missing in the MJCF");
+  if (m_->jnt_type[j] != mjJNT_HINGE && m_->jnt_type[j] != mjJNT_SLIDE) {
+    throw ConfigError(config_.arm_file(), a.joint_name, "expected a hinge or slide joint");
+  }
   const auto k = static_cast<std::size_t>(i);
   qadr_[k] = m_->jnt_qposadr[j];
   dadr_[k] = m_->jnt_dofadr[j];
@@ -153,7 +155,7 @@ int SimRobot::bind_joint(int i) {
   if (q0 < lower_[i] || q0 > upper_[i]) {
     throw ConfigError(config_.source, "plant.initial.q_rad[" + std::to_string(i) + "]",
                       std::to_string(q0) + " rad is beyond " + a.joint_name + "'s range [" + std::to_string(lower_[i]) +
-                          ", " + std::to_string(upper_[i]) + "] in " + config_.mjcf_path);
+                          ", " + std::to_string(upper_[i]) + "] in " + config_.arm_file());
   }
   torque_per_amp_[i] = a.torque_per_amp();
   nominal_torque_per_amp_[i] = config_.actuators[i].torque_per_amp();

@@ -47,8 +47,23 @@ ExternalForce::Profile parse_profile(const std::string& name) {
 // ---- one parser per section of `plant:`, in the order parse() reads them
 
 void parse_robot_files(const YamlReader& r, const std::string& base_dir, SimRobotConfig& c) {
-  r.allow_keys({"mjcf", "actuators"});
-  c.mjcf_path = resolve_path(base_dir, r.text("mjcf"), PathForm::kAsGiven);
+  r.allow_keys({"mjcf", "urdf", "locked_joints", "balance_inertia", "actuators"});
+  // The arm: a hand-written MJCF, or the URDF the plant is generated from (not both).
+  if (r.has("mjcf") == r.has("urdf")) throw r.error("urdf", "give exactly one of 'mjcf' and 'urdf'");
+  if (r.has("mjcf")) {
+    c.mjcf_path = resolve_path(base_dir, r.text("mjcf"), PathForm::kAsGiven);
+  } else {
+    c.urdf_path = resolve_path(base_dir, r.text("urdf"), PathForm::kAsGiven);
+    c.balance_inertia = r.boolean_or("balance_inertia", false);
+    if (r.has("locked_joints")) {
+      const YamlReader list = r.at("locked_joints");
+      list.expect_sequence();
+      for (std::size_t i = 0; i < list.size(); ++i) c.locked_joints.push_back(list.at(i).as_text());
+    }
+  }
+  if (!r.has("urdf") && (r.has("balance_inertia") || r.has("locked_joints"))) {
+    throw r.error(r.has("locked_joints") ? "locked_joints" : "balance_inertia", "applies to a plant generated from 'urdf' only");
+  }
   c.actuators_path = resolve_path(base_dir, r.text("actuators"), PathForm::kAsGiven);
   c.actuators = ActuatorTable::from_yaml_file(c.actuators_path);
 }

@@ -51,7 +51,13 @@ struct SimRobotConfig {
   std::string source = "<SimRobotConfig>";  ///< file the config came from (error messages)
 
   // ---- robot description
-  std::string mjcf_path;       ///< MJCF of the arm alone (robots/kinova_gen3/gen3_plant.xml)
+  std::string mjcf_path;       ///< MJCF of the arm alone (robots/kinova_gen3/gen3_plant.xml); or:
+  /// the URDF the arm's MJCF is generated from (sim/urdf_plant.hpp), when mjcf_path is empty.
+  std::string urdf_path;
+  std::vector<std::string> locked_joints;  ///< URDF joints welded at 0 in the generated plant
+  bool balance_inertia = false;  ///< generated plant: MuJoCo's balanceinertia (a warning per link it changes)
+  /// The file the arm comes from, for messages: mjcf_path, else urdf_path.
+  const std::string& arm_file() const { return mjcf_path.empty() ? urdf_path : mjcf_path; }
   std::string actuators_path;  ///< actuators.yaml
   ActuatorTable actuators;     ///< nominal drive models, loaded from actuators_path
 

@@ -2,6 +2,7 @@
 #include <phri/core/format.hpp>
 #include <phri/sim/mujoco_handles.hpp>
 #include <phri/sim/sim_scene.hpp>
+#include <phri/sim/urdf_plant.hpp>
 
 #include <mujoco/mujoco.h>
 
@@ -25,6 +26,24 @@ std::string read_mjcf_text(const std::string& file) {
   return buffer.str();
 }
 
+// The arm alone: the MJCF file, or the one generated from the URDF.
+std::string arm_text(const SimRobotConfig& config) {
+  if (!config.mjcf_path.empty()) return read_mjcf_text(config.mjcf_path);
+  UrdfPlantOptions options;
+  options.urdf_path = config.urdf_path;
+  options.locked_joints = config.locked_joints;
+  options.balance_inertia = config.balance_inertia;
+  options.timestep_s = config.physics_step_s();
+  return UrdfPlant::generate(options).mjcf;
+}
+
+MjModelPtr load_arm(const SimRobotConfig& config) {
+  std::string error;
+  MjModelPtr arm = load_mjcf_text(arm_text(config), error);
+  if (!arm) throw ConfigError(config.arm_file(), "", "MuJoCo cannot load it: " + error);
+  return arm;
+}
+
 // Where the tool chain hangs: the flange site's body and the site's placement in it.
 struct FlangeMount {
   std::string body;
@@ -34,10 +53,8 @@ struct FlangeMount {
 
 // Loads the arm alone to find the flange and to check that it leaves the scene's names free.
 FlangeMount find_flange_mount(const SimRobotConfig& config) {
-  const std::string& file = config.mjcf_path;
-  char error[1024] = "";
-  const MjModelPtr arm(mj_loadXML(file.c_str(), nullptr, error, sizeof(error)));
-  if (!arm) throw ConfigError(file, "", "MuJoCo cannot load it: " + mujoco_error_line(error));
+  const std::string& file = config.arm_file();
+  const MjModelPtr arm = load_arm(config);
   const std::string& site_name = config.ft_sensor.flange_site;
   const int site = mj_name2id(arm.get(), mjOBJ_SITE, site_name.c_str());
   if (site < 0) throw ConfigError(config.source, "plant.ft_sensor.flange_site", "no site '" + site_name + "' in " + file);
@@ -160,8 +177,8 @@ void insert_before_end_tag(std::string& xml, const std::string& element, const s
 }  // namespace
 
 std::string SimScene::build_mjcf(const SimRobotConfig& config) {
-  const std::string& file = config.mjcf_path;
-  std::string xml = read_mjcf_text(file);
+  const std::string& file = config.arm_file();
+  std::string xml = arm_text(config);
   const FlangeMount mount = find_flange_mount(config);
   remove_keyframes(xml, file);
   insert_into_body(xml, mount.body, tool_chain_mjcf(config, mount), file);
@@ -171,10 +188,8 @@ std::string SimScene::build_mjcf(const SimRobotConfig& config) {
 }
 
 std::vector<SimScene::ArmJoint> SimScene::arm_joints(const SimRobotConfig& config) {
-  const std::string& file = config.mjcf_path;
-  char error[1024] = "";
-  const MjModelPtr arm(mj_loadXML(file.c_str(), nullptr, error, sizeof(error)));
-  if (!arm) throw ConfigError(file, "", "MuJoCo cannot load it: " + mujoco_error_line(error));
+  const std::string& file = config.arm_file();
+  const MjModelPtr arm = load_arm(config);
   std::vector<ArmJoint> out;
   for (const ActuatorParameters& a : config.actuators.joints()) {
     const int j = mj_name2id(arm.get(), mjOBJ_JOINT, a.joint_name.c_str());

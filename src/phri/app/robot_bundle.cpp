@@ -1,0 +1,254 @@
+#include <phri/app/robot_bundle.hpp>
+
+#include <phri/core/format.hpp>
+#include <phri/core/yaml_reader.hpp>
+#include <phri/control/controller.hpp>
+#include <phri/model/capsule_fit.hpp>
+#include <phri/model/model.hpp>
+#include <phri/robot/actuator_table.hpp>
+
+#include <Eigen/Eigenvalues>
+
+#include <filesystem>
+#include <fstream>
+#include <optional>
+#include <sstream>
+
+namespace phri {
+namespace {
+
+// What an arm carries at its flange: at most 20 kg (5x the Gen3's rated 4 kg; above, a unit
+// mistake), inertia at most 1 kg.m^2, COM within 0.5 m of its frame, an adapter not a boom (0.5 m).
+constexpr double kMaxCarried_kg = 20.0;
+constexpr double kMaxCarriedInertia_kgm2 = 1.0;
+// A dead band hides model error (~1 N.m), not a push: 10 N.m is already a firm push at the wrist.
+constexpr double kMaxDeadband_Nm = 10.0;
+// A joint position beyond one turn each way is a typo (degrees for radians), not a posture.
+constexpr double kMaxJointAngle_rad = 2.0 * 3.14159265358979323846;
+
+std::string input_file(const YamlReader& r, std::string_view key, const std::string& folder) {
+  const std::string text = r.text(key);
+  if (text.empty()) throw r.error(key, "empty file name");
+  const std::string path = resolve_path(folder, text, PathForm::kAbsolute);
+  if (!std::filesystem::is_regular_file(path)) throw r.error(key, "file not found: " + path);
+  return path;
+}
+
+std::vector<std::string> names(const YamlReader& r, std::string_view key) {
+  std::vector<std::string> out;
+  if (!r.has(key)) return out;
+  const YamlReader list = r.at(key);
+  list.expect_sequence();
+  for (std::size_t i = 0; i < list.size(); ++i) out.push_back(list.at(i).as_text());
+  return out;
+}
+
+RigidBodyData rigid_body(const YamlReader& r) {
+  r.allow_keys({"mass_kg", "com_m", "inertia_kgm2"});
+  RigidBodyData body;
+  body.mass_kg = r.number("mass_kg", 0.0, kMaxCarried_kg);
+  if (!(body.mass_kg > 0.0)) throw r.error("mass_kg", "must be > 0");
+  body.com_m = r.vector3("com_m", -0.5, 0.5);
+  body.principal_inertia_kgm2 = r.vector3("inertia_kgm2", 1e-9, kMaxCarriedInertia_kgm2);
+  const Eigen::Vector3d& i = body.principal_inertia_kgm2;
+  if (i[0] + i[1] < i[2] || i[0] + i[2] < i[1] || i[1] + i[2] < i[0]) {
+    throw r.error("inertia_kgm2", "principal moments must satisfy the triangle inequality (a rigid body)");
+  }
+  return body;
+}
+
+void parse_frames(const YamlReader& f, RobotBundle& b) {
+  f.allow_keys({"base", "tip", "end_effector"});
+  b.base_link = f.text_or("base", "");
+  b.tip_link = f.text_or("tip", "");
+  b.end_effector_frame = f.text("end_effector");
+}
+
+void parse_end_of_arm(const YamlReader& e, RobotBundle& b) {
+  e.allow_keys({"ft_sensor", "tool"});
+  const YamlReader sensor = e.at("ft_sensor");
+  sensor.allow_keys({"offset_m", "flange_side"});
+  b.end_of_arm.sensor_offset_m = sensor.number("offset_m", 0.0, 0.5);
+  b.end_of_arm.flange_side = rigid_body(sensor.at("flange_side"));
+  b.end_of_arm.tool = rigid_body(e.at("tool"));
+}
+
+void parse_plant(const YamlReader& p, const std::string& folder, RobotBundle& b) {
+  p.allow_keys({"mjcf", "flange_site", "balance_inertia"});
+  if (p.has("mjcf")) b.plant.mjcf_path = input_file(p, "mjcf", folder);
+  // A generated plant has a site at every link frame: the end-effector frame's by default.
+  b.plant.flange_site = p.has("mjcf") ? p.text("flange_site") : p.text_or("flange_site", b.end_effector_frame);
+  b.plant.balance_inertia = p.boolean_or("balance_inertia", false);
+  if (p.has("mjcf") && p.has("balance_inertia")) {
+    throw p.error("balance_inertia", "applies to a plant generated from the URDF only (no 'mjcf')");
+  }
+}
+
+// H(z) = b(z^-1) / a(z^-1): finite, a0 != 0, order at most 5, every pole inside the unit circle
+// (the loop runs it on the torque error every period: an unstable filter would run away).
+void parse_custom_loop_filter(const YamlReader& f, RobotBundle& b) {
+  f.allow_keys({"numerator", "denominator"});
+  for (const char* key : {"numerator", "denominator"}) {
+    const YamlReader list = f.at(key);
+    list.expect_sequence();
+    if (list.size() < 1 || list.size() > 6) throw f.error(key, "1 to 6 coefficients (order at most 5)");
+    auto& out = std::string(key) == "numerator" ? b.custom_loop_numerator : b.custom_loop_denominator;
+    for (std::size_t i = 0; i < list.size(); ++i) out.push_back(list.at(i).as_number(-1e6, 1e6));
+  }
+  const std::vector<double>& a = b.custom_loop_denominator;
+  if (a[0] == 0.0) throw f.error("denominator", "a0 must be non-zero");
+  const int order = static_cast<int>(a.size()) - 1;
+  if (order == 0) return;
+  Eigen::MatrixXd companion = Eigen::MatrixXd::Zero(order, order);  // poles: its eigenvalues
+  for (int k = 0; k < order; ++k) companion(0, k) = -a[static_cast<std::size_t>(k + 1)] / a[0];
+  for (int k = 1; k < order; ++k) companion(k, k - 1) = 1.0;
+  const double largest = Eigen::EigenSolver<Eigen::MatrixXd>(companion, false).eigenvalues().cwiseAbs().maxCoeff();
+  // A margin for the eigenvalues' rounding: a double pole at z = 1 comes out within ~1e-8 of it.
+  if (!(largest < 1.0 - 1e-6)) {
+    throw f.error("denominator", "a pole at |z| = " + format_general(largest, 6) + ": every pole must lie inside the unit circle");
+  }
+}
+
+RobotBundle parse(const YamlReader& r, const std::string& folder) {
+  r.allow_keys({"name", "urdf", "actuators", "collision", "frames", "locked_joints", "home_q_rad",
+                "compliance_deadband_Nm", "drive", "custom_loop_filter", "end_of_arm", "plant"});
+  RobotBundle b;
+  b.source = r.file();
+  b.name = r.text("name");
+  b.urdf_path = input_file(r, "urdf", folder);
+  b.actuators_path = input_file(r, "actuators", folder);
+  const bool fitted = r.has("collision") && r.text("collision") == "fitted";
+  b.collision_path = r.has("collision") && !fitted ? input_file(r, "collision", folder) : "";
+  if (fitted) b.collision_yaml = "fitted";  // fitted once the model is checked (check_against_model)
+  parse_frames(r.at("frames"), b);
+  b.locked_joints = names(r, "locked_joints");
+  const int dof = ActuatorTable::from_yaml_file(b.actuators_path).size();
+  b.home_q_rad = r.per_joint<std::vector<double>>("home_q_rad", dof, -kMaxJointAngle_rad, kMaxJointAngle_rad);
+  b.compliance_deadband_Nm = r.per_joint<Eigen::VectorXd>("compliance_deadband_Nm", dof, 0.0, kMaxDeadband_Nm);
+  // Only Kinova's actuator loops are emulated so far; a generic drive is future work (issue 16).
+  (void)r.choice("drive", {"kinova"});
+  if (r.has("custom_loop_filter")) parse_custom_loop_filter(r.at("custom_loop_filter"), b);
+  parse_end_of_arm(r.at("end_of_arm"), b);
+  parse_plant(r.has("plant") ? r.at("plant") : YamlReader(YAML::Node(YAML::NodeType::Map), r.file(), "plant"), folder, b);
+  return b;
+}
+
+// The chain's problems named at the robot.yaml key that causes them (the loader names ModelOptions).
+[[noreturn]] void rethrow_at_key(const RobotBundle& b, const ConfigError& e) {
+  const std::string& element = e.element();
+  const std::string what = e.reason() + " (" + e.file() + ")";
+  if (element.find("tip_link") != std::string::npos) throw ConfigError(b.source, "frames.tip", what);
+  if (element.find("base_link") != std::string::npos) throw ConfigError(b.source, "frames.base", what);
+  if (element.find("locked_joints") != std::string::npos || e.reason().find("locked_joints") != std::string::npos) {
+    throw ConfigError(b.source, "locked_joints", element + ": " + what);
+  }
+  throw e;
+}
+
+// The frames, the chain, the drives and the home posture against the URDF's model.
+void check_against_model(const RobotBundle& b) {
+  ModelOptions chain;
+  chain.base_link = b.base_link;
+  chain.tip_link = b.tip_link;
+  chain.locked_joints = b.locked_joints;
+  std::optional<Model> loaded;
+  try {
+    loaded.emplace(Model::from_urdf_file(b.urdf_path, chain));
+  } catch (const ConfigError& e) {
+    rethrow_at_key(b, e);
+  }
+  const Model& model = *loaded;
+  if (!model.has_frame(b.end_effector_frame)) {
+    throw ConfigError(b.source, "frames.end_effector", "no frame '" + b.end_effector_frame + "' in " + b.urdf_path);
+  }
+  const ActuatorTable drives = ActuatorTable::from_yaml_file(b.actuators_path);
+  for (int i = 0; i < model.nq(); ++i) {
+    if (i >= drives.size() || drives[i].joint_name != model.joint(i).name) {
+      throw ConfigError(b.source, "actuators", "entry " + std::to_string(i + 1) + " must be the chain's joint '" +
+                                                   model.joint(i).name + "' (" + b.actuators_path + ")");
+    }
+    const double q = b.home_q_rad[static_cast<std::size_t>(i)];
+    if (q < model.joint(i).lower || q > model.joint(i).upper) {
+      throw ConfigError(b.source, "home_q_rad[" + std::to_string(i) + "]",
+                        format_general(q, 6) + " is beyond " + model.joint(i).name + "'s limits [" +
+                            format_general(model.joint(i).lower, 6) + ", " + format_general(model.joint(i).upper, 6) + "]");
+    }
+  }
+  if (drives.size() != model.nq()) {
+    throw ConfigError(b.source, "actuators", std::to_string(drives.size()) + " drives for the chain's " +
+                                                 std::to_string(model.nq()) + " joints");
+  }
+}
+
+// `collision: fitted`: the capsules on the controller's model (chain and payload frames).
+std::string fitted_capsules(const RobotBundle& b) {
+  ControllerSettings settings;
+  b.apply_to(settings);
+  const Model model = Model::from_urdf_file(b.urdf_path, Controller::model_options(settings));
+  std::ifstream file(b.urdf_path);
+  std::stringstream urdf;
+  urdf << file.rdbuf();
+  const Eigen::VectorXd home = Eigen::Map<const Eigen::VectorXd>(b.home_q_rad.data(), model.nq());
+  // Pairs within the self-collision damper's influence distance at home would be held apart at rest.
+  CapsuleFitOptions options;
+  options.clearance_m = WholeBodyQpSettings{}.collision.influence_distance;
+  return fit_capsules(urdf.str(), model, home, options).yaml;
+}
+
+}  // namespace
+
+RobotBundle RobotBundle::from_folder(const std::string& folder) {
+  const std::string file = (std::filesystem::path(folder) / "robot.yaml").string();
+  if (!std::filesystem::is_regular_file(file)) throw ConfigError(file, "", "no robot.yaml in the robot folder");
+  RobotBundle bundle = parse(YamlReader::load_file(file), std::filesystem::absolute(folder).string());
+  check_against_model(bundle);
+  if (!bundle.collision_yaml.empty()) bundle.collision_yaml = fitted_capsules(bundle);
+  return bundle;
+}
+
+void RobotBundle::apply_to(ControllerSettings& s) const {
+  s.urdf_path = urdf_path;
+  s.actuators_path = actuators_path;
+  s.collision_path = collision_path;
+  s.collision_yaml = collision_yaml;
+  s.base_link = base_link;
+  s.tip_link = tip_link;
+  s.end_effector_frame = end_effector_frame;
+  s.locked_joints = locked_joints;
+  s.qp.compliance_deadband = compliance_deadband_Nm;
+  s.ft_sensor_offset_m = end_of_arm.sensor_offset_m;
+  // In the end-effector frame: the adapter as given, the tool shifted by the sensor's offset.
+  auto payload = [](const char* name, const RigidBodyData& body, double offset_z_m) {
+    Payload p{name, "", {}};
+    p.inertia.mass = body.mass_kg;
+    p.inertia.com = body.com_m + Eigen::Vector3d(0.0, 0.0, offset_z_m);
+    p.inertia.inertia_com = body.principal_inertia_kgm2.asDiagonal();
+    return p;
+  };
+  s.payloads = {payload("ft_adapter_and_sensor", end_of_arm.flange_side, 0.0),
+                payload("tool", end_of_arm.tool, end_of_arm.sensor_offset_m)};
+  s.custom_torque.filter_numerator = custom_loop_numerator;
+  s.custom_torque.filter_denominator = custom_loop_denominator;
+  s.wrench.tool_mass_kg = end_of_arm.tool.mass_kg;
+  s.wrench.tool_com_m = end_of_arm.tool.com_m;
+}
+
+void RobotBundle::apply_to(SimRobotConfig& c) const {
+  c.mjcf_path = plant.mjcf_path;
+  c.urdf_path = plant.mjcf_path.empty() ? urdf_path : "";
+  c.locked_joints = plant.mjcf_path.empty() ? locked_joints : std::vector<std::string>{};
+  c.balance_inertia = plant.balance_inertia;
+  c.actuators_path = actuators_path;
+  c.actuators = ActuatorTable::from_yaml_file(actuators_path);
+  if (c.initial_q_rad.size() != home_q_rad.size()) c.initial_q_rad = home_q_rad;
+  c.ft_sensor.flange_site = plant.flange_site;
+  c.ft_sensor.sensor_offset_m = end_of_arm.sensor_offset_m;
+  c.ft_sensor.flange_side_mass_kg = end_of_arm.flange_side.mass_kg;
+  c.ft_sensor.flange_side_com_m = end_of_arm.flange_side.com_m;
+  c.ft_sensor.flange_side_inertia_kgm2 = end_of_arm.flange_side.principal_inertia_kgm2;
+  c.tool.mass_kg = end_of_arm.tool.mass_kg;
+  c.tool.com_m = end_of_arm.tool.com_m;
+  c.tool.inertia_kgm2 = end_of_arm.tool.principal_inertia_kgm2;
+}
+
+}  // namespace phri

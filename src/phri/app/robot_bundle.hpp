@@ -1,0 +1,64 @@
+#pragma once
+// phri::RobotBundle: one folder per robot, robots/<robot>/robot.yaml (issue 16), naming the URDF
+// and what the URDF does not say: the frames, the locked joints, the drives (actuators.yaml), the
+// self-collision capsules (collision.yaml, optional), the end of arm (F/T sensor and tool), the
+// compliance dead band per joint, the drive model and how the plant is made. Every key is
+// commented in robots/kinova_gen3/robot.yaml.
+//
+//   const phri::RobotBundle robot = phri::RobotBundle::from_folder("robots/kinova_gen3");
+//   robot.apply_to(controller_settings);   // model files, chain, frames, payloads, dead band
+//   robot.apply_to(plant_config);          // arm description, drives, F/T sensor and tool
+//
+// `collision:` names a collision.yaml, or says `fitted`: capsules fitted from the URDF at load
+// (link-frame radius 0.04 m; pairs closer than 0.03 m at the home posture, the self-collision
+// damper's influence distance, left out). Absent: no self-collision constraint.
+//
+// A run YAML names a bundle with `robot: ../robots/kinova_gen3` (relative to the YAML), and
+// `phri run --robot DIR` replaces whatever robot the YAML names. Errors are phri::ConfigError
+// naming robot.yaml and the key path (e.g. "end_of_arm.tool.mass_kg").
+#include <phri/control/controller_settings.hpp>
+#include <phri/sim/sim_robot_config.hpp>
+
+#include <Eigen/Core>
+
+#include <string>
+#include <vector>
+
+namespace phri {
+
+struct RobotBundle {
+  /// Loads <folder>/robot.yaml; file names in it are relative to the folder and must exist.
+  static RobotBundle from_folder(const std::string& folder);
+
+  void apply_to(ControllerSettings& settings) const;
+  /// The arm, its drives and its end of arm; the initial posture when the plant has none.
+  void apply_to(SimRobotConfig& plant) const;
+
+  std::string source;  ///< robot.yaml
+  std::string name;
+  std::string urdf_path, actuators_path, collision_path;  ///< absolute; collision_path '' for none
+  /// `collision: fitted`: capsules fitted from the URDF at the home posture (model/capsule_fit.hpp),
+  /// as a collision.yaml's text; '' otherwise.
+  std::string collision_yaml;
+  std::string base_link, tip_link, end_effector_frame;
+  std::vector<std::string> locked_joints;
+  std::vector<double> home_q_rad;
+  Eigen::VectorXd compliance_deadband_Nm;  ///< per joint
+  enum class Drive { kKinova } drive = Drive::kKinova;
+  /// The custom torque loop's H(z) (b, a in powers of z^-1); both empty: Kinova's (the library's).
+  std::vector<double> custom_loop_numerator, custom_loop_denominator;
+
+  struct EndOfArm {
+    double sensor_offset_m = 0.0;  ///< flange -> F/T measuring frame, along the flange's z
+    RigidBodyData flange_side;     ///< adapter + sensor body, flange frame (not measured)
+    RigidBodyData tool;            ///< below the sensor, sensor frame
+  } end_of_arm;
+
+  struct Plant {
+    std::string mjcf_path;  ///< hand-written arm MJCF; '' : generated from the URDF
+    std::string flange_site;
+    bool balance_inertia = false;
+  } plant;
+};
+
+}  // namespace phri
