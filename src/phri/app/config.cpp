@@ -7,6 +7,8 @@
 #include <phri/core/yaml_reader.hpp>
 #include <phri/robot/actuator_table.hpp>
 
+#include <phri/app/physical_ranges.hpp>
+
 #include <cmath>
 #include <filesystem>
 #include <optional>
@@ -16,14 +18,11 @@ namespace {
 
 constexpr double kHuge = 1e9;
 
-// Physical ranges (the reason next to each).
-// What the arm carries beyond its URDF: at most 20 kg, 5x the Gen3's rated 4 kg payload (above,
-// a unit mistake), inertia at most 1 kg.m^2 (20 kg at a 0.22 m radius of gyration), its COM
-// within 1 m of the frame that carries it.
-constexpr double kMaxPayload_kg = 20.0;
-constexpr double kMaxPayloadInertia_kgm2 = 1.0;
-// A joint position beyond one turn each way is a typo (degrees for radians), not a posture.
-constexpr double kMaxJointAngle_rad = 2.0 * 3.14159265358979323846;
+// Physical ranges (the reason next to each; payload and joint-angle bounds in physical_ranges.hpp).
+// A payload's COM lies within 1 m of the frame that carries it.
+using physical_range::kMaxJointAngle_rad;
+using physical_range::kMaxPayload_kg;
+using physical_range::kMaxPayloadInertia_kgm2;
 // Joint speed: 10 rad/s (~570 deg/s) is beyond any collaborative arm's joint (the Gen3's 2.1 /
 // 3.05 rad/s); 120 is deg/s typed as rad/s.
 constexpr double kMaxJointVelocity_rad_s = 10.0;

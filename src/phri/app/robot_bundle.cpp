@@ -1,4 +1,5 @@
 #include <phri/app/robot_bundle.hpp>
+#include <phri/app/physical_ranges.hpp>
 
 #include <phri/core/format.hpp>
 #include <phri/core/yaml_reader.hpp>
@@ -17,14 +18,13 @@
 namespace phri {
 namespace {
 
-// What an arm carries at its flange: at most 20 kg (5x the Gen3's rated 4 kg; above, a unit
-// mistake), inertia at most 1 kg.m^2, COM within 0.5 m of its frame, an adapter not a boom (0.5 m).
-constexpr double kMaxCarried_kg = 20.0;
-constexpr double kMaxCarriedInertia_kgm2 = 1.0;
+// What an arm carries at its flange: physical_ranges.hpp; its COM within 0.5 m of its frame, an
+// adapter not a boom (0.5 m).
+using physical_range::kMaxJointAngle_rad;
+using physical_range::kMaxPayload_kg;
+using physical_range::kMaxPayloadInertia_kgm2;
 // A dead band hides model error (~1 N.m), not a push: 10 N.m is already a firm push at the wrist.
 constexpr double kMaxDeadband_Nm = 10.0;
-// A joint position beyond one turn each way is a typo (degrees for radians), not a posture.
-constexpr double kMaxJointAngle_rad = 2.0 * 3.14159265358979323846;
 
 std::string input_file(const YamlReader& r, std::string_view key, const std::string& folder) {
   const std::string text = r.text(key);
@@ -46,10 +46,10 @@ std::vector<std::string> names(const YamlReader& r, std::string_view key) {
 RigidBodyData rigid_body(const YamlReader& r) {
   r.allow_keys({"mass_kg", "com_m", "inertia_kgm2"});
   RigidBodyData body;
-  body.mass_kg = r.number("mass_kg", 0.0, kMaxCarried_kg);
+  body.mass_kg = r.number("mass_kg", 0.0, kMaxPayload_kg);
   if (!(body.mass_kg > 0.0)) throw r.error("mass_kg", "must be > 0");
   body.com_m = r.vector3("com_m", -0.5, 0.5);
-  body.principal_inertia_kgm2 = r.vector3("inertia_kgm2", 1e-9, kMaxCarriedInertia_kgm2);
+  body.principal_inertia_kgm2 = r.vector3("inertia_kgm2", 1e-9, kMaxPayloadInertia_kgm2);
   const Eigen::Vector3d& i = body.principal_inertia_kgm2;
   if (i[0] + i[1] < i[2] || i[0] + i[2] < i[1] || i[1] + i[2] < i[0]) {
     throw r.error("inertia_kgm2", "principal moments must satisfy the triangle inequality (a rigid body)");
@@ -218,15 +218,8 @@ void RobotBundle::apply_to(ControllerSettings& s) const {
   s.qp.compliance_deadband = compliance_deadband_Nm;
   s.ft_sensor_offset_m = end_of_arm.sensor_offset_m;
   // In the end-effector frame: the adapter as given, the tool shifted by the sensor's offset.
-  auto payload = [](const char* name, const RigidBodyData& body, double offset_z_m) {
-    Payload p{name, "", {}};
-    p.inertia.mass = body.mass_kg;
-    p.inertia.com = body.com_m + Eigen::Vector3d(0.0, 0.0, offset_z_m);
-    p.inertia.inertia_com = body.principal_inertia_kgm2.asDiagonal();
-    return p;
-  };
-  s.payloads = {payload("ft_adapter_and_sensor", end_of_arm.flange_side, 0.0),
-                payload("tool", end_of_arm.tool, end_of_arm.sensor_offset_m)};
+  s.payloads = {ControllerSettings::end_of_arm_payload("ft_adapter_and_sensor", end_of_arm.flange_side, 0.0),
+                ControllerSettings::end_of_arm_payload("tool", end_of_arm.tool, end_of_arm.sensor_offset_m)};
   s.custom_torque.filter_numerator = custom_loop_numerator;
   s.custom_torque.filter_denominator = custom_loop_denominator;
   s.wrench.tool_mass_kg = end_of_arm.tool.mass_kg;

@@ -86,17 +86,18 @@ struct ControllerSettings {
   /// What the arm carries beyond its URDF, in the end-effector frame (the paper's setup, as the
   /// plant models it, robot/paper_end_of_arm.hpp): F/T adapter + sensor 0.269 kg, tool 0.3 kg.
   std::vector<Payload> payloads = default_payloads();
+  /// A body carried on the end-effector frame, its COM shifted along that frame's z by offset_z_m.
+  static Payload end_of_arm_payload(const char* name, const RigidBodyData& body, double offset_z_m) {
+    Payload p{name, "", {}};
+    p.inertia.mass = body.mass_kg;
+    p.inertia.com = body.com_m + Eigen::Vector3d(0.0, 0.0, offset_z_m);
+    p.inertia.inertia_com = body.principal_inertia_kgm2.asDiagonal();
+    return p;
+  }
   static std::vector<Payload> default_payloads() {
-    auto payload = [](const char* name, const RigidBodyData& body, double offset_z_m) {
-      Payload p{name, "", {}};
-      p.inertia.mass = body.mass_kg;
-      p.inertia.com = body.com_m + Eigen::Vector3d(0.0, 0.0, offset_z_m);
-      p.inertia.inertia_com = body.principal_inertia_kgm2.asDiagonal();
-      return p;
-    };
     // The tool's COM is given below the sensor: shift it by the sensor's offset.
-    return {payload("ft_adapter_and_sensor", PaperEndOfArm::ft_adapter_and_sensor(), 0.0),
-            payload("tool", PaperEndOfArm::tool(), PaperEndOfArm::kSensorOffset_m)};
+    return {end_of_arm_payload("ft_adapter_and_sensor", PaperEndOfArm::ft_adapter_and_sensor(), 0.0),
+            end_of_arm_payload("tool", PaperEndOfArm::tool(), PaperEndOfArm::kSensorOffset_m)};
   }
   double period_s = 1e-3;
   /// Momentum observer bandwidth K_O [rad/s]. The paper's code uses 10; 50 follows a push 5x
