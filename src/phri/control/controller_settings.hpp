@@ -60,8 +60,10 @@ struct SafetySettings {
   /// a gain margin of 2 to that.
   double velocity_guard_rate = 300.0;
   /// Limit guard: beyond the damper's safety distance d_s, an outward torque of the joint's static
-  /// friction plus stiffness x the depth, so that a joint leaves the band against its stiction.
-  double limit_guard_stiffness_Nm_per_rad = 200.0;
+  /// friction plus stiffness x the depth, so that a joint leaves the band against its stiction and
+  /// a hand pressing it in meets a growing answer: ~50 N.m at the URDF limit (d_s 0.05 rad on the
+  /// Gen3). At 200 a 160 N push held joint 4 0.2 mrad past its limit (safety-fuzz seed 8642).
+  double limit_guard_stiffness_Nm_per_rad = 1000.0;
   /// |tau_ext| used by the QP is bounded by this factor x the joint's torque limit: more than the
   /// arm can resist is not a push the controller can act on (a spike, a stop).
   double external_torque_bound_factor = 1.5;
@@ -104,6 +106,13 @@ struct ControllerSettings {
   /// faster, which the stiff tasks need to hold the end effector within millimetres, at the cost
   /// of 5x more torque-sensor noise in tau_ext (about 0.05 N.m rms with the plant's sensor noise).
   double observer_gain = 50.0;
+  /// The observer's release path (MomentumObserver): a push that ends is followed at this gain
+  /// [rad/s] (0: off; x period_s < 1) on joints faster than release_speed_fraction x the drive's
+  /// velocity limit whose estimate resists their motion, once the fast estimate is below the slow
+  /// one by more than the threshold [N.m] (above its noise).
+  double observer_release_gain = 500.0;
+  double observer_release_speed_fraction = 0.5;
+  double observer_release_threshold_Nm = 5.0;
   ExternalTorqueSource external_torque_source = ExternalTorqueSource::kObserver;
   /// Under the robot's position loop, the QP runs on the measured state (false: what the servo
   /// cannot follow comes back as task error and is corrected) or, as the paper's mc_rtc controller

@@ -1,5 +1,7 @@
 #include <phri/control/momentum_observer.hpp>
 
+#include <algorithm>
+
 namespace phri {
 
 MomentumObserver::MomentumObserver(const Model& model, double gain)
@@ -7,7 +9,18 @@ MomentumObserver::MomentumObserver(const Model& model, double gain)
       momentum_(Eigen::VectorXd::Zero(model.nv())),
       initial_momentum_(Eigen::VectorXd::Zero(model.nv())),
       integral_(Eigen::VectorXd::Zero(model.nv())),
-      residual_(Eigen::VectorXd::Zero(model.nv())) {}
+      residual_(Eigen::VectorXd::Zero(model.nv())),
+      release_integral_(Eigen::VectorXd::Zero(model.nv())),
+      release_residual_(Eigen::VectorXd::Zero(model.nv())),
+      release_velocity_(Eigen::VectorXd::Zero(model.nv())) {}
+
+void MomentumObserver::set_release_path(double gain, double threshold, const Eigen::VectorXd& release_speed) {
+  release_gain_ = gain;
+  release_threshold_ = threshold;
+  release_speed_ = release_speed;
+  release_integral_ = momentum_ - initial_momentum_ - residual_ / std::max(gain, 1e-12);
+  release_residual_ = residual_;
+}
 
 void MomentumObserver::set_gain(double gain) { gains_.setConstant(gain); }
 void MomentumObserver::set_gains(const Eigen::VectorXd& gains) { gains_ = gains; }
@@ -16,6 +29,9 @@ void MomentumObserver::reset(const Data& data, const Eigen::VectorXd& qd) {
   initial_momentum_.noalias() = data.mass_matrix * qd;
   integral_.setZero();
   residual_.setZero();
+  release_integral_.setZero();
+  release_residual_.setZero();
+  release_velocity_ = qd;
   initialised_ = true;
 }
 
@@ -30,6 +46,23 @@ const Eigen::VectorXd& MomentumObserver::update(const Data& data, const Eigen::V
   integral_ += dt * (tau_sensor + data.coriolis_transpose_qd - data.gravity_torque + residual_);
   momentum_.noalias() = data.mass_matrix * qd;
   residual_ = gains_.cwiseProduct(momentum_ - initial_momentum_ - integral_);
+  if (release_gain_ <= 0.0) return residual_;
+  release_integral_ += dt * (tau_sensor + data.coriolis_transpose_qd - data.gravity_torque + release_residual_);
+  release_residual_ = release_gain_ * (momentum_ - initial_momentum_ - release_integral_);
+  // The joint's speed over the last ~10 ms: an elastic joint's ringing (fast, tiny) is no motion.
+  release_velocity_ += (dt / (kReleaseVelocityFilter_s + dt)) * (qd - release_velocity_);
+  for (Eigen::Index i = 0; i < residual_.size(); ++i) {
+    // On a fast joint whose r resists its motion: shrink r toward the fast estimate, never past
+    // zero nor beyond r itself.
+    const double r = residual_[i];
+    if (!(r * release_velocity_[i] < 0.0 && std::abs(release_velocity_[i]) > release_speed_[i])) continue;
+    const double shrunk = r > 0.0 ? std::clamp(release_residual_[i] + release_threshold_, 0.0, r)
+                                   : std::clamp(release_residual_[i] - release_threshold_, r, 0.0);
+    if (shrunk != r) {
+      residual_[i] = shrunk;
+      integral_[i] = momentum_[i] - initial_momentum_[i] - shrunk / gains_[i];  // the observer's state follows
+    }
+  }
   return residual_;
 }
 

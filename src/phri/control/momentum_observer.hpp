@@ -10,6 +10,15 @@
 // implementation uses K_O = 10 (mc_residual_estimation, paper_parameters §4); the controller's
 // default, ControllerSettings::observer_gain, is 50 (the reason is given there).
 // M must be the link-side inertia (no rotor inertia): the torque sensors sit after the rotor.
+//
+// Release path: a push that ends leaves r behind for ~1/K_O, and a controller that cancels r
+// goes on pushing for the human who has let go. Where r resists a joint's motion, that phantom
+// cancellation drives the joint along its motion: near its velocity limit, an overspeed
+// (safety-fuzz: up to 1.28x, full-body compliance). A second observer of gain release_gain runs
+// beside; on a joint faster than release_speed (over 10 ms) whose r opposes its velocity, when the fast
+// estimate is below |r| by more than release_threshold, r drops to it at once (only toward zero).
+// Elsewhere r keeps its K_O low-pass: a bouncing load (the drop test) must be averaged, not
+// followed down and up again at two speeds (that halves its estimate: 35 mm sag instead of 3).
 #include <phri/model/data.hpp>
 #include <phri/model/model.hpp>
 
@@ -21,6 +30,9 @@ public:
   MomentumObserver(const Model& model, double gain);
 
   void set_gain(double gain);
+  /// The release path (gain 0: off) on joints moving faster than release_speed [rad/s]. gain * dt
+  /// must stay below 1 (checked by the caller's settings).
+  void set_release_path(double gain, double threshold, const Eigen::VectorXd& release_speed);
   void set_gains(const Eigen::VectorXd& gains);
   const Eigen::VectorXd& gains() const { return gains_; }
 
@@ -39,6 +51,13 @@ private:
   Eigen::VectorXd initial_momentum_;
   Eigen::VectorXd integral_;
   Eigen::VectorXd residual_;
+  double release_gain_ = 0.0;
+  double release_threshold_ = 0.0;
+  Eigen::VectorXd release_speed_;
+  Eigen::VectorXd release_integral_;  // the release path's own observer (gain release_gain_)
+  Eigen::VectorXd release_residual_;
+  Eigen::VectorXd release_velocity_;  // qd low-passed over kReleaseVelocityFilter_s
+  static constexpr double kReleaseVelocityFilter_s = 0.01;
   bool initialised_ = false;
 };
 

@@ -80,11 +80,24 @@ StateSupervisor::StateSupervisor(const SensorRanges& ranges, const SupervisorSet
   check_settings(ranges_, settings_);
   last_good_ = RobotState(n_);
   previous_ = RobotState(n_);
-  torque_residual_ = Eigen::VectorXd::Zero(n_);
+  for (ResidualTrack& track : residual_track_) track.resize(n_);
   residual_qd_ = Eigen::VectorXd::Zero(n_);
   residual_tau_[0] = residual_tau_[1] = Eigen::VectorXd::Zero(n_);
-  raw_residual_[0] = raw_residual_[1] = Eigen::VectorXd::Zero(n_);
-  rotor_acceleration_size_ = Eigen::VectorXd::Zero(n_);
+}
+
+void StateSupervisor::ResidualTrack::resize(int n) {
+  filtered = acceleration_size = raw[0] = raw[1] = Eigen::VectorXd::Zero(n);
+}
+
+double StateSupervisor::ResidualTrack::update(int i, double residual, double acceleration, double alpha, bool median) {
+  // Median of the last three raw residuals: an impact (a hard stop, a step push) aliases into one
+  // or two samples of ~100 N.m between a 1 kHz q̈ and the sensor's instant; a fault persists.
+  const double m = median ? median_of_three(residual, raw[0][i], raw[1][i]) : residual;
+  raw[1][i] = raw[0][i];
+  raw[0][i] = residual;
+  filtered[i] += alpha * (m - filtered[i]);
+  acceleration_size[i] += alpha * (std::abs(acceleration) - acceleration_size[i]);
+  return filtered[i];
 }
 
 void StateSupervisor::reset() {
@@ -191,38 +204,39 @@ int StateSupervisor::first_torque_current_mismatch(const RobotState& s) {
   // The filter starts from zero: a push at the first sample is not a fault, an offset soon is.
   if (residual_updates_ == 0) {
     dt = c.period_s;
-    torque_residual_.setZero();
-    rotor_acceleration_size_.setZero();
+    for (ResidualTrack& track : residual_track_) track.filtered.setZero(), track.acceleration_size.setZero();
   }
   const double alpha = dt / (c.torque_current_filter_s + dt);
+  const double clamp = c.motor_acceleration_clamp_rad_s2;
   int culprit = -1;
   for (int i = 0; i < n_; ++i) {
     const double motor = ranges_.torque_per_amp[i] * s.current_A[i];
-    double rotor_acceleration = 0.0;
-    if (residual_updates_ >= 1) rotor_acceleration = (s.qd_rad_s[i] - residual_qd_[i]) / dt;
+    // The rotor's acceleration, rigid and with the transmission's deflection τ_s / K.
+    double rigid = 0.0, elastic = 0.0;
+    if (residual_updates_ >= 1) rigid = elastic = (s.qd_rad_s[i] - residual_qd_[i]) / dt;
     if (residual_updates_ >= 2) {
       const double tau_dd = (s.tau_sensor_Nm[i] - 2.0 * residual_tau_[0][i] + residual_tau_[1][i]) / (dt * dt);
-      rotor_acceleration += ranges_.transmission_compliance[i] * tau_dd;
+      elastic += ranges_.transmission_compliance[i] * tau_dd;
     }
-    rotor_acceleration = std::clamp(rotor_acceleration, -c.motor_acceleration_clamp_rad_s2, c.motor_acceleration_clamp_rad_s2);
+    const double acceleration[2] = {std::clamp(rigid, -clamp, clamp), std::clamp(elastic, -clamp, clamp)};
     // Kinetic friction as modelled while the joint moves; stiction (unknown sign) in the tolerance.
     const double speed = std::abs(s.qd_rad_s[i]);
     const double kinetic = speed > c.torque_current_moving_rad_s
                                ? std::copysign(ranges_.friction_coulomb[i] + ranges_.friction_viscous[i] * speed, s.qd_rad_s[i])
                                : 0.0;
-    const double residual = motor - s.tau_sensor_Nm[i] - ranges_.reflected_inertia[i] * rotor_acceleration - kinetic;
-    // Median of the last three raw residuals: an impact (a hard stop, a step push) aliases into one
-    // or two samples of ~100 N.m between a 1 kHz q̈ and the sensor's instant; a fault persists.
-    const double median = residual_updates_ >= 2 ? median_of_three(residual, raw_residual_[0][i], raw_residual_[1][i]) : residual;
-    raw_residual_[1][i] = raw_residual_[0][i];
-    raw_residual_[0][i] = residual;
-    torque_residual_[i] += alpha * (median - torque_residual_[i]);
-    rotor_acceleration_size_[i] += alpha * (std::abs(rotor_acceleration) - rotor_acceleration_size_[i]);
-    const double tolerance = ranges_.friction_static[i] + c.torque_current_friction_relative * std::abs(kinetic) +
-                             c.torque_current_relative * std::min(std::abs(s.tau_sensor_Nm[i]), std::abs(motor)) +
-                             c.torque_current_inertia_relative * ranges_.reflected_inertia[i] * rotor_acceleration_size_[i] +
-                             c.torque_current_margin_Nm;
-    if (culprit < 0 && ranges_.torque_per_amp[i] > 0.0 && std::abs(torque_residual_[i]) > tolerance) culprit = i;
+    const double base_tolerance = ranges_.friction_static[i] + c.torque_current_friction_relative * std::abs(kinetic) +
+                                  c.torque_current_relative * std::min(std::abs(s.tau_sensor_Nm[i]), std::abs(motor)) +
+                                  c.torque_current_margin_Nm;
+    // A mismatch under both hypotheses with one sign: no compliance in between explains it either.
+    double excess[2];
+    for (int h = 0; h < 2; ++h) {
+      const double residual = motor - s.tau_sensor_Nm[i] - ranges_.reflected_inertia[i] * acceleration[h] - kinetic;
+      const double filtered = residual_track_[h].update(i, residual, acceleration[h], alpha, residual_updates_ >= 2);
+      const double tolerance =
+          base_tolerance + c.torque_current_inertia_relative * ranges_.reflected_inertia[i] * residual_track_[h].acceleration_size[i];
+      excess[h] = std::abs(filtered) > tolerance ? filtered : 0.0;
+    }
+    if (culprit < 0 && ranges_.torque_per_amp[i] > 0.0 && excess[0] * excess[1] > 0.0) culprit = i;
   }
   residual_qd_ = s.qd_rad_s;
   residual_tau_[1] = residual_tau_[0];

@@ -135,7 +135,8 @@ struct SupervisorSettings {
   /// (the custom loop's ripple and the harmonic drive's ringing average out), beyond
   ///   static + friction_relative |τ_f| + relative min(|τ_s|, |K_T G_r i|)
   ///     + inertia_relative I_r G_r^2 LP(|a_r|) + margin
-  /// means a sensor is wrong (an offset or spike within range): an observer fed with it reports a
+  /// both for a rigid transmission (a_r = q̈) and for the catalogue's stiffness K, with one sign
+  /// (the true compliance lies in between and the residual is linear in it), means a sensor is wrong (an offset or spike within range): an observer fed with it reports a
   /// push nobody makes, and the controller drives the joint to cancel it (safety-fuzz seed 55555,
   /// +50 N.m on joint 6 for 100 ms: 1.45x the velocity limit). Kinova's actuators make the same
   /// check (MOTOR_CURRENT_MISMATCH fault, kinova_gen3_actuators.md). I_r is known within a factor
@@ -225,11 +226,19 @@ private:
   double last_stamp_ = 0.0;
   bool has_sequence_ = false;
   double frozen_since_s_ = -1.0;     // stamp at which the values stopped changing (-1: changing)
-  Eigen::VectorXd torque_residual_;  // low-passed K_T G_r i - τ_s - I_r G_r^2 q̈ [N.m]
-  Eigen::VectorXd rotor_acceleration_size_;  // low-passed |a_r| [rad/s^2]
+  // The residual K_T G_r i - τ_s - I_r G_r^2 a_r - τ_f under one hypothesis on the transmission.
+  struct ResidualTrack {
+    Eigen::VectorXd filtered;           // median of three, then low-passed [N.m]
+    Eigen::VectorXd acceleration_size;  // low-passed |a_r| [rad/s^2]
+    Eigen::VectorXd raw[2];             // the last two unfiltered residuals
+    void resize(int n);
+    /// Feeds joint i's raw residual; returns the filtered one.
+    double update(int i, double residual, double acceleration, double alpha, bool median);
+  };
+  // [0]: rigid (a_r = q̈); [1]: the catalogue's compliance (a_r = q̈ + τ̈_s / K).
+  ResidualTrack residual_track_[2];
   Eigen::VectorXd residual_qd_;      // q̇ of the residual's last update (for q̈)
   Eigen::VectorXd residual_tau_[2];  // τ_s of the residual's last two updates (for τ̈_s)
-  Eigen::VectorXd raw_residual_[2];  // the last two unfiltered residuals (median of three)
   double residual_stamp_s_ = 0.0;
   int residual_updates_ = 0;         // updates since the filter (re)started
   int good_in_row_ = 0;
