@@ -107,9 +107,9 @@ struct ControllerSettings {
   /// of 5x more torque-sensor noise in tau_ext (about 0.05 N.m rms with the plant's sensor noise).
   double observer_gain = 50.0;
   /// The observer's release path (MomentumObserver): a push that ends is followed at this gain
-  /// [rad/s] (0: off; x period_s < 1) on joints faster than release_speed_fraction x the drive's
-  /// velocity limit whose estimate resists their motion, once the fast estimate is below the slow
-  /// one by more than the threshold [N.m] (above its noise).
+  /// [rad/s] (0: off; x period_s < 1) while the kick -M^-1 tau_ext would drive a joint faster than
+  /// release_speed_fraction x the drive's velocity limit along its motion, once the fast estimate
+  /// is below the slow one by more than the threshold [N.m] (above its noise).
   double observer_release_gain = 500.0;
   double observer_release_speed_fraction = 0.5;
   double observer_release_threshold_Nm = 5.0;

@@ -12,7 +12,8 @@ MomentumObserver::MomentumObserver(const Model& model, double gain)
       residual_(Eigen::VectorXd::Zero(model.nv())),
       release_integral_(Eigen::VectorXd::Zero(model.nv())),
       release_residual_(Eigen::VectorXd::Zero(model.nv())),
-      release_velocity_(Eigen::VectorXd::Zero(model.nv())) {}
+      release_velocity_(Eigen::VectorXd::Zero(model.nv())),
+      release_kick_(Eigen::VectorXd::Zero(model.nv())) {}
 
 void MomentumObserver::set_release_path(double gain, double threshold, const Eigen::VectorXd& release_speed) {
   release_gain_ = gain;
@@ -51,11 +52,19 @@ const Eigen::VectorXd& MomentumObserver::update(const Data& data, const Eigen::V
   release_residual_ = release_gain_ * (momentum_ - initial_momentum_ - release_integral_);
   // The joint's speed over the last ~10 ms: an elastic joint's ringing (fast, tiny) is no motion.
   release_velocity_ += (dt / (kReleaseVelocityFilter_s + dt)) * (qd - release_velocity_);
+  // The kick the arm would get if every push were gone and the controller still cancelled r:
+  // -M^-1 r. Only where it drives a fast joint along its motion does the release path act.
+  release_kick_ = -residual_;
+  data.mass_matrix_llt.solveInPlace(release_kick_);
+  bool kick_along_motion = false;
+  for (Eigen::Index j = 0; j < residual_.size(); ++j) {
+    kick_along_motion = kick_along_motion || (std::abs(release_velocity_[j]) > release_speed_[j] &&
+                                              release_kick_[j] * release_velocity_[j] > 0.0);
+  }
+  if (!kick_along_motion) return residual_;
   for (Eigen::Index i = 0; i < residual_.size(); ++i) {
-    // On a fast joint whose r resists its motion: shrink r toward the fast estimate, never past
-    // zero nor beyond r itself.
+    // Shrink r toward the fast estimate, never past zero nor beyond r itself.
     const double r = residual_[i];
-    if (!(r * release_velocity_[i] < 0.0 && std::abs(release_velocity_[i]) > release_speed_[i])) continue;
     const double shrunk = r > 0.0 ? std::clamp(release_residual_[i] + release_threshold_, 0.0, r)
                                    : std::clamp(release_residual_[i] - release_threshold_, r, 0.0);
     if (shrunk != r) {

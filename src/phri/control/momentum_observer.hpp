@@ -12,13 +12,14 @@
 // M must be the link-side inertia (no rotor inertia): the torque sensors sit after the rotor.
 //
 // Release path: a push that ends leaves r behind for ~1/K_O, and a controller that cancels r
-// goes on pushing for the human who has let go. Where r resists a joint's motion, that phantom
-// cancellation drives the joint along its motion: near its velocity limit, an overspeed
-// (safety-fuzz: up to 1.28x, full-body compliance). A second observer of gain release_gain runs
-// beside; on a joint faster than release_speed (over 10 ms) whose r opposes its velocity, when the fast
-// estimate is below |r| by more than release_threshold, r drops to it at once (only toward zero).
-// Elsewhere r keeps its K_O low-pass: a bouncing load (the drop test) must be averaged, not
-// followed down and up again at two speeds (that halves its estimate: 35 mm sag instead of 3).
+// goes on pushing for the human who has let go: the arm gets the kick -M^-1 r. Where that kick
+// drives a fast joint along its motion, near its velocity limit it is an overspeed (safety-fuzz:
+// up to 1.28x, full-body compliance). A second observer of gain release_gain runs beside; while
+// -M^-1 r points along the velocity of a joint faster than its release_speed (over 10 ms), each
+// r_i whose fast estimate is below |r_i| by more than release_threshold drops to it at once (only
+// toward zero). Otherwise r keeps its K_O low-pass: a bouncing load (the drop test) must be
+// averaged, not followed down fast and up slowly (that under-estimates it: 35 mm sag, not 3).
+// `data` must hold the mass matrix's Cholesky factor (compute_all_terms).
 #include <phri/model/data.hpp>
 #include <phri/model/model.hpp>
 
@@ -30,8 +31,8 @@ public:
   MomentumObserver(const Model& model, double gain);
 
   void set_gain(double gain);
-  /// The release path (gain 0: off) on joints moving faster than release_speed [rad/s]. gain * dt
-  /// must stay below 1 (checked by the caller's settings).
+  /// The release path (gain 0: off), gated by joints moving faster than release_speed [rad/s].
+  /// gain * dt must stay below 1 (checked by the caller's settings).
   void set_release_path(double gain, double threshold, const Eigen::VectorXd& release_speed);
   void set_gains(const Eigen::VectorXd& gains);
   const Eigen::VectorXd& gains() const { return gains_; }
@@ -57,6 +58,7 @@ private:
   Eigen::VectorXd release_integral_;  // the release path's own observer (gain release_gain_)
   Eigen::VectorXd release_residual_;
   Eigen::VectorXd release_velocity_;  // qd low-passed over kReleaseVelocityFilter_s
+  Eigen::VectorXd release_kick_;      // -M^-1 r
   static constexpr double kReleaseVelocityFilter_s = 0.01;
   bool initialised_ = false;
 };
