@@ -110,12 +110,10 @@ SensorRanges sensor_ranges(const Model& model, const ActuatorTable& actuators) {
       r.q_lower[i] = -std::numeric_limits<double>::infinity();
       r.q_upper[i] = std::numeric_limits<double>::infinity();
     }
-    r.velocity_limit[i] = actuators[i].velocity_limit_rad_s;
-    r.torque_range[i] = std::max(actuators[i].max_motor_torque_Nm(), actuators[i].torque_limit_Nm);
-    r.current_range[i] = actuators[i].current_limit_A;
-  }
-  for (int i = 0; i < n; ++i) {
     const ActuatorParameters& a = actuators[i];
+    r.velocity_limit[i] = a.velocity_limit_rad_s;
+    r.torque_range[i] = std::max(a.max_motor_torque_Nm(), a.torque_limit_Nm);
+    r.current_range[i] = a.current_limit_A;
     r.torque_per_amp[i] = a.torque_per_amp();
     r.reflected_inertia[i] = a.reflected_inertia_kgm2;
     r.friction_static[i] = a.friction.static_Nm;

@@ -1,4 +1,5 @@
 #include <phri/control/momentum_observer.hpp>
+#include <phri/core/error.hpp>
 
 #include <algorithm>
 
@@ -16,11 +17,13 @@ MomentumObserver::MomentumObserver(const Model& model, double gain)
       release_kick_(Eigen::VectorXd::Zero(model.nv())) {}
 
 void MomentumObserver::set_release_path(double gain, double threshold, const Eigen::VectorXd& release_speed) {
+  check_size("MomentumObserver::set_release_path", "release_speed", release_speed.size(), gains_.size());
   release_gain_ = gain;
   release_threshold_ = threshold;
   release_speed_ = release_speed;
-  release_integral_ = momentum_ - initial_momentum_ - residual_ / std::max(gain, 1e-12);
+  // The fast observer starts where the slow one stands: r_fast = gain (p - p0 - I_fast) = r.
   release_residual_ = residual_;
+  if (gain > 0.0) release_integral_ = momentum_ - initial_momentum_ - residual_ / gain;
 }
 
 void MomentumObserver::set_gain(double gain) { gains_.setConstant(gain); }
