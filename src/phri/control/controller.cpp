@@ -169,6 +169,7 @@ Controller::Controller(LoadedRobot robot, const ControllerSettings& settings)
       sensor_frame_(model_.frame_id("ft_sensor")),
       q_(Eigen::VectorXd::Zero(model_.nq())),
       qd_(Eigen::VectorXd::Zero(model_.nv())),
+      previous_qd_(Eigen::VectorXd::Zero(model_.nv())),
       ee_jacobian_(Eigen::MatrixXd::Zero(6, model_.nv())),
       ft_torque_(Eigen::VectorXd::Zero(model_.nv())),
       tau_ext_(Eigen::VectorXd::Zero(model_.nv())),
@@ -359,18 +360,25 @@ void Controller::bound_external_torque() {
 // acceleration alone is below stiction, so a joint could rest there). A guard that acts may go
 // beyond the QP's limit up to kGuardDriveFraction of the drive's peak torque (the rest is K_T's
 // spread: the robot refuses a torque beyond its own peak, safety-fuzz seed 31337 at the full peak).
+// The speed is the mean of the last two samples, whose zero at the Nyquist frequency keeps the
+// guard out of a period-2 limit cycle: scaled by M_ii, it acts several times harder on a coupled
+// pair (the Gen3's joints 1 and 3 near q2 = 0 share an axis), and under Kinova's high-velocity
+// loop joints 1 and 3 rang at the threshold until a release took one to 1.09x (seed 13579).
+// Scaling by 1 / (M^-1)_ii or applying it through the whole M instead weakened the guard where
+// the torque saturates (1.07x to 1.15x in the custom loop, same seed).
 void Controller::guard_torque(Eigen::VectorXd& tau) const {
   constexpr double kGuardDriveFraction = 0.9;
   const SafetySettings& s = settings_.safety;
   for (int i = 0; i < model_.nv(); ++i) {
     const double inertia = data_.mass_matrix(i, i) + reflected_inertia_[i];
     const double guard_speed = s.velocity_guard_fraction * drive_velocity_limit_[i];
-    const double excess = std::abs(qd_[i]) - guard_speed;
+    const double qd = 0.5 * (qd_[i] + previous_qd_[i]);
+    const double excess = std::abs(qd) - guard_speed;
     const double above = q_[i] - qp_.safe_upper()[i], below = qp_.safe_lower()[i] - q_[i];
     const double limit = excess > 0.0 || above > 0.0 || below > 0.0
                              ? std::max(torque_limit_[i], kGuardDriveFraction * drive_torque_[i])
                              : torque_limit_[i];
-    if (excess > 0.0) tau[i] -= std::copysign(s.velocity_guard_rate * inertia * excess, qd_[i]);
+    if (excess > 0.0) tau[i] -= std::copysign(s.velocity_guard_rate * inertia * excess, qd);
     if (above > 0.0) tau[i] -= static_friction_[i] + s.limit_guard_stiffness_Nm_per_rad * above;
     if (below > 0.0) tau[i] += static_friction_[i] + s.limit_guard_stiffness_Nm_per_rad * below;
     tau[i] = std::clamp(tau[i], -limit, limit);
@@ -454,6 +462,7 @@ CycleStatus Controller::step(const RobotState& state, const ControllerTargets& t
   }
   cycles_since_good_ = 0;
   q_ = state.q_rad;
+  previous_qd_ = qd_;
   qd_ = state.qd_rad_s;
   // The observer integrates over the time since the last sample it saw (missed ones included).
   const double dt = had_good ? std::clamp(state.joints.stamp_s - previous_good_stamp, settings_.period_s,

@@ -147,6 +147,7 @@ private:
   int end_effector_frame_ = 0;
   int sensor_frame_ = 0;
   Eigen::VectorXd q_, qd_;
+  Eigen::VectorXd previous_qd_;  // the last good sample's velocity (the guard's two-sample mean)
   std::uint32_t last_joint_sequence_ = 0;
   std::uint32_t last_wrench_sequence_ = 0;
   bool started_ = false;
