@@ -204,7 +204,10 @@ int StateSupervisor::first_torque_current_mismatch(const RobotState& s) {
   // The filter starts from zero: a push at the first sample is not a fault, an offset soon is.
   if (residual_updates_ == 0) {
     dt = c.period_s;
-    for (ResidualTrack& track : residual_track_) track.filtered.setZero(), track.acceleration_size.setZero();
+    for (ResidualTrack& track : residual_track_) {
+      track.filtered.setZero();
+      track.acceleration_size.setZero();
+    }
   }
   const double alpha = dt / (c.torque_current_filter_s + dt);
   const double clamp = c.motor_acceleration_clamp_rad_s2;
