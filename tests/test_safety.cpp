@@ -152,6 +152,44 @@ TEST(Safety, PositionLoopReferenceNeverRunsAwayFromTheArm) {
   EXPECT_LT(speed_after, 1.0) << "the push (beyond what the servo resists) ended: no swing";
 }
 
+// A safe stop in the position loop while the arm moves (its end effector streamed along x at
+// 0.2 m/s): the held reference brakes from where it is, so the servo's torque makes no step (it
+// jumped to the measured pose: a spike of kd x (following error / T) in the velocity
+// feed-forward: 33 N.m here).
+TEST(Safety, ASafeStopInThePositionLoopBrakesTheReferenceWithoutATorqueStep) {
+  Rig rig(phri::ComplianceMode::kNullSpace, phri::LowLevelMode::kPosition);
+  rig.run(0.3);
+  Eigen::Isometry3d pose = rig.cycle_.qp().end_effector().target_pose();
+  double before = 0.0, after = 0.0;
+  Eigen::VectorXd last_tau = rig.robot_.truth().tau_motor_Nm;
+  auto largest_step = [&](double& largest) {
+    largest = std::max(largest, (rig.robot_.truth().tau_motor_Nm - last_tau).cwiseAbs().maxCoeff());
+    last_tau = rig.robot_.truth().tau_motor_Nm;
+  };
+  rig.run(0.5, {}, [&]() {
+    pose.translation().x() += 0.2 * rig.robot_.period_s();
+    rig.targets_.has_pose = true;
+    rig.targets_.pose.pose = pose;
+    rig.targets_.pose.velocity.setZero();
+    rig.targets_.pose.velocity[0] = 0.2;
+    if (rig.robot_.truth().time_s > 0.5) largest_step(before);
+  });
+  const double speed_at_fault = rig.qd().cwiseAbs().maxCoeff();
+  rig.cycle_.report_fault(phri::SafetyFault::kWriteRefused, 0.8);
+  const Eigen::VectorXd start = rig.q();
+  rig.run(0.5, {}, [&]() { largest_step(after); });
+  std::printf("safe stop in the position loop at %.3f rad/s: largest motor-torque step per ms %.2f N.m before, %.2f after; "
+              "%.4f rad travelled while braking; refused writes %ld\n",
+              speed_at_fault, before, after, distance(rig.q(), start), rig.refused_);
+  EXPECT_GT(speed_at_fault, 0.1) << "the arm moves when the stop comes";
+  EXPECT_EQ(rig.cycle_.status(), phri::CycleStatus::kSafeStop);
+  EXPECT_TRUE(rig.cycle_.holding());
+  EXPECT_LT(rig.qd().cwiseAbs().maxCoeff(), 0.01) << "at rest 0.5 s later";
+  EXPECT_LT(after, before + 5.0);
+  EXPECT_LT(distance(rig.q(), start), speed_at_fault / 20.0 + 0.01) << "the brake's distance: speed / brake_rate";
+  EXPECT_EQ(rig.refused_, 0);
+}
+
 // Defect 2, second half: a refused write is a fault the loop acts on (here: the controller is told
 // by the caller, as run_session does) — a safe stop, at rest, holding.
 TEST(Safety, ARefusedWriteReportedToTheControllerEndsInASafeStopAtRest) {

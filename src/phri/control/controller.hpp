@@ -130,6 +130,7 @@ private:
   void update_modes_and_targets();
   void shape_tasks();
   void guard_torque(Eigen::VectorXd& tau) const;
+  void brake_reference();
   void check_qp(WholeBodyQpStatus qp_status, double t);
 
   ControllerSettings settings_;
@@ -168,7 +169,8 @@ private:
   long cycles_since_good_ = 0;
   long safe_stop_cycles_ = 0;
   bool holding_ = false;
-  Eigen::VectorXd hold_q_, brake_q_, brake_qd_, brake_tau_, guarded_tau_;
+  Eigen::VectorXd hold_q_, hold_qd_;  // the safe stop's held reference, braking to rest (position loop)
+  Eigen::VectorXd brake_q_, brake_qd_, brake_tau_, guarded_tau_;
   Eigen::VectorXd limit_lower_, limit_upper_;       // URDF limits (±inf: continuous)
   Eigen::VectorXd torque_limit_, drive_velocity_limit_, reflected_inertia_, static_friction_;
   Eigen::VectorXd drive_torque_;  // the drives' peak motor torque
