@@ -109,6 +109,54 @@ TEST_F(ConstraintTest, VelocityLimitBoundsVanishAtTheLimitAndConvergeAtTheirGain
   EXPECT_NEAR(speed - 1.2, 1.2 * std::exp(-50.0 * 0.1), 1e-4);
 }
 
+// Braking reserve (velocity_limit_constraint.hpp), against its closed form: full limit from
+// reserve_fraction x tau_max of reserve, linear below, min_speed_fraction at none; a joint faster
+// than its lowered limit is asked exactly the deceleration its reserve gives.
+TEST_F(ConstraintTest, BrakingReserveLowersTheLimitTowardAPushThatTakesTheTorque) {
+  const Eigen::VectorXd v = Eigen::VectorXd::Constant(7, 2.0), gain = Eigen::VectorXd::Constant(7, 80.0);
+  const Eigen::VectorXd tau_max = Eigen::VectorXd::Constant(7, 100.0), inertia = Eigen::VectorXd::Constant(7, 0.5);
+  const phri::VelocityLimitConstraint plain(v, gain);
+  const phri::VelocityLimitConstraint limit(v, gain, {0.3, 0.5});
+  Eigen::VectorXd qd = Eigen::VectorXd::LinSpaced(7, -1.5, 1.5), hold = Eigen::VectorXd::Zero(7);
+  Eigen::VectorXd lower(7), upper(7), plain_lower(7), plain_upper(7);
+  // Plenty of reserve both ways (|hold| <= 70 % of tau_max): the paper's bounds, bit for bit.
+  hold << -70.0, -40.0, -10.0, 0.0, 10.0, 40.0, 70.0;
+  limit.bound(qd, hold, tau_max, inertia, lower, upper);
+  plain.bound(qd, plain_lower, plain_upper);
+  EXPECT_EQ(lower, plain_lower);
+  EXPECT_EQ(upper, plain_upper);
+  // Moving toward + brakes with tau >= -tau_max: reserve tau_max + hold. hold -76 leaves 24 N.m,
+  // 0.8 of the 30 N.m from which the full limit holds: the + limit is 1.6 rad/s; the - one keeps 2.
+  qd.setZero();
+  hold.setConstant(-76.0);
+  limit.bound(qd, hold, tau_max, inertia, lower, upper);
+  EXPECT_NEAR(upper[0], 80.0 * 1.6, 1e-9);
+  EXPECT_NEAR(lower[0], -80.0 * 2.0, 1e-9);
+  // No reserve (or less than none: a push beyond the drive): min_speed_fraction x v.
+  for (double h : {-100.0, -130.0, -95.5}) {
+    hold.setConstant(h);
+    limit.bound(qd, hold, tau_max, inertia, lower, upper);
+    EXPECT_NEAR(upper[0], 80.0 * 1.0, 1e-9) << h;
+  }
+  // Already at 1.8 rad/s with 6 N.m of reserve (hold -94): lowered limit 0.5 x 2 = 1 rad/s, but the
+  // bound asks only what 6 N.m decelerates the joint's 0.5 kg.m^2 at: qdd <= -12 rad/s^2.
+  qd.setConstant(1.8);
+  hold.setConstant(-94.0);
+  limit.bound(qd, hold, tau_max, inertia, lower, upper);
+  EXPECT_NEAR(upper[0], -6.0 / 0.5, 1e-9);
+  // ... and with no reserve at all it asks for no acceleration along the motion, not a deceleration
+  // the torque limits forbid (the QP would go infeasible).
+  hold.setConstant(-100.0);
+  limit.bound(qd, hold, tau_max, inertia, lower, upper);
+  EXPECT_NEAR(upper[0], 0.0, 1e-9);
+  // Mirror image toward -: reserve tau_max - hold.
+  qd.setConstant(-1.8);
+  hold.setConstant(94.0);
+  limit.bound(qd, hold, tau_max, inertia, lower, upper);
+  EXPECT_NEAR(lower[0], 6.0 / 0.5, 1e-9);
+  EXPECT_NEAR(upper[0], -80.0 * (-1.8 - 2.0), 1e-9);  // + keeps its full limit (reserve 194 N.m)
+}
+
 TEST_F(ConstraintTest, TorqueRowsHoldExactlyTheTorquesWithinTheLimits) {
   Eigen::VectorXd q(7), qd(7);
   q << 0.3, 0.58, 3.14, -1.84, 0.2, 0.85, 1.57;

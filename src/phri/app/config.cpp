@@ -255,7 +255,8 @@ Eigen::VectorXd parse_torque_limits(const YamlReader& q, const ActuatorTable& dr
 
 void parse_qp(const YamlReader& q, const ActuatorTable& drives, WholeBodyQpSettings& s) {
   q.allow_keys({"torque_limit_Nm", "velocity_limit_rad_s", "velocity_limit_fraction", "joint_limits",
-                "velocity_limit_gain", "collision", "regularization", "brake_damping", "smoothing_time_constant_s"});
+                "velocity_limit_gain", "braking_reserve", "collision", "regularization", "brake_damping",
+                "smoothing_time_constant_s"});
   const int dof = drives.size();
   if (q.has("torque_limit_Nm")) s.torque_limit = parse_torque_limits(q, drives);
   if (q.has("velocity_limit_rad_s")) {
@@ -264,6 +265,12 @@ void parse_qp(const YamlReader& q, const ActuatorTable& drives, WholeBodyQpSetti
   s.velocity_limit_fraction = positive_or(q, "velocity_limit_fraction", s.velocity_limit_fraction, 1.0);
   if (q.has("joint_limits")) parse_joint_limit_damper(q.at("joint_limits"), s);
   s.velocity_limit_gain = positive_or(q, "velocity_limit_gain", s.velocity_limit_gain, kMaxTaskDamping_per_s);
+  if (q.has("braking_reserve")) {
+    const YamlReader b = q.at("braking_reserve");
+    b.allow_keys({"reserve_fraction", "min_speed_fraction"});
+    s.braking_reserve.reserve_fraction = b.number_or("reserve_fraction", s.braking_reserve.reserve_fraction, 0.0, 1.0);
+    s.braking_reserve.min_speed_fraction = b.number_or("min_speed_fraction", s.braking_reserve.min_speed_fraction, 0.05, 1.0);
+  }
   if (q.has("collision")) parse_collision_damper(q.at("collision"), s.collision);
   s.regularization = non_negative_or(q, "regularization", s.regularization, 1.0);
   s.brake_damping = positive_or(q, "brake_damping", s.brake_damping, kMaxTaskDamping_per_s);

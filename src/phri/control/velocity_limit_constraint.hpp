@@ -2,14 +2,36 @@
 // Joint velocity limits of the QP (paper: 0.9 of the robot's limits), as bounds on qdd that drive
 // qd back within +-v_max at the rate lambda: qdd <= -lambda (qd - v_max), qdd >= -lambda (qd + v_max).
 // lambda per joint: its joint-limit damper's for a limited joint, a set gain for a continuous one.
+//
+// Braking reserve (ours, not the paper's). A limit the joint can reach is only as good as the
+// torque left to stop it there. Moving toward +, a joint brakes with tau >= -tau_max, which leaves
+// the reserve tau_max + hold, hold = h - tau_ext being the torque that holds it against gravity,
+// its motion and the push (toward -: tau_max - hold). A push that takes nearly all of a joint's
+// torque (a 160 N step on the Gen3's bracelet asks 96 % of joint 2's 95 N.m) left full-body
+// compliance carrying the joint to 0.9 v_max with ~2 N.m to stop it: the QP went infeasible and
+// the joint reached 1.10 x its limit (safety-fuzz seed 5150, full_body/custom/17). So below
+// reserve_fraction x tau_max of reserve in a direction, that direction's limit falls linearly
+// with the reserve, down to min_speed_fraction x v_max at none. A joint already faster than the
+// lowered limit is asked no more deceleration than its reserve gives (reserve / (M_ii lambda) of
+// speed per cycle's bound), so the lowered limit never makes the QP infeasible by itself.
 #include <Eigen/Core>
+
+#include <algorithm>
 
 namespace phri {
 
+struct BrakingReserveSettings {
+  /// Reserve (fraction of the torque limit) from which a direction keeps its full limit; 0: off.
+  double reserve_fraction = 0.3;
+  /// The limit's fraction with no reserve left.
+  double min_speed_fraction = 0.5;
+};
+
 class VelocityLimitConstraint {
 public:
-  VelocityLimitConstraint(const Eigen::VectorXd& velocity_limit, const Eigen::VectorXd& gain)
-      : velocity_limit_(velocity_limit), gain_(gain) {}
+  VelocityLimitConstraint(const Eigen::VectorXd& velocity_limit, const Eigen::VectorXd& gain,
+                          const BrakingReserveSettings& reserve = {0.0, 1.0})
+      : velocity_limit_(velocity_limit), gain_(gain), reserve_(reserve) {}
 
   /// Sets the acceleration bounds from the velocity limits.
   void bound(const Eigen::VectorXd& qd, Eigen::VectorXd& lower, Eigen::VectorXd& upper) const {
@@ -18,10 +40,38 @@ public:
       lower[i] = -gain_[i] * (qd[i] + velocity_limit_[i]);
     }
   }
+
+  /// The same with each direction's limit lowered by its braking reserve (header). hold: h - tau_ext;
+  /// inertia: the diagonal of M (what one N.m of reserve decelerates).
+  void bound(const Eigen::VectorXd& qd, const Eigen::VectorXd& hold, const Eigen::VectorXd& torque_limit,
+             const Eigen::VectorXd& inertia, Eigen::VectorXd& lower, Eigen::VectorXd& upper) const {
+    for (int i = 0; i < qd.size(); ++i) {
+      const double up = speed_limit(i, torque_limit[i] + hold[i], torque_limit[i], qd[i], inertia[i]);
+      const double down = speed_limit(i, torque_limit[i] - hold[i], torque_limit[i], -qd[i], inertia[i]);
+      upper[i] = -gain_[i] * (qd[i] - up);
+      lower[i] = -gain_[i] * (qd[i] + down);
+    }
+  }
+
+  /// The speed limit of joint i in one direction, given the torque reserve to brake a motion that
+  /// way and the joint's speed along it.
+  double speed_limit(int i, double reserve, double torque_limit, double speed, double inertia) const {
+    const double v = velocity_limit_[i];
+    if (!(reserve_.reserve_fraction > 0.0)) return v;
+    const double fraction = std::clamp(reserve / (reserve_.reserve_fraction * torque_limit), reserve_.min_speed_fraction, 1.0);
+    const double lowered = fraction * v;
+    if (fraction >= 1.0 || speed <= lowered) return lowered;
+    // Faster than the lowered limit: the bound asks gain x slack of deceleration, what the reserve gives.
+    const double slack = std::max(reserve, 0.0) / (inertia * gain_[i]);
+    return std::max(lowered, std::min(speed, v) - slack);
+  }
+
   const Eigen::VectorXd& velocity_limit() const { return velocity_limit_; }
+  const BrakingReserveSettings& braking_reserve() const { return reserve_; }
 
 private:
   Eigen::VectorXd velocity_limit_, gain_;
+  BrakingReserveSettings reserve_;
 };
 
 }  // namespace phri

@@ -28,6 +28,11 @@ WholeBodyQp::Limits WholeBodyQp::checked_limits(const Model& model, const WholeB
   if (!(c.safety_distance >= 0 && c.influence_distance > c.safety_distance && c.xi > 0 && c.amortization >= 1.0)) {
     fail("collision", "need 0 <= safety_distance < influence_distance, xi > 0, amortization >= 1");
   }
+  const BrakingReserveSettings& reserve = settings.braking_reserve;
+  if (!(reserve.reserve_fraction >= 0 && reserve.reserve_fraction <= 1 && reserve.min_speed_fraction > 0 &&
+        reserve.min_speed_fraction <= 1)) {
+    fail("braking_reserve", "reserve_fraction must be in [0, 1] and min_speed_fraction in (0, 1]");
+  }
   if (!(settings.velocity_limit_gain > 0) || !(settings.brake_damping > 0)) fail("velocity_limit_gain", "gains must be > 0");
   if (settings.compliance_deadband.size() &&
       (settings.compliance_deadband.size() != model.nv() || !(settings.compliance_deadband.array() >= 0).all() ||
@@ -62,13 +67,16 @@ WholeBodyQp::WholeBodyQp(const Model& model, const CollisionModel* collision, co
       joint_limits_(model,
                     {settings.joint_influence_fraction, settings.joint_safety_fraction, settings.joint_damper_amortization},
                     limits.velocity),
-      velocity_limit_(limits.velocity, velocity_limit_gains(joint_limits_, settings.velocity_limit_gain, model.nv())),
+      velocity_limit_(limits.velocity, velocity_limit_gains(joint_limits_, settings.velocity_limit_gain, model.nv()),
+                      settings.braking_reserve),
       torque_limit_(limits.torque),
       deadband_(settings.compliance_deadband.size() ? settings.compliance_deadband : Eigen::VectorXd::Zero(model.nv())),
       qdd_external_(Eigen::VectorXd::Zero(nv_)),
       qdd_desired_(Eigen::VectorXd::Zero(nv_)),
       tau_desired_(Eigen::VectorXd::Zero(nv_)),
       last_good_tau_(Eigen::VectorXd::Zero(nv_)),
+      hold_torque_(Eigen::VectorXd::Zero(nv_)),
+      inertia_diagonal_(Eigen::VectorXd::Zero(nv_)),
       weighted_jacobian_(Eigen::MatrixXd::Zero(6, nv_)) {
   if (collision) self_collision_.emplace(model, *collision, settings.collision);
   // Rows: nv torque rows (A = M), then one row per collision pair. Bounds: qdd.
@@ -78,8 +86,11 @@ WholeBodyQp::WholeBodyQp(const Model& model, const CollisionModel* collision, co
 
 // Acceleration bounds from the velocity limits and the joint-limit dampers (paper: qdd_d <=
 // min(ë_p, ë_v) for an upper limit, >= max(...) for a lower one).
-void WholeBodyQp::joint_bounds(const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
-  velocity_limit_.bound(qd, problem_.lb, problem_.ub);
+void WholeBodyQp::joint_bounds(const Data& data, const Eigen::VectorXd& q, const Eigen::VectorXd& qd,
+                               const Eigen::VectorXd& tau_ext) {
+  hold_torque_ = data.nonlinear_effects - tau_ext;
+  inertia_diagonal_ = data.mass_matrix.diagonal();
+  velocity_limit_.bound(qd, hold_torque_, torque_limit(), inertia_diagonal_, problem_.lb, problem_.ub);
   joint_limits_.tighten(q, qd, problem_.lb, problem_.ub);
   for (int i = 0; i < nv_; ++i) {
     // Both limits bind (e.g. beyond one): split the difference.
@@ -109,7 +120,7 @@ WholeBodyQpStatus WholeBodyQp::update(const Model& model, const Data& data, cons
   problem_.g.noalias() = -w_ee * end_effector_.jacobian().transpose() * end_effector_.reference();
   problem_.g.noalias() -= w_0 * posture_.reference();
 
-  joint_bounds(q, qd);
+  joint_bounds(data, q, qd, tau_ext);
   torque_limit_.rows(data, tau_ext, problem_.A.topRows(nv_), problem_.l.head(nv_), problem_.u.head(nv_));
   if (self_collision_) {
     self_collision_->rows(model, data, problem_.A.middleRows(nv_, num_pairs_), problem_.l.segment(nv_, num_pairs_),

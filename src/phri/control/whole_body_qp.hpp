@@ -49,6 +49,8 @@ struct WholeBodyQpSettings {
   double joint_damper_amortization = 1.8;
   /// lambda of the velocity-limit constraint for continuous joints (limited joints use their damper's).
   double velocity_limit_gain = 50.0;
+  /// The velocity limit lowered where little torque is left to brake (velocity_limit_constraint.hpp).
+  BrakingReserveSettings braking_reserve;
   /// Self-collision damper (paper: d_i 0.03 m, d_s 0.015 m, M 1.8; xi 0.08 m/s gives its lambda ~ 70).
   VelocityDamperSettings collision{0.03, 0.015, 0.08, 1.8};
   /// Soft dead band on tau_ext before it enters the compliant tasks (gamma terms) only, per joint
@@ -119,7 +121,7 @@ private:
   static Limits checked_limits(const Model& model, const WholeBodyQpSettings& settings);
   WholeBodyQp(const Model& model, const CollisionModel* collision, const WholeBodyQpSettings& settings,
               const Limits& limits);
-  void joint_bounds(const Eigen::VectorXd& q, const Eigen::VectorXd& qd);
+  void joint_bounds(const Data& data, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, const Eigen::VectorXd& tau_ext);
   void fallback_brake(const Data& data, const Eigen::VectorXd& qd, const Eigen::VectorXd& tau_ext);
 
   WholeBodyQpSettings settings_;
@@ -135,6 +137,7 @@ private:
   QpSolver solver_;
   Eigen::VectorXd deadband_;
   Eigen::VectorXd qdd_external_, qdd_desired_, tau_desired_, last_good_tau_;
+  Eigen::VectorXd hold_torque_, inertia_diagonal_;  // the braking reserve's scratch
   Eigen::MatrixXd weighted_jacobian_;  // 6 x nv scratch
   WholeBodyQpStatus status_ = WholeBodyQpStatus::kOk;
   bool warm_ = false;
