@@ -145,10 +145,14 @@ TEST_F(ConstraintTest, BrakingReserveLowersTheLimitTowardAPushThatTakesTheTorque
   limit.bound(qd, hold, tau_max, inertia, lower, upper);
   EXPECT_NEAR(upper[0], -6.0 / 0.5, 1e-9);
   // ... and with no reserve at all it asks for no acceleration along the motion, not a deceleration
-  // the torque limits forbid (the QP would go infeasible).
+  // the torque limits forbid (the QP would go infeasible); with 5 N.m less than none it lets
+  // through the 10 rad/s^2 the torque limit cannot stop.
   hold.setConstant(-100.0);
   limit.bound(qd, hold, tau_max, inertia, lower, upper);
   EXPECT_NEAR(upper[0], 0.0, 1e-9);
+  hold.setConstant(-105.0);
+  limit.bound(qd, hold, tau_max, inertia, lower, upper);
+  EXPECT_NEAR(upper[0], 5.0 / 0.5, 1e-9);
   // Mirror image toward -: reserve tau_max - hold.
   qd.setConstant(-1.8);
   hold.setConstant(94.0);
@@ -211,6 +215,38 @@ TEST_F(ConstraintTest, SelfCollisionRowsActOnlyInsideTheInfluenceDistance) {
       EXPECT_TRUE(a.row(p).isApprox(constraint.data().jacobian.row(p)));
     }
   }
+}
+
+// The braking row ahead of the collision damper (self_collision_constraint.hpp) on a distance
+// riding its bound: from 1.5 m/s at 0.5 m it stops before d_s, decelerating no harder than about
+// the set deceleration (a pure v^2 = 2 a (d - d_s) profile asks exactly a), and a slow approach
+// never meets it; what the paper's damper alone asks at d_i from that speed is far beyond.
+TEST_F(ConstraintTest, CollisionBrakingStopsAFastApproachBeforeTheSafetyDistance) {
+  const phri::CollisionBrakingSettings braking{3.0, 50.0};
+  const double d_s = 0.015, dt = 1e-4;
+  double d = 0.5, d_dot = -1.5, hardest = 0.0, closest = d;
+  for (int k = 0; k < 200000; ++k) {
+    const double bound = phri::collision_braking_bound(d, d_dot, d_s, braking);
+    const double d_ddot = std::isfinite(bound) ? std::max(bound, 0.0) : 0.0;  // coasting unless bounded
+    hardest = std::max(hardest, d_ddot);
+    d_dot += dt * d_ddot;
+    d += dt * d_dot;
+    closest = std::min(closest, d);
+  }
+  EXPECT_GT(closest, 0.99 * d_s);
+  EXPECT_LT(closest, d_s + 0.005);               // it does come near: the row only brakes
+  EXPECT_LT(hardest, 2.0 * braking.deceleration);  // the profile's a, plus the gain's lag
+  EXPECT_GT(hardest, 0.8 * braking.deceleration);
+  // Slow approaches (below half the braking profile's speed) and separating pairs: no row.
+  EXPECT_EQ(phri::collision_braking_bound(0.1, -0.3, d_s, braking), -std::numeric_limits<double>::infinity());
+  EXPECT_EQ(phri::collision_braking_bound(0.02, 0.5, d_s, braking), -std::numeric_limits<double>::infinity());
+  EXPECT_EQ(phri::collision_braking_bound(0.1, -1.0, d_s, {0.0, 50.0}), -std::numeric_limits<double>::infinity());
+  // Inside d_s it asks to stop approaching at the gain: -gain x d_dot; near it, the linear end.
+  EXPECT_DOUBLE_EQ(phri::collision_braking_bound(0.01, -0.2, d_s, braking), 50.0 * 0.2);
+  EXPECT_DOUBLE_EQ(phri::collision_braking_bound(d_s + 0.01, -0.2, d_s, braking), -50.0 * (-0.2 + 10.0 * 0.01));
+  // The paper's damper at d_i from 1.5 m/s asks some 100 m/s^2.
+  const phri::VelocityDamper damper({0.03, d_s, 0.08, 1.8});
+  EXPECT_GT(damper.min_acceleration(0.03, -1.5), 90.0);
 }
 
 }  // namespace

@@ -255,7 +255,7 @@ Eigen::VectorXd parse_torque_limits(const YamlReader& q, const ActuatorTable& dr
 
 void parse_qp(const YamlReader& q, const ActuatorTable& drives, WholeBodyQpSettings& s) {
   q.allow_keys({"torque_limit_Nm", "velocity_limit_rad_s", "velocity_limit_fraction", "joint_limits",
-                "velocity_limit_gain", "braking_reserve", "collision", "regularization", "brake_damping",
+                "velocity_limit_gain", "braking_reserve", "collision", "collision_braking", "regularization", "brake_damping",
                 "smoothing_time_constant_s"});
   const int dof = drives.size();
   if (q.has("torque_limit_Nm")) s.torque_limit = parse_torque_limits(q, drives);
@@ -272,6 +272,12 @@ void parse_qp(const YamlReader& q, const ActuatorTable& drives, WholeBodyQpSetti
     s.braking_reserve.min_speed_fraction = b.number_or("min_speed_fraction", s.braking_reserve.min_speed_fraction, 0.05, 1.0);
   }
   if (q.has("collision")) parse_collision_damper(q.at("collision"), s.collision);
+  if (q.has("collision_braking")) {
+    const YamlReader b = q.at("collision_braking");
+    b.allow_keys({"deceleration_m_s2", "gain_per_s"});
+    s.collision_braking.deceleration = b.number_or("deceleration_m_s2", s.collision_braking.deceleration, 0.0, 100.0);
+    s.collision_braking.gain = positive_or(b, "gain_per_s", s.collision_braking.gain, kMaxTaskDamping_per_s);
+  }
   s.regularization = non_negative_or(q, "regularization", s.regularization, 1.0);
   s.brake_damping = positive_or(q, "brake_damping", s.brake_damping, kMaxTaskDamping_per_s);
   s.smoothing_time_constant = non_negative_or(q, "smoothing_time_constant_s", s.smoothing_time_constant, 10.0);

@@ -33,6 +33,10 @@ WholeBodyQp::Limits WholeBodyQp::checked_limits(const Model& model, const WholeB
         reserve.min_speed_fraction <= 1)) {
     fail("braking_reserve", "reserve_fraction must be in [0, 1] and min_speed_fraction in (0, 1]");
   }
+  if (!(settings.collision_braking.deceleration >= 0 && std::isfinite(settings.collision_braking.deceleration) &&
+        settings.collision_braking.gain > 0 && std::isfinite(settings.collision_braking.gain))) {
+    fail("collision_braking", "deceleration must be >= 0 and gain > 0");
+  }
   if (!(settings.velocity_limit_gain > 0) || !(settings.brake_damping > 0)) fail("velocity_limit_gain", "gains must be > 0");
   if (settings.compliance_deadband.size() &&
       (settings.compliance_deadband.size() != model.nv() || !(settings.compliance_deadband.array() >= 0).all() ||
@@ -78,7 +82,7 @@ WholeBodyQp::WholeBodyQp(const Model& model, const CollisionModel* collision, co
       hold_torque_(Eigen::VectorXd::Zero(nv_)),
       inertia_diagonal_(Eigen::VectorXd::Zero(nv_)),
       weighted_jacobian_(Eigen::MatrixXd::Zero(6, nv_)) {
-  if (collision) self_collision_.emplace(model, *collision, settings.collision);
+  if (collision) self_collision_.emplace(model, *collision, settings.collision, settings.collision_braking);
   // Rows: nv torque rows (A = M), then one row per collision pair. Bounds: qdd.
   problem_.resize(nv_, 0, nv_ + num_pairs_);
   solver_.resize(nv_, 0, nv_ + num_pairs_);
@@ -127,7 +131,12 @@ WholeBodyQpStatus WholeBodyQp::update(const Model& model, const Data& data, cons
                           problem_.u.segment(nv_, num_pairs_));
   }
 
-  const QpStatus qp = solver_.solve(problem_, {.warm_start = warm_, .reuse_hessian_factor = false});
+  QpStatus qp = solver_.solve(problem_, {.warm_start = warm_, .reuse_hessian_factor = false});
+  if (qp == QpStatus::kInfeasible && self_collision_ && self_collision_->braking_binds()) {
+    // The braking rows are a comfort ahead of the damper: without them rather than the fallback.
+    problem_.l.segment(nv_, num_pairs_) = self_collision_->damper_lower();
+    qp = solver_.solve(problem_, {.warm_start = false, .reuse_hessian_factor = false});
+  }
   if (qp == QpStatus::kOptimal && solver_.x().allFinite()) {
     warm_ = true;
     qdd_desired_ = solver_.x();

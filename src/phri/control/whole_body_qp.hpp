@@ -53,6 +53,8 @@ struct WholeBodyQpSettings {
   BrakingReserveSettings braking_reserve;
   /// Self-collision damper (paper: d_i 0.03 m, d_s 0.015 m, M 1.8; xi 0.08 m/s gives its lambda ~ 70).
   VelocityDamperSettings collision{0.03, 0.015, 0.08, 1.8};
+  /// The approach speed bounded by a braking distance ahead of that damper (self_collision_constraint.hpp).
+  CollisionBrakingSettings collision_braking;
   /// Soft dead band on tau_ext before it enters the compliant tasks (gamma terms) only, per joint
   /// [N.m]; empty: none. The observer's estimate carries the model's errors (a 5 % mass error is
   /// ~1 N.m on the shoulder) and the torque sensors' offsets as a constant "push"; through
