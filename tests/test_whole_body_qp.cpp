@@ -157,7 +157,42 @@ TEST_F(WholeBodyQpTest, InvalidInputHoldsTheLastCommandAndInfeasibleBrakes) {
   EXPECT_EQ(status, phri::WholeBodyQpStatus::kQpInfeasible);
   EXPECT_TRUE(qp.desired_torque().allFinite());
   EXPECT_TRUE((qp.desired_torque().cwiseAbs().array() <= qp.torque_limit().array() + 1e-9).all());
-  EXPECT_LT(qp.desired_acceleration()[1], 0.0);  // braking joint 2
+  // Joint 2's torque is beyond its limit with no brake at all: the brake never asks it for more
+  // (braking the others through M would), so the fallback coasts rather than speeding joint 2 up.
+  EXPECT_LE(qp.desired_acceleration()[1], 0.0);
+  EXPECT_NEAR(qp.desired_torque()[1], -qp.torque_limit()[1], 1e-9);
+}
+
+// The fallback brake, scaled to the torque limits, is what the arm does: its torques are
+// M qdd + h - tau_ext exactly (none clipped), within the limits, and it brakes every moving joint
+// in the brake's direction; before, a joint near its limit lost the torque that braking its
+// neighbours through M asked of it, and sped up (safety-fuzz seed 2718: 1.88 -> 2.51 rad/s).
+TEST_F(WholeBodyQpTest, TheFallbackBrakeIsScaledToTheTorqueLimitsAndRealisesItsAcceleration) {
+  Eigen::VectorXd q = q_, qd(7);
+  q[1] = 2.24 - 0.02;  // inside joint 2's damper band, moving into it: the damper asks more than 30 N.m gives
+  qd << 0.8, 1.3, -0.8, 0.8, -1.0, 1.0, -1.0;
+  phri::compute_all_terms(model_, data_, q, qd);
+  Eigen::VectorXd tau_ext = Eigen::VectorXd::Zero(7);
+  tau_ext[1] = data_.nonlinear_effects[1] + 27.0;  // joint 2 needs -27 of its 30 N.m just to hold
+  phri::WholeBodyQpSettings settings;  // the others: 15 N.m beyond what holds them
+  settings.torque_limit = data_.nonlinear_effects.cwiseAbs() + Eigen::VectorXd::Constant(7, 15.0);
+  settings.torque_limit[1] = 30.0;
+  phri::WholeBodyQp qp(model_, nullptr, settings);
+  set_tasks(qp, 0.0, 1.0);
+  ASSERT_EQ(qp.update(model_, data_, q, qd, tau_ext, 1e-3), phri::WholeBodyQpStatus::kQpInfeasible);
+  const Eigen::VectorXd realised = data_.mass_matrix * qp.desired_acceleration() + data_.nonlinear_effects - tau_ext;
+  EXPECT_LT((realised - qp.desired_torque()).cwiseAbs().maxCoeff(), 1e-9);
+  EXPECT_TRUE((qp.desired_torque().cwiseAbs().array() <= settings.torque_limit.array() + 1e-9).all());
+  const Eigen::VectorXd full = -settings.brake_damping * qd;
+  double scale = -1.0;
+  for (int i = 0; i < 7; ++i) {
+    if (i == 1) continue;  // joint 2's brake is clipped by its damper's bounds
+    const double s = qp.desired_acceleration()[i] / full[i];
+    if (scale < 0.0) scale = s;
+    EXPECT_NEAR(s, scale, 1e-9);  // one scale: the brake's direction kept
+  }
+  EXPECT_GT(scale, 0.0);
+  EXPECT_LT(scale, 1.0);
 }
 
 TEST_F(WholeBodyQpTest, OneFullCycleDoesNotAllocate) {
