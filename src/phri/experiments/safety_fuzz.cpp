@@ -17,6 +17,7 @@
 #include <cmath>
 #include <exception>
 #include <fstream>
+#include <limits>
 #include <functional>
 #include <memory>
 #include <mutex>
@@ -234,6 +235,7 @@ public:
     for (const char* name : {"ee_error", "ee_integral"}) {
       for (int i = 0; i < 6; ++i) trace_ << ',' << name << i + 1;
     }
+    trace_ << ",qp_status,min_capsule_distance_m";
     trace_ << '\n';
   }
 
@@ -271,6 +273,10 @@ private:
     for (const Vector6d* v : {&cycle_.qp().end_effector().error(), &cycle_.qp().end_effector().integral_term()}) {
       for (Eigen::Index i = 0; i < 6; ++i) trace_ << ',' << (*v)[i];
     }
+    const CollisionData* collision = cycle_.qp().collision_data();
+    trace_ << ',' << to_string(cycle_.qp().status()) << ','
+           << (collision != nullptr && collision->distance.size() > 0 ? collision->distance.minCoeff()
+                                                                       : std::numeric_limits<double>::infinity());
     trace_ << '\n';
   }
 
