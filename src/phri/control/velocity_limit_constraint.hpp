@@ -72,7 +72,6 @@ public:
   }
 
   const Eigen::VectorXd& velocity_limit() const { return velocity_limit_; }
-  const BrakingReserveSettings& braking_reserve() const { return reserve_; }
 
 private:
   Eigen::VectorXd velocity_limit_, gain_;
