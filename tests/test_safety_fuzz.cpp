@@ -353,7 +353,17 @@ TEST(SafetyFuzz, FormerFailuresReplayedPass) {
                        // -8.7 and -6.4 mm, before the collision braking row.
                        Case{5150, "push/full_body/kinova_torque/1"}, Case{424243, "push/full_body/kinova_torque/1"},
                        // The QP's fallback brake, clipped on joint 2 at its limit, sped it up: 1.198x.
-                       Case{2718, "push/full_body/custom/17"}}) {
+                       Case{2718, "push/full_body/custom/17"},
+                       // Joints 1 and 3 (one axis near q2 = 0) rang at 250 Hz under the velocity
+                       // guard, 1.139x, before its coupling bound (torque_guards.hpp).
+                       Case{60606, "push/full_body/custom/0"},
+                       // A 189 N step took joint 3 from rest to 1.087x in 8 ms: the guard on the
+                       // two-sample mean acted a cycle late.
+                       Case{31337, "push/full_body/custom/22"},
+                       // Pairs pushed through d_s to contact (-1.65 and -1.49 mm), the QP feasible,
+                       // before the collision guard.
+                       Case{4242, "push/full_body/kinova_torque/21"},
+                       Case{2718, "push/full_body/kinova_torque_high_velocity/5"}}) {
     SCOPED_TRACE(c.run);
     phri::SafetyFuzzOptions o = small_options("");
     o.seed = c.seed;

@@ -1,6 +1,7 @@
 #include <phri/control/controller.hpp>
 
 #include <phri/core/error.hpp>
+#include <phri/control/torque_guards.hpp>
 #include <phri/model/algorithms.hpp>
 
 #include <algorithm>
@@ -88,6 +89,7 @@ const ControllerSettings& checked(const ControllerSettings& settings) {
   if (!(safety.max_qp_fallback_s >= 0 && safety.brake_rate > 0 && safety.handover_speed_rad_s > 0 &&
         safety.max_brake_s > 0 && safety.velocity_guard_fraction > 0 && safety.velocity_guard_fraction <= 1.5 &&
         safety.velocity_guard_rate >= 0 && safety.limit_guard_stiffness_Nm_per_rad >= 0 &&
+        safety.collision_guard_stiffness_N_per_m >= 0 && safety.collision_guard_damping_Ns_per_m >= 0 &&
         safety.external_torque_bound_factor > 0)) {
     throw ConfigError("ControllerSettings", "safety", "rates, speeds and times must be > 0 (guard fraction <= 1.5)");
   }
@@ -169,7 +171,6 @@ Controller::Controller(LoadedRobot robot, const ControllerSettings& settings)
       sensor_frame_(model_.frame_id("ft_sensor")),
       q_(Eigen::VectorXd::Zero(model_.nq())),
       qd_(Eigen::VectorXd::Zero(model_.nv())),
-      previous_qd_(Eigen::VectorXd::Zero(model_.nv())),
       ee_jacobian_(Eigen::MatrixXd::Zero(6, model_.nv())),
       ft_torque_(Eigen::VectorXd::Zero(model_.nv())),
       tau_ext_(Eigen::VectorXd::Zero(model_.nv())),
@@ -188,7 +189,13 @@ Controller::Controller(LoadedRobot robot, const ControllerSettings& settings)
       drive_velocity_limit_(supervisor_.ranges().velocity_limit),
       reflected_inertia_(Eigen::VectorXd::Zero(model_.nv())),
       static_friction_(Eigen::VectorXd::Zero(model_.nv())),
-      drive_torque_(supervisor_.ranges().torque_range) {
+      drive_torque_(supervisor_.ranges().torque_range),
+      guard_excess_(Eigen::VectorXd::Zero(model_.nv())),
+      guard_damping_(Eigen::VectorXd::Zero(model_.nv())),
+      collision_guard_(Eigen::VectorXd::Zero(model_.nv())),
+      guard_inertia_(Eigen::MatrixXd::Zero(model_.nv(), model_.nv())),
+      guard_mobility_(Eigen::MatrixXd::Zero(model_.nv(), model_.nv())),
+      guard_llt_(model_.nv()) {
   observer_.set_release_path(settings.observer_release_gain, settings.observer_release_threshold_Nm,
                              settings.observer_release_speed_fraction * drive_velocity_limit_);
   for (int i = 0; i < model_.nv(); ++i) {
@@ -377,33 +384,62 @@ void Controller::bound_external_torque() {
   }
 }
 
-// The last line behind the QP, on the torque: damping on the excess speed above
-// velocity_guard_fraction of the drive's limit, and beyond a limit's safety distance d_s an
-// outward torque of the joint's static friction plus a spring on the depth (the damper's
-// acceleration alone is below stiction, so a joint could rest there). A guard that acts may go
-// beyond the QP's limit up to kGuardDriveFraction of the drive's peak torque (the rest is K_T's
-// spread: the robot refuses a torque beyond its own peak, safety-fuzz seed 31337 at the full peak).
-// The speed is the mean of the last two samples, whose zero at the Nyquist frequency keeps the
-// guard out of a period-2 limit cycle: scaled by M_ii, it acts several times harder on a coupled
-// pair (the Gen3's joints 1 and 3 near q2 = 0 share an axis), and under Kinova's high-velocity
-// loop joints 1 and 3 rang at the threshold until a release took one to 1.09x (seed 13579).
-// Scaling by 1 / (M^-1)_ii or applying it through the whole M instead weakened the guard where
-// the torque saturates (1.07x to 1.15x in the custom loop, same seed).
-void Controller::guard_torque(Eigen::VectorXd& tau) const {
+// The last lines behind the QP, on the torque (torque_guards.hpp):
+// - velocity guard: damping rate x (M_ii + I_r) on the excess speed above velocity_guard_fraction
+//   of the drive's limit, scaled down where joints that share an axis would make it ring
+//   (guard_coupling_scale). It acts on the latest sample: a 189 N step on the Gen3's half_arm_2_link
+//   took joint 3 from rest to 1.09x in 8 ms, and the two-sample mean used before (against that
+//   ringing) acted one cycle late (safety-fuzz seed 31337, full_body/custom/22; now 0.99x);
+// - limit guard: beyond a limit's safety distance d_s an outward torque of the joint's static
+//   friction plus a spring on the depth (the damper's acceleration alone is below stiction, so a
+//   joint could rest there);
+// - collision guard: capsule pairs inside d_s pushed apart through their distance Jacobian. The
+//   QP's damper asks the same through the acceleration, but under a strong push the torque loops'
+//   tracking error let a pair through d_s to contact (-1.65 mm, seed 4242, full_body/kinova_torque/21,
+//   the QP feasible throughout; now 10.7 mm at the closest).
+// A guard that acts may go beyond the QP's limit up to kGuardDriveFraction of the drive's peak
+// torque (the rest is K_T's spread: the robot refuses a torque beyond its own peak, safety-fuzz
+// seed 31337 at the full peak).
+void Controller::guard_torque(Eigen::VectorXd& tau) {
   constexpr double kGuardDriveFraction = 0.9;
+  // g <= 1.5 in guard_coupling_scale: 1.0 left joint 3 at 1.08x under a push near the elbow's
+  // straight posture (joints 3 and 5 aligned, seed 60606, full_body/custom/23; 1.07x at 1.5),
+  // 2.0 let joints 1 and 3 ring again (1.04x on full_body/custom/0, 0.9994x at 1.5).
+  constexpr double kGuardMaxStep = 1.5;
   const SafetySettings& s = settings_.safety;
-  for (int i = 0; i < model_.nv(); ++i) {
-    const double inertia = data_.mass_matrix(i, i) + reflected_inertia_[i];
-    const double guard_speed = s.velocity_guard_fraction * drive_velocity_limit_[i];
-    const double qd = 0.5 * (qd_[i] + previous_qd_[i]);
-    const double excess = std::abs(qd) - guard_speed;
+  const int n = model_.nv();
+  bool speeding = false;
+  for (int i = 0; i < n; ++i) {
+    guard_excess_[i] = std::max(std::abs(qd_[i]) - s.velocity_guard_fraction * drive_velocity_limit_[i], 0.0);
+    guard_damping_[i] = s.velocity_guard_rate * (data_.mass_matrix(i, i) + reflected_inertia_[i]);
+    speeding = speeding || guard_excess_[i] > 0.0;
+  }
+  double scale = 1.0;
+  if (speeding) {
+    guard_inertia_ = data_.mass_matrix;
+    guard_inertia_.diagonal() += reflected_inertia_;
+    guard_llt_.compute(guard_inertia_);
+    if (guard_llt_.info() == Eigen::Success) {
+      guard_mobility_.setIdentity();
+      guard_llt_.solveInPlace(guard_mobility_);
+      scale = guard_coupling_scale(guard_mobility_, guard_damping_, guard_excess_, settings_.period_s, kGuardMaxStep);
+    }
+  }
+  collision_guard_.setZero();
+  if (const CollisionData* pairs = qp_.collision_data()) {
+    add_collision_guard(*pairs, qp_.settings().collision.safety_distance, s.collision_guard_stiffness_N_per_m,
+                        s.collision_guard_damping_Ns_per_m, collision_guard_);
+  }
+  for (int i = 0; i < n; ++i) {
+    const double excess = guard_excess_[i];
     const double above = q_[i] - qp_.safe_upper()[i], below = qp_.safe_lower()[i] - q_[i];
-    const double limit = excess > 0.0 || above > 0.0 || below > 0.0
+    const double limit = excess > 0.0 || above > 0.0 || below > 0.0 || collision_guard_[i] != 0.0
                              ? std::max(torque_limit_[i], kGuardDriveFraction * drive_torque_[i])
                              : torque_limit_[i];
-    if (excess > 0.0) tau[i] -= std::copysign(s.velocity_guard_rate * inertia * excess, qd);
+    if (excess > 0.0) tau[i] -= std::copysign(scale * guard_damping_[i] * excess, qd_[i]);
     if (above > 0.0) tau[i] -= static_friction_[i] + s.limit_guard_stiffness_Nm_per_rad * above;
     if (below > 0.0) tau[i] += static_friction_[i] + s.limit_guard_stiffness_Nm_per_rad * below;
+    tau[i] += collision_guard_[i];
     tau[i] = std::clamp(tau[i], -limit, limit);
   }
 }
@@ -485,7 +521,6 @@ CycleStatus Controller::step(const RobotState& state, const ControllerTargets& t
   }
   cycles_since_good_ = 0;
   q_ = state.q_rad;
-  previous_qd_ = qd_;
   qd_ = state.qd_rad_s;
   // The observer integrates over the time since the last sample it saw (missed ones included).
   const double dt = had_good ? std::clamp(state.joints.stamp_s - previous_good_stamp, settings_.period_s,

@@ -17,7 +17,7 @@
 // torque and current loops a joint-damping brake on gravity compensation from the last good
 // state, then the robot's position hold at the measured pose; in the position loop, the hold at
 // once. Behind the QP: tau_ext bounded (and a hard stop's reaction never read as a push), a
-// velocity guard and a limit guard on the torque.
+// velocity guard, a limit guard and a collision guard on the torque (torque_guards.hpp).
 // Everything that changes the controller at run time arrives in ControllerTargets: the FSM, the
 // gamepad, a dashboard or a script never reach into its stages.
 #include <phri/control/controller_settings.hpp>
@@ -129,7 +129,7 @@ private:
   void bound_external_torque();
   void update_modes_and_targets();
   void shape_tasks();
-  void guard_torque(Eigen::VectorXd& tau) const;
+  void guard_torque(Eigen::VectorXd& tau);
   void brake_reference();
   void check_qp(WholeBodyQpStatus qp_status, double t);
 
@@ -148,7 +148,6 @@ private:
   int end_effector_frame_ = 0;
   int sensor_frame_ = 0;
   Eigen::VectorXd q_, qd_;
-  Eigen::VectorXd previous_qd_;  // the last good sample's velocity (the guard's two-sample mean)
   std::uint32_t last_joint_sequence_ = 0;
   std::uint32_t last_wrench_sequence_ = 0;
   bool started_ = false;
@@ -174,6 +173,10 @@ private:
   Eigen::VectorXd limit_lower_, limit_upper_;       // URDF limits (±inf: continuous)
   Eigen::VectorXd torque_limit_, drive_velocity_limit_, reflected_inertia_, static_friction_;
   Eigen::VectorXd drive_torque_;  // the drives' peak motor torque
+  // The guards' working memory (guard_torque): excess speed, damping, collision torque, M + I_r and its inverse
+  Eigen::VectorXd guard_excess_, guard_damping_, collision_guard_;
+  Eigen::MatrixXd guard_inertia_, guard_mobility_;
+  Eigen::LLT<Eigen::MatrixXd> guard_llt_;
 };
 
 }  // namespace phri

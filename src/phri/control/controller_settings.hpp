@@ -52,7 +52,8 @@ struct SafetySettings {
   /// [s] longest brake before the hand-over, whatever the speed.
   double max_brake_s = 1.0;
   /// Velocity guard of the torque loops, the last line behind the QP's velocity constraint: above
-  /// guard_fraction x the drive's velocity limit, damping rate x (M_ii + I_r) x the excess.
+  /// guard_fraction x the drive's velocity limit, damping rate x (M_ii + I_r) x the excess, scaled
+  /// down where coupled joints would ring (torque_guards.hpp).
   double velocity_guard_fraction = 0.9;
   /// [1/s] Replaying the runs of safety-fuzz seeds 4242 and 2026 with controller failures (17
   /// overspeed windows at 200): 5 left at 300; 400 (measured beside a check since removed) left 3;
@@ -64,6 +65,12 @@ struct SafetySettings {
   /// a hand pressing it in meets a growing answer: ~50 N.m at the URDF limit (d_s 0.05 rad on the
   /// Gen3). At 200 a 160 N push held joint 4 0.2 mrad past its limit (safety-fuzz seed 8642).
   double limit_guard_stiffness_Nm_per_rad = 1000.0;
+  /// Collision guard: a capsule pair closer than the damper's safety distance d_s is pushed apart
+  /// through its distance Jacobian, J_d^T (stiffness x depth + damping x approach speed)
+  /// (torque_guards.hpp). 6000 N/m answers 90 N at contact (d_s 15 mm); 150 N.s/m is critical
+  /// damping (2 sqrt(k m)) for 1 kg along the pair's normal.
+  double collision_guard_stiffness_N_per_m = 6000.0;
+  double collision_guard_damping_Ns_per_m = 150.0;
   /// |tau_ext| used by the QP is bounded by this factor x the joint's torque limit: more than the
   /// arm can resist is not a push the controller can act on (a spike, a stop).
   double external_torque_bound_factor = 1.5;
