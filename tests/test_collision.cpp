@@ -1,6 +1,8 @@
 // ctest-labels: unit
 // Capsule self-collision geometry: segment closest points against a brute-force minimisation,
-// distance Jacobians and J̇q̇ against finite differences, collision YAML validation.
+// distance Jacobians and J̇q̇ against finite differences, collision YAML validation; the collision
+// guard against its formula and, from rest, against the distance it opens.
+#include <phri/control/torque_guards.hpp>
 #include <phri/core/error.hpp>
 #include <phri/model/algorithms.hpp>
 #include <phri/model/capsule_distance.hpp>
@@ -11,6 +13,9 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Cholesky>
+
+#include <algorithm>
 #include <random>
 
 namespace {
@@ -133,6 +138,66 @@ TEST_F(Gen3Collision, DistanceJacobianAndBiasMatchFiniteDifferences) {
     }
   }
   EXPECT_GT(checked, 1000);
+}
+
+// The collision guard (torque_guards.hpp, Controller::guard_torque).
+TEST_F(Gen3Collision, TorqueIsTheFormulaOnThePairsInsideTheSafetyDistance) {
+  Eigen::VectorXd q(7), qd(7);
+  q << 0, 1.2, 0, 2.5, 0, 2.0, 0;  // folded: some pairs close
+  qd << 0.3, -0.2, 0.1, 0.4, -0.3, 0.2, 0.1;
+  phri::compute_all_terms(model_, data_, q, qd);
+  phri::compute_collision_distances(model_, data_, collision_, out_, true);
+  const double safety_distance = out_.distance.minCoeff() + 0.02;  // some pairs inside, not all
+  const double k = 6000.0, c = 150.0;
+  Eigen::VectorXd tau = Eigen::VectorXd::Constant(7, 1.0), expected = tau;
+  int inside = 0;
+  for (int p = 0; p < collision_.num_pairs(); ++p) {
+    if (out_.distance[p] >= safety_distance) continue;
+    ++inside;
+    const double force = k * (safety_distance - out_.distance[p]) + c * std::max(-out_.velocity[p], 0.0);
+    expected += force * out_.jacobian.row(p).transpose();
+  }
+  ASSERT_GT(inside, 0);
+  ASSERT_LT(inside, collision_.num_pairs());
+  EXPECT_TRUE(phri::add_collision_guard(out_, safety_distance, k, c, tau));
+  EXPECT_TRUE(tau.isApprox(expected, 1e-14));
+  // Every pair outside: nothing added.
+  Eigen::VectorXd untouched = Eigen::VectorXd::Constant(7, 1.0);
+  EXPECT_FALSE(phri::add_collision_guard(out_, out_.distance.minCoeff() - 1e-3, k, c, untouched));
+  EXPECT_EQ(untouched, Eigen::VectorXd::Constant(7, 1.0));
+}
+
+// From rest the guard's torque alone accelerates the arm by M^-1 tau; after a short time h the
+// pair inside d_s must have opened by h^2 / 2 J M^-1 J^T F > 0, measured on the distances
+// themselves (no Jacobian): the torque separates the pair it answers.
+TEST_F(Gen3Collision, FromRestTheTorqueOpensThePair) {
+  Eigen::VectorXd q(7);
+  q << 0, 1.2, 0, 2.5, 0, 2.0, 0;
+  const Eigen::VectorXd rest = Eigen::VectorXd::Zero(7);
+  phri::compute_all_terms(model_, data_, q, rest);
+  phri::compute_collision_distances(model_, data_, collision_, out_, true);
+  int closest = 0;
+  const double d0 = out_.distance.minCoeff(&closest);
+  const double safety_distance = d0 + 0.005;
+  // Only the closest pair inside d_s.
+  Eigen::VectorXd sorted = out_.distance;
+  std::sort(sorted.data(), sorted.data() + sorted.size());
+  ASSERT_GT(sorted[1], safety_distance);
+  Eigen::VectorXd tau = Eigen::VectorXd::Zero(7);
+  ASSERT_TRUE(phri::add_collision_guard(out_, safety_distance, 6000.0, 150.0, tau));
+  const Eigen::LLT<Eigen::MatrixXd> inertia(data_.mass_matrix);
+  const Eigen::VectorXd qdd = inertia.solve(tau);
+  const double h = 1e-3, force = 6000.0 * 0.005;
+  const Eigen::VectorXd jacobian = out_.jacobian.row(closest).transpose();
+  const double predicted = 0.5 * h * h * force * jacobian.dot(inertia.solve(jacobian));
+  phri::forward_kinematics(model_, data_, q + 0.5 * h * h * qdd);
+  phri::CollisionData after(model_, collision_);
+  phri::compute_collision_distances(model_, data_, collision_, after, false);
+  const double opened = after.distance[closest] - d0;
+  EXPECT_GT(opened, 0.0);
+  EXPECT_NEAR(opened, predicted, 1e-3 * predicted);
+  std::printf("closest pair %d at %.2f mm: opened %.3e m in 1 ms from rest (predicted %.3e)\n", closest, 1e3 * d0,
+              opened, predicted);
 }
 
 TEST_F(Gen3Collision, DistancesDoNotAllocate) {

@@ -1,10 +1,7 @@
 // ctest-labels: unit
-// The torque guards behind the QP (torque_guards.hpp): the velocity guard's coupling bound against
-// the eigenvalues it bounds and a closed-form pair of joints on one axis; the collision guard
-// against its formula and, from rest, against the distance it opens (finite differences).
+// The velocity guard's coupling bound (torque_guards.hpp) against the eigenvalues it bounds and a
+// closed-form pair of joints on one axis. The collision guard's tests are in test_collision.cpp.
 #include <phri/control/torque_guards.hpp>
-#include <phri/model/algorithms.hpp>
-#include <phri/model/collision_model.hpp>
 
 #include <gtest/gtest.h>
 
@@ -16,7 +13,6 @@
 
 namespace {
 
-const std::string kGen3 = std::string(PHRI_SOURCE_DIR) + "/robots/kinova_gen3/";
 constexpr double kPeriod = 1e-3;
 
 // The largest eigenvalue of T D^1/2 (M^-1)_SS D^1/2 over the guarded set S, by Eigen's solver.
@@ -104,73 +100,6 @@ TEST(GuardCouplingScale, StopsTheRingingOfTwoJointsOnOneAxis) {
   // Scaled: lambda <= 1.5, the excess decays.
   EXPECT_LT(worst_factor(scale), 1.0);
   EXPECT_LT(final_excess(scale), 0.1 * 0.1);
-}
-
-class Gen3CollisionGuard : public ::testing::Test {
-protected:
-  phri::Model model_ = phri::Model::from_urdf_file(kGen3 + "gen3.urdf");
-  phri::CollisionModel collision_ = phri::CollisionModel::from_yaml_file(kGen3 + "collision.yaml", model_);
-  phri::Data data_{model_};
-  phri::CollisionData pairs_{model_, collision_};
-};
-
-TEST_F(Gen3CollisionGuard, TorqueIsTheFormulaOnThePairsInsideTheSafetyDistance) {
-  Eigen::VectorXd q(7), qd(7);
-  q << 0, 1.2, 0, 2.5, 0, 2.0, 0;  // folded: some pairs close
-  qd << 0.3, -0.2, 0.1, 0.4, -0.3, 0.2, 0.1;
-  phri::compute_all_terms(model_, data_, q, qd);
-  phri::compute_collision_distances(model_, data_, collision_, pairs_, true);
-  const double safety_distance = pairs_.distance.minCoeff() + 0.02;  // some pairs inside, not all
-  const double k = 6000.0, c = 150.0;
-  Eigen::VectorXd tau = Eigen::VectorXd::Constant(7, 1.0), expected = tau;
-  int inside = 0;
-  for (int p = 0; p < collision_.num_pairs(); ++p) {
-    if (pairs_.distance[p] >= safety_distance) continue;
-    ++inside;
-    const double force = k * (safety_distance - pairs_.distance[p]) + c * std::max(-pairs_.velocity[p], 0.0);
-    expected += force * pairs_.jacobian.row(p).transpose();
-  }
-  ASSERT_GT(inside, 0);
-  ASSERT_LT(inside, collision_.num_pairs());
-  EXPECT_TRUE(phri::add_collision_guard(pairs_, safety_distance, k, c, tau));
-  EXPECT_TRUE(tau.isApprox(expected, 1e-14));
-  // Every pair outside: nothing added.
-  Eigen::VectorXd untouched = Eigen::VectorXd::Constant(7, 1.0);
-  EXPECT_FALSE(phri::add_collision_guard(pairs_, pairs_.distance.minCoeff() - 1e-3, k, c, untouched));
-  EXPECT_EQ(untouched, Eigen::VectorXd::Constant(7, 1.0));
-}
-
-// From rest the guard's torque alone accelerates the arm by M^-1 tau; after a short time h the
-// pair inside d_s must have opened by h^2 / 2 J M^-1 J^T F > 0, measured on the distances
-// themselves (no Jacobian): the torque separates the pair it answers.
-TEST_F(Gen3CollisionGuard, FromRestTheTorqueOpensThePair) {
-  Eigen::VectorXd q(7);
-  q << 0, 1.2, 0, 2.5, 0, 2.0, 0;
-  const Eigen::VectorXd rest = Eigen::VectorXd::Zero(7);
-  phri::compute_all_terms(model_, data_, q, rest);
-  phri::compute_collision_distances(model_, data_, collision_, pairs_, true);
-  int closest = 0;
-  const double d0 = pairs_.distance.minCoeff(&closest);
-  const double safety_distance = d0 + 0.005;
-  // Only the closest pair inside d_s.
-  Eigen::VectorXd sorted = pairs_.distance;
-  std::sort(sorted.data(), sorted.data() + sorted.size());
-  ASSERT_GT(sorted[1], safety_distance);
-  Eigen::VectorXd tau = Eigen::VectorXd::Zero(7);
-  ASSERT_TRUE(phri::add_collision_guard(pairs_, safety_distance, 6000.0, 150.0, tau));
-  const Eigen::LLT<Eigen::MatrixXd> inertia(data_.mass_matrix);
-  const Eigen::VectorXd qdd = inertia.solve(tau);
-  const double h = 1e-3, force = 6000.0 * 0.005;
-  const Eigen::VectorXd jacobian = pairs_.jacobian.row(closest).transpose();
-  const double predicted = 0.5 * h * h * force * jacobian.dot(inertia.solve(jacobian));
-  phri::forward_kinematics(model_, data_, q + 0.5 * h * h * qdd);
-  phri::CollisionData after(model_, collision_);
-  phri::compute_collision_distances(model_, data_, collision_, after, false);
-  const double opened = after.distance[closest] - d0;
-  EXPECT_GT(opened, 0.0);
-  EXPECT_NEAR(opened, predicted, 1e-3 * predicted);
-  std::printf("closest pair %d at %.2f mm: opened %.3e m in 1 ms from rest (predicted %.3e)\n", closest, 1e3 * d0,
-              opened, predicted);
 }
 
 }  // namespace
