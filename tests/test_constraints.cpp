@@ -109,6 +109,63 @@ TEST_F(ConstraintTest, VelocityLimitBoundsVanishAtTheLimitAndConvergeAtTheirGain
   EXPECT_NEAR(speed - 1.2, 1.2 * std::exp(-50.0 * 0.1), 1e-4);
 }
 
+// Return gain (VelocityLimitConstraint::deceleration), against its closed form: below the limit the
+// paper's bound; beyond it return_gain x the excess, but never more deceleration than the
+// direction's reserve gives (reserve / M_ii), nor less than the paper's gain asks.
+TEST_F(ConstraintTest, BeyondTheLimitTheBoundReturnsAtItsGainWithinTheReserve) {
+  const Eigen::VectorXd v = Eigen::VectorXd::Constant(7, 2.0), gain = Eigen::VectorXd::Constant(7, 50.0);
+  const Eigen::VectorXd tau_max = Eigen::VectorXd::Constant(7, 100.0), inertia = Eigen::VectorXd::Constant(7, 0.5);
+  phri::VelocityLimitConstraint paper(v, gain, {0.3, 0.5, 0.0});
+  phri::VelocityLimitConstraint limit(v, gain, {0.3, 0.5, 200.0});
+  Eigen::VectorXd lower(7), upper(7), paper_lower(7), paper_upper(7);
+  Eigen::VectorXd qd = Eigen::VectorXd::LinSpaced(7, -1.9, 1.9), hold = Eigen::VectorXd::Zero(7);
+  // Within the limits: identical.
+  limit.bound(qd, hold, tau_max, inertia, lower, upper);
+  paper.bound(qd, hold, tau_max, inertia, paper_lower, paper_upper);
+  EXPECT_EQ(lower, paper_lower);
+  EXPECT_EQ(upper, paper_upper);
+  EXPECT_FALSE(limit.returning());
+  // 0.3 rad/s beyond +2 with the whole reserve (100 N.m, 200 rad/s^2 on 0.5 kg.m^2): 200 x 0.3 = 60
+  // rad/s^2, four times the paper's 15. Mirror image below -2.
+  qd.setConstant(2.3);
+  limit.bound(qd, hold, tau_max, inertia, lower, upper);
+  paper.bound(qd, hold, tau_max, inertia, paper_lower, paper_upper);
+  EXPECT_NEAR(paper_upper[0], -15.0, 1e-9);
+  EXPECT_NEAR(upper[0], -60.0, 1e-9);
+  EXPECT_TRUE(limit.returning());
+  // Without it (WholeBodyQp's second solve when the QP is infeasible with it): the paper's bound.
+  limit.bound(qd, hold, tau_max, inertia, lower, upper, false);
+  EXPECT_EQ(upper, paper_upper);
+  EXPECT_FALSE(limit.returning());
+  qd.setConstant(-2.3);
+  limit.bound(qd, hold, tau_max, inertia, lower, upper);
+  EXPECT_NEAR(lower[0], 60.0, 1e-9);
+  // A push holding -75 N.m leaves 25 N.m to brake a + motion (50 rad/s^2) and lowers the + limit
+  // to 25 / 30 of 2: 1.667 rad/s, 0.633 below 2.3. The paper's gain asks 31.7 rad/s^2, the return
+  // gain 126.7: the reserve's 50 is asked.
+  qd.setConstant(2.3);
+  hold.setConstant(-75.0);
+  limit.bound(qd, hold, tau_max, inertia, lower, upper);
+  paper.bound(qd, hold, tau_max, inertia, paper_lower, paper_upper);
+  EXPECT_NEAR(paper_upper[0], -50.0 * (2.3 - 2.0 * 25.0 / 30.0), 1e-9);
+  EXPECT_NEAR(upper[0], -50.0, 1e-9);
+  // No reserve left: the paper's bound alone (which asks nothing the torque cannot give).
+  hold.setConstant(-100.0);
+  limit.bound(qd, hold, tau_max, inertia, lower, upper);
+  paper.bound(qd, hold, tau_max, inertia, paper_lower, paper_upper);
+  EXPECT_EQ(upper[0], paper_upper[0]);
+  // Riding the bound from 2.6 rad/s with the whole reserve: the excess decays as exp(-200 t).
+  hold.setZero();
+  double speed = 2.6;
+  const double dt = 1e-5;
+  for (int k = 0; k < 1000; ++k) {
+    qd.setConstant(speed);
+    limit.bound(qd, hold, tau_max, inertia, lower, upper);
+    speed += dt * upper[0];
+  }
+  EXPECT_NEAR(speed - 2.0, 0.6 * std::exp(-200.0 * 0.01), 1e-3);
+}
+
 // Braking reserve (velocity_limit_constraint.hpp), against its closed form: full limit from
 // reserve_fraction x tau_max of reserve, linear below, min_speed_fraction at none; a joint faster
 // than its lowered limit is asked exactly the deceleration its reserve gives.
@@ -116,7 +173,7 @@ TEST_F(ConstraintTest, BrakingReserveLowersTheLimitTowardAPushThatTakesTheTorque
   const Eigen::VectorXd v = Eigen::VectorXd::Constant(7, 2.0), gain = Eigen::VectorXd::Constant(7, 80.0);
   const Eigen::VectorXd tau_max = Eigen::VectorXd::Constant(7, 100.0), inertia = Eigen::VectorXd::Constant(7, 0.5);
   const phri::VelocityLimitConstraint plain(v, gain);
-  const phri::VelocityLimitConstraint limit(v, gain, {0.3, 0.5});
+  phri::VelocityLimitConstraint limit(v, gain, {0.3, 0.5, 0.0});
   Eigen::VectorXd qd = Eigen::VectorXd::LinSpaced(7, -1.5, 1.5), hold = Eigen::VectorXd::Zero(7);
   Eigen::VectorXd lower(7), upper(7), plain_lower(7), plain_upper(7);
   // Plenty of reserve both ways (|hold| <= 70 % of tau_max): the paper's bounds, bit for bit.

@@ -462,7 +462,13 @@ TEST(Fsm, DemoYamlSession) {
   const std::vector<S> expected = {S::kStartup, S::kStatic, S::kDynamic, S::kStatic, S::kStopped};
   ASSERT_EQ(transitions.size(), expected.size()) << describe(transitions);
   for (std::size_t i = 0; i < expected.size(); ++i) EXPECT_EQ(transitions[i].state, expected[i]) << i;
-  EXPECT_NEAR(transitions[2].time, 22.0, 2e-3);  // the static pose was reached again before 22 s
+  // The script asks for the dynamic scenario at 22 s; the FSM starts it once the static move back
+  // to the pose and posture the hand left has come to rest. How long that move takes depends on
+  // where the elbow push and the hand left the joints (the null-space motion of the pushes runs
+  // joints 1 and 3 to their velocity bound): 22.000 s with the paper's bound alone, 22.2-22.5 s
+  // with the return gain at 100-400/s (velocity_limit_constraint.hpp).
+  EXPECT_GE(transitions[2].time, 22.0 - 2e-3);
+  EXPECT_LT(transitions[2].time, 22.6);
   EXPECT_TRUE(fsm.finished());
   EXPECT_TRUE(all_ok);
   EXPECT_LT(elbow_ee_error, 0.003);

@@ -267,9 +267,10 @@ void parse_qp(const YamlReader& q, const ActuatorTable& drives, WholeBodyQpSetti
   s.velocity_limit_gain = positive_or(q, "velocity_limit_gain", s.velocity_limit_gain, kMaxTaskDamping_per_s);
   if (q.has("braking_reserve")) {
     const YamlReader b = q.at("braking_reserve");
-    b.allow_keys({"reserve_fraction", "min_speed_fraction"});
+    b.allow_keys({"reserve_fraction", "min_speed_fraction", "return_gain"});
     s.braking_reserve.reserve_fraction = b.number_or("reserve_fraction", s.braking_reserve.reserve_fraction, 0.0, 1.0);
     s.braking_reserve.min_speed_fraction = b.number_or("min_speed_fraction", s.braking_reserve.min_speed_fraction, 0.05, 1.0);
+    s.braking_reserve.return_gain = b.number_or("return_gain", s.braking_reserve.return_gain, 0.0, kMaxTaskDamping_per_s);
   }
   if (q.has("collision")) parse_collision_damper(q.at("collision"), s.collision);
   if (q.has("collision_braking")) {

@@ -30,8 +30,8 @@ WholeBodyQp::Limits WholeBodyQp::checked_limits(const Model& model, const WholeB
   }
   const BrakingReserveSettings& reserve = settings.braking_reserve;
   if (!(reserve.reserve_fraction >= 0 && reserve.reserve_fraction <= 1 && reserve.min_speed_fraction > 0 &&
-        reserve.min_speed_fraction <= 1)) {
-    fail("braking_reserve", "reserve_fraction must be in [0, 1] and min_speed_fraction in (0, 1]");
+        reserve.min_speed_fraction <= 1 && reserve.return_gain >= 0 && std::isfinite(reserve.return_gain))) {
+    fail("braking_reserve", "reserve_fraction must be in [0, 1], min_speed_fraction in (0, 1] and return_gain finite and >= 0");
   }
   if (!(settings.collision_braking.deceleration >= 0 && std::isfinite(settings.collision_braking.deceleration) &&
         settings.collision_braking.gain > 0 && std::isfinite(settings.collision_braking.gain))) {
@@ -91,10 +91,10 @@ WholeBodyQp::WholeBodyQp(const Model& model, const CollisionModel* collision, co
 // Acceleration bounds from the velocity limits and the joint-limit dampers (paper: qdd_d <=
 // min(ë_p, ë_v) for an upper limit, >= max(...) for a lower one).
 void WholeBodyQp::joint_bounds(const Data& data, const Eigen::VectorXd& q, const Eigen::VectorXd& qd,
-                               const Eigen::VectorXd& tau_ext) {
+                               const Eigen::VectorXd& tau_ext, bool with_return) {
   hold_torque_ = data.nonlinear_effects - tau_ext;
   inertia_diagonal_ = data.mass_matrix.diagonal();
-  velocity_limit_.bound(qd, hold_torque_, torque_limit(), inertia_diagonal_, problem_.lb, problem_.ub);
+  velocity_limit_.bound(qd, hold_torque_, torque_limit(), inertia_diagonal_, problem_.lb, problem_.ub, with_return);
   joint_limits_.tighten(q, qd, problem_.lb, problem_.ub);
   for (int i = 0; i < nv_; ++i) {
     // Both limits bind (e.g. beyond one): split the difference.
@@ -132,6 +132,12 @@ WholeBodyQpStatus WholeBodyQp::update(const Model& model, const Data& data, cons
   }
 
   QpStatus qp = solver_.solve(problem_, {.warm_start = warm_, .reuse_hessian_factor = false});
+  if (qp == QpStatus::kInfeasible && velocity_limit_.returning()) {
+    // The return gain is a comfort beyond the paper's bound too (its reserve is M's diagonal's,
+    // the coupled joints may need more): the paper's bounds rather than the fallback.
+    joint_bounds(data, q, qd, tau_ext, false);
+    qp = solver_.solve(problem_, {.warm_start = false, .reuse_hessian_factor = false});
+  }
   if (qp == QpStatus::kInfeasible && self_collision_ && self_collision_->braking_binds()) {
     // The braking rows are a comfort ahead of the damper: without them rather than the fallback.
     problem_.l.segment(nv_, num_pairs_) = self_collision_->damper_lower();

@@ -123,7 +123,8 @@ private:
   static Limits checked_limits(const Model& model, const WholeBodyQpSettings& settings);
   WholeBodyQp(const Model& model, const CollisionModel* collision, const WholeBodyQpSettings& settings,
               const Limits& limits);
-  void joint_bounds(const Data& data, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, const Eigen::VectorXd& tau_ext);
+  void joint_bounds(const Data& data, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, const Eigen::VectorXd& tau_ext,
+                    bool with_return = true);
   void fallback_brake(const Data& data, const Eigen::VectorXd& qd, const Eigen::VectorXd& tau_ext);
 
   WholeBodyQpSettings settings_;
