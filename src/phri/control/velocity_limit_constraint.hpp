@@ -35,7 +35,7 @@ class VelocityLimitConstraint {
 public:
   VelocityLimitConstraint(const Eigen::VectorXd& velocity_limit, const Eigen::VectorXd& gain,
                           const BrakingReserveSettings& reserve = {0.0, 1.0, 0.0})
-      : velocity_limit_(velocity_limit), gain_(gain), reserve_(reserve), return_gain_(reserve.return_gain) {}
+      : velocity_limit_(velocity_limit), gain_(gain), reserve_(reserve) {}
 
   /// Sets the acceleration bounds from the velocity limits.
   void bound(const Eigen::VectorXd& qd, Eigen::VectorXd& lower, Eigen::VectorXd& upper) const {
@@ -52,13 +52,12 @@ public:
   void bound(const Eigen::VectorXd& qd, const Eigen::VectorXd& hold, const Eigen::VectorXd& torque_limit,
              const Eigen::VectorXd& inertia, Eigen::VectorXd& lower, Eigen::VectorXd& upper, bool with_return = true) {
     returning_ = false;
-    with_return_ = with_return;
     for (int i = 0; i < qd.size(); ++i) {
       const double up_reserve = torque_limit[i] + hold[i], down_reserve = torque_limit[i] - hold[i];
       const double up = speed_limit(i, up_reserve, torque_limit[i], qd[i], inertia[i]);
       const double down = speed_limit(i, down_reserve, torque_limit[i], -qd[i], inertia[i]);
-      upper[i] = -deceleration(i, qd[i] - up, up_reserve, inertia[i]);
-      lower[i] = deceleration(i, -qd[i] - down, down_reserve, inertia[i]);
+      upper[i] = -deceleration(i, qd[i] - up, up_reserve, inertia[i], with_return);
+      lower[i] = deceleration(i, -qd[i] - down, down_reserve, inertia[i], with_return);
     }
   }
 
@@ -70,10 +69,10 @@ public:
   /// 30 ms (safety-fuzz seed 60606, full_body/custom/23). Unbounded by the reserve, the return gain
   /// made the QP infeasible under a push that took 91 % of a joint's torque (1.29x after the safe
   /// stop, same seed, full_body/custom/10).
-  double deceleration(int i, double over, double reserve, double inertia) {
+  double deceleration(int i, double over, double reserve, double inertia, bool with_return) {
     const double paper = gain_[i] * over;
-    if (!with_return_ || !(over > 0.0) || !(return_gain_ > gain_[i])) return paper;
-    const double returning = std::min(return_gain_ * over, std::max(reserve, 0.0) / inertia);
+    if (!with_return || !(over > 0.0) || !(reserve_.return_gain > gain_[i])) return paper;
+    const double returning = std::min(reserve_.return_gain * over, std::max(reserve, 0.0) / inertia);
     if (!(returning > paper)) return paper;
     returning_ = true;
     return returning;
@@ -104,8 +103,7 @@ public:
 private:
   Eigen::VectorXd velocity_limit_, gain_;
   BrakingReserveSettings reserve_;
-  double return_gain_ = 0.0;
-  bool with_return_ = true, returning_ = false;
+  bool returning_ = false;  // the last bound() asked more than the paper's gain somewhere
 };
 
 }  // namespace phri

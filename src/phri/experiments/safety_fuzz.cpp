@@ -17,8 +17,8 @@
 #include <cmath>
 #include <exception>
 #include <fstream>
-#include <limits>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <mutex>
 #include <optional>
