@@ -301,6 +301,49 @@ TEST(Safety, AnUnstableObserverGainIsRefusedAndAQpThatKeepsFailingStopsSafely) {
   EXPECT_LT(rig.qd().cwiseAbs().maxCoeff(), 0.01);
 }
 
+// A push the QP cannot answer (its torque limits lowered to a third here; the drives keep theirs):
+// the QP falls back, then the safe stop. Its brake was gravity compensation and damping only; the
+// push it dropped then flung the arm (safety-fuzz seed 24680, full_body/custom/3: 2.66x the
+// velocity limit, a joint past its limit, -34 mm collision). The brake goes on resisting the push
+// it saw, as the QP's fallback did, up to the drive's torque. Before: 1.07x and 1.02 rad after the
+// stop (stiff, 70 N), 0.75 rad (full body, 50 N); now 0.12 and 0.11 rad, below the limit.
+TEST(Safety, ASafeStopAfterTheQpFailedUnderAPushKeepsResistingIt) {
+  struct Case {
+    phri::ComplianceMode mode;
+    double force_N;
+  };
+  for (const Case& c : {Case{phri::ComplianceMode::kStiff, 70.0}, Case{phri::ComplianceMode::kFullBody, 50.0}}) {
+    SCOPED_TRACE(std::string(phri::to_string(c.mode)));
+    const Eigen::Vector3d force = c.force_N * joint_direction("bracelet_link", 1);
+    Rig rig(c.mode, phri::LowLevelMode::kCurrent, {hand_push("bracelet_link", Eigen::Vector3d::Zero(), force, 0.5, 2.0)},
+            [](phri::ControllerSettings& s) {
+              s.qp.torque_limit.resize(7);
+              s.qp.torque_limit << 30, 30, 30, 30, 8, 15, 8;
+            });
+    bool stopped = false;
+    double ratio_after = 0.0, moved_after = 0.0;
+    Eigen::VectorXd q_stop;
+    rig.run(3.0, {}, [&]() {
+      if (!stopped && rig.cycle_.status() == phri::CycleStatus::kSafeStop) {
+        stopped = true;
+        q_stop = rig.q();
+      }
+      if (!stopped) return;
+      ratio_after = std::max(ratio_after, rig.qd().cwiseQuotient(rig.velocity_limit_).cwiseAbs().maxCoeff());
+      moved_after = std::max(moved_after, distance(rig.q(), q_stop));
+    });
+    std::printf("%.0f N on the bracelet, %s: after the safe stop max |qd| / limit %.3f, moved %.3f rad\n", c.force_N,
+                std::string(phri::to_string(c.mode)).c_str(), ratio_after, moved_after);
+    ASSERT_TRUE(stopped);
+    EXPECT_EQ(rig.cycle_.supervisor().safe_stop_transition().reason, phri::SafetyFault::kQpFailure);
+    EXPECT_LT(ratio_after, 1.0);
+    EXPECT_LT(moved_after, 0.25);
+    EXPECT_TRUE(rig.cycle_.holding());
+    EXPECT_LT(rig.qd().cwiseAbs().maxCoeff(), 0.01);
+    EXPECT_LE(rig.limit_excess_, 0.0);
+  }
+}
+
 // Defect 6: with NaN on q2 for 2.5 s, the torque loops repeated the last torque or current command
 // for the whole time and the arm moved 5-6 rad. Now: a brake, then the robot's position hold,
 // which also resists a push meanwhile.

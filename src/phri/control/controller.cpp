@@ -310,7 +310,8 @@ void Controller::hold_previous(const RobotState& state, RobotCommand& command) {
 // The latched safe stop. Position loop (or no command yet): the robot's position hold at once.
 // Torque and current loops: gravity compensation with joint damping on the last good velocity
 // (decaying at brake_rate while no good sample comes: a stale velocity is not repeated for ever),
-// then, at rest or after max_brake_s, the hand-over to the position hold at the measured pose.
+// after a QP failure also -tau_ext while the samples stay good, then, at rest or after
+// max_brake_s, the hand-over to the position hold at the measured pose.
 void Controller::safe_stop(bool sample_good, RobotCommand& command) {
   status_ = CycleStatus::kSafeStop;
   const SafetySettings& s = settings_.safety;
@@ -319,6 +320,7 @@ void Controller::safe_stop(bool sample_good, RobotCommand& command) {
   if (safe_stop_cycles_++ == 0) {
     const bool position_loop = have_command_ && low_level_.loop() == LowLevelMode::kPosition;
     holding_ = !have_command_ || position_loop || !supervisor_.has_good();
+    brake_against_push_ = !holding_ && supervisor_.safe_stop_transition().reason == SafetyFault::kQpFailure;
     hold_q_ = supervisor_.has_good() ? good.q_rad : q_;
     hold_qd_.setZero();
     // In the position loop the reference brakes from where it is (kept within the following
@@ -344,14 +346,18 @@ void Controller::safe_stop(bool sample_good, RobotCommand& command) {
     low_level_.hold(hold_q_, command);
     return;
   }
+  // A push the QP could not answer goes on being resisted (see step()); after a sensor fault the
+  // estimate is not trusted (a phantom push would be driven, defect 1 of issue 14).
+  if (!sample_good) brake_against_push_ = false;
   brake_tau_.setZero();  // zero velocity: data_.nonlinear_effects = g(q)
   compute_all_terms(model_, data_, brake_q_, brake_tau_);
   for (int i = 0; i < model_.nv(); ++i) {
     const double inertia = data_.mass_matrix(i, i) + reflected_inertia_[i];
-    // Gravity up to what the drive gives (the arm must not fall, whatever the QP's limit), the
-    // damping within the QP's torque limit.
+    // Gravity (and the push) up to what the drive gives (the arm must not fall, whatever the QP's
+    // limit), the damping within the QP's torque limit.
     const double damping = std::clamp(-s.brake_rate * inertia * brake_qd_[i], -torque_limit_[i], torque_limit_[i]);
-    brake_tau_[i] = std::clamp(data_.nonlinear_effects[i] + damping, -drive_torque_[i], drive_torque_[i]);
+    const double push = brake_against_push_ ? tau_ext_[i] : 0.0;
+    brake_tau_[i] = std::clamp(data_.nonlinear_effects[i] - push + damping, -drive_torque_[i], drive_torque_[i]);
   }
   low_level_.command_torque(brake_tau_, command);
 }
@@ -512,7 +518,22 @@ CycleStatus Controller::step(const RobotState& state, const ControllerTargets& t
   const bool had_good = supervisor_.has_good();
   const double previous_good_stamp = supervisor_.last_good_time();
   const bool good = supervisor_.check(state);
+  // The observer integrates over the time since the last sample it saw (missed ones included).
+  const double dt = had_good ? std::clamp(state.joints.stamp_s - previous_good_stamp, settings_.period_s,
+                                          settings_.period_s + supervisor_.settings().max_degraded_s)
+                             : settings_.period_s;
   if (supervisor_.safe_stop()) {
+    // After a QP failure (the samples good, a push beyond what the constraints could answer) the
+    // brake keeps resisting the push as the QP's fallback did: dropping it flung the arm (safety-
+    // fuzz seed 24680, full_body/custom/3: a 154 N step on bracelet_link, joint 6 from 0.76x to
+    // 2.66x its velocity limit within 60 ms of the safe stop). The estimate stays current.
+    if (good && brake_against_push_ && !holding_) {
+      q_ = state.q_rad;
+      qd_ = state.qd_rad_s;
+      estimate(state, dt);
+      select_external_torque();
+      bound_external_torque();
+    }
     safe_stop(good, command);
     return status_;
   }
@@ -523,10 +544,6 @@ CycleStatus Controller::step(const RobotState& state, const ControllerTargets& t
   cycles_since_good_ = 0;
   q_ = state.q_rad;
   qd_ = state.qd_rad_s;
-  // The observer integrates over the time since the last sample it saw (missed ones included).
-  const double dt = had_good ? std::clamp(state.joints.stamp_s - previous_good_stamp, settings_.period_s,
-                                          settings_.period_s + supervisor_.settings().max_degraded_s)
-                             : settings_.period_s;
   estimate(state, dt);
 
   // ---- modes and targets

@@ -15,8 +15,8 @@
 // Beyond that, or on a fault found elsewhere (the QP failing for max_qp_fallback_s, a refused
 // write reported by the loop through report_fault(), a robot fault), a latched safe stop: in the
 // torque and current loops a joint-damping brake on gravity compensation from the last good
-// state, then the robot's position hold at the measured pose; in the position loop, the hold at
-// once. Behind the QP: tau_ext bounded (and a hard stop's reaction never read as a push), a
+// state (after a QP failure, with the samples good, also resisting the push the observer sees),
+// then the robot's position hold at the measured pose; in the position loop, the hold at once. Behind the QP: tau_ext bounded (and a hard stop's reaction never read as a push), a
 // velocity guard, a limit guard and a collision guard on the torque (torque_guards.hpp).
 // Everything that changes the controller at run time arrives in ControllerTargets: the FSM, the
 // gamepad, a dashboard or a script never reach into its stages.
@@ -168,6 +168,7 @@ private:
   long cycles_since_good_ = 0;
   long safe_stop_cycles_ = 0;
   bool holding_ = false;
+  bool brake_against_push_ = false;  // the safe stop's brake resists tau_ext (after a QP failure)
   Eigen::VectorXd hold_q_, hold_qd_;  // the safe stop's held reference, braking to rest (position loop)
   Eigen::VectorXd brake_q_, brake_qd_, brake_tau_, guarded_tau_;
   Eigen::VectorXd limit_lower_, limit_upper_;       // URDF limits (±inf: continuous)
