@@ -7,6 +7,7 @@
 // the same states in the same run, the safety supervisor's plausibility check alone (a second
 // StateSupervisor built like the controller's: supervisor_median_us, the part of the cycle it adds):
 //   build/release/bench/phri_bench --benchmark_filter=ControllerCycle
+#include <phri/app/robot_bundle.hpp>
 #include <phri/control/controller.hpp>
 #include <phri/core/statistics.hpp>
 #include <phri/sim/sim_robot.hpp>
@@ -41,9 +42,7 @@ void ControllerCycle(benchmark::State& state) {
   }
   phri::SimRobot robot(plant);
   phri::ControllerSettings settings;
-  settings.urdf_path = root + "/robots/kinova_gen3/gen3.urdf";
-  settings.actuators_path = root + "/robots/kinova_gen3/actuators.yaml";
-  settings.collision_path = root + "/robots/kinova_gen3/collision.yaml";
+  phri::RobotBundle::from_folder(root + "/robots/kinova_gen3").apply_to(settings);  // files, frames, end of arm
   settings.initial_compliance = phri::ComplianceMode::kDual;
   phri::Controller cycle(settings);
   phri::RobotCommand command(robot.dof());

@@ -124,14 +124,16 @@ TEST(Config, RelativeConfigPathFromTheWorkingDirectory) {
 
 TEST(Config, MinimalFileTakesTheDefaults) {
   const std::string yaml =
-      "robot: {urdf: ../robots/kinova_gen3/gen3.urdf, actuators: ../robots/kinova_gen3/actuators.yaml}\n"
+      "robot: {urdf: ../robots/kinova_gen3/gen3.urdf, actuators: ../robots/kinova_gen3/actuators.yaml, end_effector_frame: end_effector_link}\n"
       "plant: {file: plant_gen3.yaml}\n";
   const phri::Config c = phri::Config::from_yaml_string(yaml, "minimal.yaml", kRoot + "/configs");
   EXPECT_TRUE(c.controller.collision_path.empty());  // no collision key: no self-collision constraint
   EXPECT_FALSE(c.plant.mismatch.enabled);
   EXPECT_TRUE(c.fsm.timeline.empty());
   EXPECT_DOUBLE_EQ(c.controller.observer_gain, phri::ControllerSettings{}.observer_gain);
-  EXPECT_EQ(c.controller.payloads.size(), 2u);
+  EXPECT_TRUE(c.controller.payloads.empty());  // the library knows no arm's end of arm
+  EXPECT_EQ(c.controller.ft_sensor_offset_m, 0.0);
+  EXPECT_EQ(c.controller.wrench.tool_mass_kg, 0.0);
   EXPECT_EQ(c.fsm.startup.home_q_rad, phri::paper_posture_target());
 }
 
@@ -140,7 +142,7 @@ TEST(Config, InlinePlantResolvesItsPathsAgainstThisFile) {
   // Indent the plant file's section under our own `plant:` key.
   const std::string body = plant_file.substr(plant_file.find("plant:\n") + 7);
   const std::string yaml =
-      "robot: {urdf: ../robots/kinova_gen3/gen3.urdf, actuators: ../robots/kinova_gen3/actuators.yaml}\n"
+      "robot: {urdf: ../robots/kinova_gen3/gen3.urdf, actuators: ../robots/kinova_gen3/actuators.yaml, end_effector_frame: end_effector_link}\n"
       "plant:\n" + body;
   const phri::Config c = phri::Config::from_yaml_string(yaml, "inline.yaml", kRoot + "/configs");
   EXPECT_TRUE(std::filesystem::is_regular_file(c.plant.mjcf_path)) << c.plant.mjcf_path;
@@ -185,7 +187,7 @@ TEST(Config, ExternalTorqueSourceIsChosenByName) {
 
 TEST(Config, SectionOfTheWrongKind) {
   const std::string head =
-      "robot: {urdf: ../robots/kinova_gen3/gen3.urdf, actuators: ../robots/kinova_gen3/actuators.yaml}\n"
+      "robot: {urdf: ../robots/kinova_gen3/gen3.urdf, actuators: ../robots/kinova_gen3/actuators.yaml, end_effector_frame: end_effector_link}\n"
       "plant: {file: plant_gen3.yaml}\n";
   for (const auto& [text, key] : {std::pair<std::string, std::string>{"controller: {compliance: 3}", "controller.compliance"},
                                   {"events: {at: 1}", "events"},

@@ -12,6 +12,7 @@
 #include <phri/model/algorithms.hpp>
 #include <phri/sim/sim_robot.hpp>
 
+#include "gen3_settings.hpp"
 #include "generated_arm.hpp"
 #include "hand_push.hpp"
 #include "temp_dir.hpp"
@@ -67,16 +68,18 @@ public:
     c.actuators_path = "drives of " + arm.name;
     c.initial_q_rad = arm.arm.home_q;
     c.ft_sensor.flange_site = arm.arm.flange;  // the generated plant has a site at every link frame
+    c.set_end_of_arm(gen3_end_of_arm());
     c.disturbances = std::move(pushes);
     return c;
   }
 
-  // The library's defaults for the end of arm (F/T adapter + tool payloads) match the plant's
-  // default adapter and tool at the flange.
+  // Every arm carries the Gen3's F/T sensor and tool at its flange, the controller knowing them.
+  static const std::optional<phri::EndOfArm>& gen3_end_of_arm() { return phri::test::gen3_bundle().end_of_arm; }
   static phri::Controller controller(const NamedArm& arm, phri::ComplianceMode mode, phri::LowLevelMode loop) {
     phri::ControllerSettings s;
     s.urdf_path = arm.urdf_path;
     s.end_effector_frame = arm.arm.flange;
+    s.set_end_of_arm(gen3_end_of_arm());
     s.tip_link = arm.arm.flange;
     s.locked_joints = arm.arm.locked_joints;
     s.initial_compliance = mode;

@@ -4,6 +4,7 @@
 // (hexadecimal floats), which the script compares with its own runs: the same loop, bit for bit.
 //
 //   phri_loop_reference [--seconds S] [--repetitions R]
+#include <phri/app/robot_bundle.hpp>
 #include <phri/control/controller.hpp>
 #include <phri/sim/sim_robot.hpp>
 
@@ -42,9 +43,7 @@ phri::SimRobotConfig plant(double seconds) {
 phri::ControllerSettings controller_settings() {
   const std::string gen3 = std::string(PHRI_SOURCE_DIR) + "/robots/kinova_gen3/";
   phri::ControllerSettings settings;
-  settings.urdf_path = gen3 + "gen3.urdf";
-  settings.actuators_path = gen3 + "actuators.yaml";
-  settings.collision_path = gen3 + "collision.yaml";
+  phri::RobotBundle::from_folder(gen3).apply_to(settings);  // files, frames, end of arm (as Python's ControllerSettings())
   settings.initial_compliance = phri::ComplianceMode::kDual;
   return settings;
 }

@@ -6,6 +6,7 @@
 // Controller outputs (desired torque, external torque...) are read-only views updated every step.
 #include "bindings.hpp"
 
+#include <phri/app/robot_bundle.hpp>
 #include <phri/control/controller.hpp>
 
 namespace phri::python {
@@ -49,13 +50,12 @@ void bind_settings(py::module_& m) {
       .def_readwrite("rotor_inertia_compensation", &CustomTorqueSettings::rotor_inertia_compensation);
   using S = ControllerSettings;
   py::class_<S>(m, "ControllerSettings",
-                "Everything Controller needs. From Python the robot files default to the shipped Gen3 "
-                "(robots/kinova_gen3 in data_dir()); the C++ defaults leave them empty.")
+                "Everything Controller needs. From Python the robot defaults to the shipped Gen3 bundle "
+                "(robots/kinova_gen3 in data_dir(): files, frames, F/T sensor and tool); the C++ defaults "
+                "name no robot and carry no end of arm.")
       .def(py::init([] {
         S s;
-        s.urdf_path = locate("robots/kinova_gen3/gen3.urdf");
-        s.actuators_path = locate("robots/kinova_gen3/actuators.yaml");
-        s.collision_path = locate("robots/kinova_gen3/collision.yaml");
+        RobotBundle::from_folder(locate("robots/kinova_gen3")).apply_to(s);
         return s;
       }))
       .def_readwrite("urdf_path", &S::urdf_path)

@@ -77,7 +77,7 @@ void parse_robot(const YamlReader& r, const std::string& base_dir, ControllerSet
   c.urdf_path = input_file(r, "urdf", base_dir, false);
   c.actuators_path = input_file(r, "actuators", base_dir, false);
   c.collision_path = r.has("collision") ? input_file(r, "collision", base_dir, true) : "";
-  c.end_effector_frame = r.text_or("end_effector_frame", c.end_effector_frame);
+  c.end_effector_frame = r.text("end_effector_frame");  // no default: every arm names its own
   c.ft_sensor_offset_m = r.number_or("ft_sensor_offset_m", c.ft_sensor_offset_m, 0.0, 0.5);  // an adapter, not a boom
   if (r.has("payloads")) {
     const YamlReader list = r.at("payloads");
@@ -517,6 +517,10 @@ Config parse(const YamlReader& root, const std::string& base_dir, const std::str
   }
 
   if (root.has("controller")) parse_controller(root.at("controller"), drives, c.controller);
+  if (!c.plant.has_end_of_arm && c.controller.external_torque_source != ExternalTorqueSource::kObserver) {
+    throw ConfigError(source, "controller.external_torque_source",
+                      std::string(to_string(c.controller.external_torque_source)) + " needs an F/T sensor, and the plant has none (no end of arm)");
+  }
   if (std::abs(c.controller.period_s - c.plant.control_period_s) > 1e-12) {
     throw ConfigError(source, "controller.period_s",
                       "must equal the plant's control period (plant.timing.control_period_s)");

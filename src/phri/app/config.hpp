@@ -23,8 +23,9 @@
 // Schema (top-level sections; all but `robot` and `plant` optional, absent keys keep the defaults
 // of the settings structs, which follow the paper where it gives a value):
 //   robot:       either a robot bundle's folder (robots/<robot>, see app/robot_bundle.hpp), or
-//                urdf, actuators, collision ('' for none), end_effector_frame, ft_sensor_offset_m,
-//                payloads [{name, frame, mass_kg, com_m, inertia_kgm2}]       -> ControllerSettings
+//                urdf, actuators, collision ('' for none), end_effector_frame (required),
+//                ft_sensor_offset_m (default 0), payloads [{name, frame, mass_kg, com_m,
+//                inertia_kgm2}] (default none: the library knows no arm's end of arm) -> ControllerSettings
 //                (a bundle also sets the plant's arm, drives, F/T sensor and tool; `plant:` may
 //                then be left out, the plant's defaults and the bundle's home posture applying)
 //   plant:       either `file: plant_gen3.yaml` plus any keys of that file's `plant:` section to

@@ -64,13 +64,40 @@ void parse_frames(const YamlReader& f, RobotBundle& b) {
   b.end_effector_frame = f.text("end_effector");
 }
 
-void parse_end_of_arm(const YamlReader& e, RobotBundle& b) {
+// Gravity: finite, at most 3 g (more is a unit mistake; 0 is an arm in orbit, allowed).
+Eigen::Vector3d parse_gravity(const YamlReader& r) {
+  const Eigen::Vector3d g = r.vector3("gravity_m_s2", -30.0, 30.0);
+  if (!(g.norm() <= 30.0)) throw r.error("gravity_m_s2", "|g| = " + format_general(g.norm(), 6) + " m/s^2: at most 30 (3 g)");
+  return g;
+}
+
+// The base link in the world: within 10 m of the origin, angles within a turn.
+Eigen::Isometry3d parse_base_placement(const YamlReader& b) {
+  b.allow_keys({"xyz_m", "rpy_rad"});
+  const Eigen::Vector3d xyz = b.vector3_or("xyz_m", Eigen::Vector3d::Zero(), -10.0, 10.0);
+  const Eigen::Vector3d rpy = b.vector3_or("rpy_rad", Eigen::Vector3d::Zero(), -kMaxJointAngle_rad, kMaxJointAngle_rad);
+  Eigen::Isometry3d placement = Eigen::Isometry3d::Identity();
+  placement.translation() = xyz;
+  placement.linear() = (Eigen::AngleAxisd(rpy.z(), Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(rpy.y(), Eigen::Vector3d::UnitY()) *
+                        Eigen::AngleAxisd(rpy.x(), Eigen::Vector3d::UnitX()))
+                           .toRotationMatrix();
+  return placement;
+}
+
+// `end_of_arm: none` (or no key): a bare flange.
+std::optional<EndOfArm> parse_end_of_arm(const YamlReader& e) {
+  if (e.node().IsScalar()) {
+    if (e.as_text() != "none") throw e.error("", "a map (ft_sensor, tool) or `none`");
+    return std::nullopt;
+  }
   e.allow_keys({"ft_sensor", "tool"});
   const YamlReader sensor = e.at("ft_sensor");
   sensor.allow_keys({"offset_m", "flange_side"});
-  b.end_of_arm.sensor_offset_m = sensor.number("offset_m", 0.0, 0.5);
-  b.end_of_arm.flange_side = rigid_body(sensor.at("flange_side"));
-  b.end_of_arm.tool = rigid_body(e.at("tool"));
+  EndOfArm end;
+  end.sensor_offset_m = sensor.number("offset_m", 0.0, 0.5);
+  end.flange_side = rigid_body(sensor.at("flange_side"));
+  end.tool = rigid_body(e.at("tool"));
+  return end;
 }
 
 void parse_plant(const YamlReader& p, const std::string& folder, RobotBundle& b) {
@@ -111,7 +138,8 @@ void parse_custom_loop_filter(const YamlReader& f, RobotBundle& b) {
 
 RobotBundle parse(const YamlReader& r, const std::string& folder) {
   r.allow_keys({"name", "urdf", "actuators", "collision", "frames", "locked_joints", "home_q_rad",
-                "compliance_deadband_Nm", "drive", "custom_loop_filter", "end_of_arm", "plant"});
+                "compliance_deadband_Nm", "drive", "custom_loop_filter", "end_of_arm", "plant", "gravity_m_s2",
+                "base_placement"});
   RobotBundle b;
   b.source = r.file();
   b.name = r.text("name");
@@ -121,6 +149,8 @@ RobotBundle parse(const YamlReader& r, const std::string& folder) {
   b.collision_path = r.has("collision") && !fitted ? input_file(r, "collision", folder) : "";
   if (fitted) b.collision_yaml = "fitted";  // fitted once the model is checked (check_against_model)
   parse_frames(r.at("frames"), b);
+  if (r.has("gravity_m_s2")) b.gravity_m_s2 = parse_gravity(r);
+  if (r.has("base_placement")) b.base_placement = parse_base_placement(r.at("base_placement"));
   b.locked_joints = names(r, "locked_joints");
   const int dof = ActuatorTable::from_yaml_file(b.actuators_path).size();
   b.home_q_rad = r.per_joint<std::vector<double>>("home_q_rad", dof, -kMaxJointAngle_rad, kMaxJointAngle_rad);
@@ -128,7 +158,7 @@ RobotBundle parse(const YamlReader& r, const std::string& folder) {
   // Only Kinova's actuator loops are emulated so far; a generic drive is future work (issue 16).
   (void)r.choice("drive", {"kinova"});
   if (r.has("custom_loop_filter")) parse_custom_loop_filter(r.at("custom_loop_filter"), b);
-  parse_end_of_arm(r.at("end_of_arm"), b);
+  if (r.has("end_of_arm")) b.end_of_arm = parse_end_of_arm(r.at("end_of_arm"));
   parse_plant(r.has("plant") ? r.at("plant") : YamlReader(YAML::Node(YAML::NodeType::Map), r.file(), "plant"), folder, b);
   return b;
 }
@@ -216,14 +246,11 @@ void RobotBundle::apply_to(ControllerSettings& s) const {
   s.end_effector_frame = end_effector_frame;
   s.locked_joints = locked_joints;
   s.qp.compliance_deadband = compliance_deadband_Nm;
-  s.ft_sensor_offset_m = end_of_arm.sensor_offset_m;
-  // In the end-effector frame: the adapter as given, the tool shifted by the sensor's offset.
-  s.payloads = {ControllerSettings::end_of_arm_payload("ft_adapter_and_sensor", end_of_arm.flange_side, 0.0),
-                ControllerSettings::end_of_arm_payload("tool", end_of_arm.tool, end_of_arm.sensor_offset_m)};
+  s.set_end_of_arm(end_of_arm);
+  s.gravity_m_s2 = gravity_m_s2;
+  s.base_placement = base_placement;
   s.custom_torque.filter_numerator = custom_loop_numerator;
   s.custom_torque.filter_denominator = custom_loop_denominator;
-  s.wrench.tool_mass_kg = end_of_arm.tool.mass_kg;
-  s.wrench.tool_com_m = end_of_arm.tool.com_m;
 }
 
 void RobotBundle::apply_to(SimRobotConfig& c) const {
@@ -235,13 +262,9 @@ void RobotBundle::apply_to(SimRobotConfig& c) const {
   c.actuators = ActuatorTable::from_yaml_file(actuators_path);
   if (c.initial_q_rad.size() != home_q_rad.size()) c.initial_q_rad = home_q_rad;
   c.ft_sensor.flange_site = plant.flange_site;
-  c.ft_sensor.sensor_offset_m = end_of_arm.sensor_offset_m;
-  c.ft_sensor.flange_side_mass_kg = end_of_arm.flange_side.mass_kg;
-  c.ft_sensor.flange_side_com_m = end_of_arm.flange_side.com_m;
-  c.ft_sensor.flange_side_inertia_kgm2 = end_of_arm.flange_side.principal_inertia_kgm2;
-  c.tool.mass_kg = end_of_arm.tool.mass_kg;
-  c.tool.com_m = end_of_arm.tool.com_m;
-  c.tool.inertia_kgm2 = end_of_arm.tool.principal_inertia_kgm2;
+  c.set_end_of_arm(end_of_arm);
+  c.gravity_m_s2 = gravity_m_s2;
+  c.base_placement = base_placement;
 }
 
 }  // namespace phri

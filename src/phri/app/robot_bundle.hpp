@@ -20,7 +20,9 @@
 #include <phri/sim/sim_robot_config.hpp>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -43,16 +45,19 @@ struct RobotBundle {
   std::string base_link, tip_link, end_effector_frame;
   std::vector<std::string> locked_joints;
   std::vector<double> home_q_rad;
+  /// `gravity_m_s2` [m/s^2, world frame] and `base_placement` {xyz_m, rpy_rad} (the base link in
+  /// the world, URDF origin convention: R = Rz(yaw) Ry(pitch) Rx(roll)): the controller's model
+  /// and the plant get the same. Defaults: (0, 0, -9.81), the identity.
+  Eigen::Vector3d gravity_m_s2 = Eigen::Vector3d(0.0, 0.0, -9.81);
+  Eigen::Isometry3d base_placement = Eigen::Isometry3d::Identity();
   Eigen::VectorXd compliance_deadband_Nm;  ///< per joint
   enum class Drive { kKinova } drive = Drive::kKinova;
   /// The custom torque loop's H(z) (b, a in powers of z^-1); both empty: Kinova's (the library's).
   std::vector<double> custom_loop_numerator, custom_loop_denominator;
 
-  struct EndOfArm {
-    double sensor_offset_m = 0.0;  ///< flange -> F/T measuring frame, along the flange's z
-    RigidBodyData flange_side;     ///< adapter + sensor body, flange frame (not measured)
-    RigidBodyData tool;            ///< below the sensor, sensor frame
-  } end_of_arm;
+  /// `end_of_arm`: the F/T sensor and the tool (becoming the controller's payloads and the
+  /// plant's bodies); nullopt when the key is absent or says `none` (a bare flange).
+  std::optional<EndOfArm> end_of_arm;
 
   struct Plant {
     std::string mjcf_path;  ///< hand-written arm MJCF; '' : generated from the URDF

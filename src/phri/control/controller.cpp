@@ -10,11 +10,29 @@
 
 namespace phri {
 
+namespace {
+void require_end_effector_frame(const ControllerSettings& settings) {
+  if (settings.end_effector_frame.empty()) {
+    throw ConfigError("ControllerSettings", "end_effector_frame", "empty: name the end-effector frame (a robot bundle's frames.end_effector)");
+  }
+}
+
+// The F/T estimator removes the tool's weight under the model's gravity (one gravity per run).
+WrenchEstimatorSettings wrench_settings(const ControllerSettings& settings, const Model& model) {
+  WrenchEstimatorSettings w = settings.wrench;
+  w.gravity = model.gravity();
+  return w;
+}
+}  // namespace
+
 ModelOptions Controller::model_options(const ControllerSettings& settings) {
+  require_end_effector_frame(settings);
   ModelOptions options;
   options.base_link = settings.base_link;
   options.tip_link = settings.tip_link;
   options.locked_joints = settings.locked_joints;
+  options.gravity = settings.gravity_m_s2;
+  options.base_placement = settings.base_placement;
   ExtraFrame sensor;
   sensor.name = "ft_sensor";
   sensor.parent_frame = settings.end_effector_frame;
@@ -94,6 +112,7 @@ const ControllerSettings& checked(const ControllerSettings& settings) {
     throw ConfigError("ControllerSettings", "safety", "rates, speeds and times must be > 0 (guard fraction <= 1.5)");
   }
   if (!(settings.wrench_trigger_filter_s >= 0)) throw ConfigError("ControllerSettings", "wrench_trigger_filter_s", "must be >= 0");
+  require_end_effector_frame(settings);
   return settings;
 }
 
@@ -164,7 +183,7 @@ Controller::Controller(LoadedRobot robot, const ControllerSettings& settings)
       compliance_(settings.compliance),
       leash_(model_, model_.frame_id(settings.end_effector_frame), settings.compliance.return_leash),
       observer_(model_, settings.observer_gain),
-      wrench_(settings.wrench),
+      wrench_(wrench_settings(settings, model_)),
       low_level_(actuators_, custom_torque_settings(settings), settings.initial_loop),
       supervisor_(sensor_ranges(model_, actuators_), supervisor_settings(settings)),
       end_effector_frame_(model_.frame_id(settings.end_effector_frame)),

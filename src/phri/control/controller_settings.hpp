@@ -1,6 +1,8 @@
 #pragma once
-// Everything Controller needs, with the defaults of the paper's demo where it gives them.
-// configs/*.yaml fill it (app/Config); tests and experiments may also build it in code.
+// Everything Controller needs, with the defaults of the paper's demo where it gives them (gains,
+// thresholds); nothing in it describes one arm: the robot's files, frames and end of arm come from
+// its bundle (robots/<robot>/robot.yaml, app/RobotBundle::apply_to) or a run YAML (app/Config).
+// Tests and experiments may also build it in code.
 #include <phri/control/compliance_controller.hpp>
 #include <phri/control/compliance_mode.hpp>
 #include <phri/control/whole_body_qp.hpp>
@@ -10,8 +12,10 @@
 #include <phri/lowlevel/low_level_controller.hpp>
 
 #include <phri/model/model.hpp>
-#include <phri/robot/paper_end_of_arm.hpp>
+#include <phri/robot/end_of_arm.hpp>
 #include <phri/safety/state_supervisor.hpp>
+
+#include <Eigen/Geometry>
 
 #include <array>
 #include <optional>
@@ -83,18 +87,23 @@ struct ControllerSettings {
   /// A collision model's text (capsules fitted from the URDF, model/capsule_fit.hpp), used in
   /// place of collision_path when not empty.
   std::string collision_yaml;
-  std::string end_effector_frame = "end_effector_link";
+  /// The frame of the end-effector task (and where the end of arm mounts); a link or fixed frame
+  /// of the URDF. No default: every arm names its own.
+  std::string end_effector_frame;
   /// The controlled chain (ModelOptions): base and tip links ('' : the URDF's root, the end of its
   /// only moving branch) and the URDF joints held at 0 (e.g. a gripper's fingers).
   std::string base_link;
   std::string tip_link;
   std::vector<std::string> locked_joints;
-  /// F/T sensor measuring frame on the end-effector frame: offset along its z axis (paper setup,
-  /// robot/paper_end_of_arm.hpp).
-  double ft_sensor_offset_m = PaperEndOfArm::kSensorOffset_m;
-  /// What the arm carries beyond its URDF, in the end-effector frame (the paper's setup, as the
-  /// plant models it, robot/paper_end_of_arm.hpp): F/T adapter + sensor 0.269 kg, tool 0.3 kg.
-  std::vector<Payload> payloads = default_payloads();
+  /// [m/s^2] gravity in the world frame, and where the base link sits in the world (ModelOptions):
+  /// a robot bundle's `gravity_m_s2` and `base` keys; the plant is given the same.
+  Eigen::Vector3d gravity_m_s2 = Eigen::Vector3d(0.0, 0.0, -9.81);
+  Eigen::Isometry3d base_placement = Eigen::Isometry3d::Identity();
+  /// F/T sensor measuring frame on the end-effector frame: offset along its z axis (0 without a sensor).
+  double ft_sensor_offset_m = 0.0;
+  /// What the arm carries beyond its URDF (frame '' : the end-effector frame). None by default:
+  /// set_end_of_arm, a bundle's end_of_arm or a run YAML's robot.payloads add them.
+  std::vector<Payload> payloads;
   /// A body carried on the end-effector frame, its COM shifted along that frame's z by offset_z_m.
   static Payload end_of_arm_payload(const char* name, const RigidBodyData& body, double offset_z_m) {
     Payload p{name, "", {}};
@@ -103,10 +112,21 @@ struct ControllerSettings {
     p.inertia.inertia_com = body.principal_inertia_kgm2.asDiagonal();
     return p;
   }
-  static std::vector<Payload> default_payloads() {
-    // The tool's COM is given below the sensor: shift it by the sensor's offset.
-    return {end_of_arm_payload("ft_adapter_and_sensor", PaperEndOfArm::ft_adapter_and_sensor(), 0.0),
-            end_of_arm_payload("tool", PaperEndOfArm::tool(), PaperEndOfArm::kSensorOffset_m)};
+  /// The controller's view of an end of arm (none: a bare flange): the F/T frame's offset, the
+  /// adapter and the tool as payloads on the end-effector frame, the tool's weight removed from
+  /// the F/T reading.
+  void set_end_of_arm(const std::optional<EndOfArm>& end_of_arm) {
+    const EndOfArm none;
+    const EndOfArm& e = end_of_arm ? *end_of_arm : none;
+    ft_sensor_offset_m = e.sensor_offset_m;
+    payloads.clear();
+    if (end_of_arm) {
+      // The tool's COM is given below the sensor: shift it by the sensor's offset.
+      payloads = {end_of_arm_payload("ft_adapter_and_sensor", e.flange_side, 0.0),
+                  end_of_arm_payload("tool", e.tool, e.sensor_offset_m)};
+    }
+    wrench.tool_mass_kg = e.tool.mass_kg;
+    wrench.tool_com_m = e.tool.com_m;
   }
   double period_s = 1e-3;
   /// Momentum observer bandwidth K_O [rad/s]. The paper's code uses 10; 50 follows a push 5x

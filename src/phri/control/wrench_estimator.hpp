@@ -8,16 +8,15 @@
 // Sensor convention (RobotState): the wrench (f; m) the tool exerts on the flange side, in the
 // sensor frame, about its origin; a tool at rest reads m_tool * g in sensor axes.
 #include <phri/model/spatial.hpp>
-#include <phri/robot/paper_end_of_arm.hpp>
 
 #include <Eigen/Geometry>
 
 namespace phri {
 
 struct WrenchEstimatorSettings {
-  double tool_mass_kg = PaperEndOfArm::tool().mass_kg;       ///< what hangs below the sensor
-  Eigen::Vector3d tool_com_m = PaperEndOfArm::tool().com_m;  ///< in the sensor frame
-  Eigen::Vector3d gravity = Eigen::Vector3d(0, 0, -9.81);    ///< world
+  double tool_mass_kg = 0.0;                                 ///< what hangs below the sensor (none by default)
+  Eigen::Vector3d tool_com_m = Eigen::Vector3d::Zero();      ///< in the sensor frame
+  Eigen::Vector3d gravity = Eigen::Vector3d(0, 0, -9.81);    ///< world (Controller: its model's)
   int bias_samples = 200;  ///< samples averaged at start-up (0.2 s at 1 kHz), arm at rest
 };
 

@@ -27,8 +27,10 @@ struct DropShared {
   std::optional<CollisionModel> collision;
 };
 
-ControllerSettings drop_settings(const DropTestOptions& o, DropMode mode) {
+ControllerSettings drop_settings(const DropTestOptions& o, DropMode mode, const SimRobotConfig& plant) {
   ControllerSettings s;
+  s.end_effector_frame = o.end_effector_frame;
+  s.set_end_of_arm(plant.end_of_arm());  // the controller knows the F/T sensor and tool the plant file states
   s.initial_loop = LowLevelMode::kPosition;
   s.observer_gain = o.observer_gain;
   s.external_torque_source = o.external_torque_source;
@@ -70,7 +72,7 @@ SimRobotConfig drop_plant(const DropShared& sh, int index) {
 DropRun run_drop(const DropShared& sh, DropMode mode, int index) {
   const DropTestOptions& o = sh.o;
   SimRobot robot(drop_plant(sh, index));
-  Controller cycle(sh.model, sh.actuators, sh.collision, drop_settings(o, mode));
+  Controller cycle(sh.model, sh.actuators, sh.collision, drop_settings(o, mode, sh.plant));
   const int n = robot.dof();
   const double dt = robot.period_s();
   const int window = static_cast<int>(std::lround(o.window_s / dt));
@@ -178,11 +180,12 @@ DropTestResult run_drop_test(const DropTestOptions& o, std::ostream* progress) {
   validate(o);
   const auto wall_start = std::chrono::steady_clock::now();
   if (!o.output_dir.empty()) ensure_output_directory(o.output_dir);
-  const ControllerSettings settings = drop_settings(o, DropMode::kTorque);
+  SimRobotConfig plant = SimRobotConfig::from_yaml_file(o.plant_config_path);
+  const ControllerSettings settings = drop_settings(o, DropMode::kTorque, plant);
   Model model = Model::from_urdf_file(o.urdf_path, Controller::model_options(settings));
   std::optional<CollisionModel> collision;
   if (!o.collision_path.empty()) collision = CollisionModel::from_yaml_file(o.collision_path, model);
-  const DropShared shared{o, SimRobotConfig::from_yaml_file(o.plant_config_path), std::move(model),
+  const DropShared shared{o, std::move(plant), std::move(model),
                           ActuatorTable::from_yaml_file(o.actuators_path), std::move(collision)};
   DropTestResult result;
   result.runs.resize(static_cast<std::size_t>(2 * o.drops));

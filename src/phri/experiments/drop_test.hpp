@@ -36,6 +36,7 @@ struct DropTestOptions {
   // ---- files (relative paths: the working directory)
   std::string plant_config_path = "configs/plant_gen3.yaml";
   std::string urdf_path = "robots/kinova_gen3/gen3.urdf";
+  std::string end_effector_frame = "end_effector_link";  ///< the URDF's frame the end of arm mounts on
   std::string actuators_path = "robots/kinova_gen3/actuators.yaml";
   std::string collision_path = "robots/kinova_gen3/collision.yaml";
   std::string output_dir = "results/drop_test";  ///< empty: no files

@@ -101,13 +101,16 @@ std::string samples_csv(const std::vector<DualSample>& s) {
 
 DualComplianceResult run_dual_compliance(const DualComplianceOptions& o, std::ostream* progress) {
   if (!o.output_dir.empty()) ensure_output_directory(o.output_dir);
+  const SimRobotConfig plant = dual_plant(o);
   ControllerSettings settings;
   settings.urdf_path = o.urdf_path;
   settings.actuators_path = o.actuators_path;
   settings.collision_path = o.collision_path;
+  settings.end_effector_frame = o.end_effector_frame;
+  settings.set_end_of_arm(plant.end_of_arm());  // the F/T sensor and tool the plant file states
   settings.initial_compliance = ComplianceMode::kDual;
   settings.initial_loop = LowLevelMode::kPosition;
-  SimRobot robot(dual_plant(o));
+  SimRobot robot(plant);
   Controller cycle(settings);
   RobotCommand command(robot.dof());
   ControllerTargets targets(robot.dof());

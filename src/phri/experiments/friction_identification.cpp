@@ -336,11 +336,15 @@ SimRobotConfig identification_plant(const FrictionIdentificationOptions& o) {
   return config;
 }
 
-// The controller's model (with its default tool payloads), for the gravity compensation.
-Model identification_model(const FrictionIdentificationOptions& o, int plant_dof) {
+// The controller's model (with the end of arm the plant file states), for the gravity compensation.
+Model identification_model(const FrictionIdentificationOptions& o, const SimRobotConfig& plant) {
+  const int plant_dof = plant.dof();
+  ControllerSettings settings;
+  settings.end_effector_frame = o.end_effector_frame;
+  settings.set_end_of_arm(plant.end_of_arm());
   ModelOptions model_options;
-  for (Payload p : ControllerSettings::default_payloads()) {
-    p.frame = "end_effector_link";
+  for (Payload p : settings.payloads) {
+    p.frame = o.end_effector_frame;
     model_options.payloads.push_back(p);
   }
   Model model = Model::from_urdf_file(o.urdf_path, model_options);
@@ -475,7 +479,7 @@ FrictionIdentificationResult identify_friction(const FrictionIdentificationOptio
   validate(o);
   const auto wall_start = std::chrono::steady_clock::now();
   const SimRobotConfig config = identification_plant(o);
-  const Model model = identification_model(o, config.dof());
+  const Model model = identification_model(o, config);
   FrictionRig rig(config, model);
   FrictionIdentificationResult result;
   result.samples.reserve(40000);

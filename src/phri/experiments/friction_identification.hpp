@@ -52,6 +52,7 @@ struct FrictionIdentificationOptions {
   std::string plant_config_path = "configs/plant_gen3.yaml";
   /// The controller's model, for the gravity compensation of the held joints.
   std::string urdf_path = "robots/kinova_gen3/gen3.urdf";
+  std::string end_effector_frame = "end_effector_link";  ///< the URDF's frame the end of arm mounts on
   /// CSV, YAML and markdown go here (created when missing); empty: no files.
   std::string output_dir = "results/friction_identification";
   /// Figure script run by the command (tools/report/friction_figure.py); empty: no figure.

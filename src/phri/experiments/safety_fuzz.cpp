@@ -97,6 +97,8 @@ RobotUnderTest robot_under_test(const SafetyFuzzOptions& o) {
     r.settings.urdf_path = r.urdf_path = o.urdf_path;
     r.settings.actuators_path = o.actuators_path;
     r.settings.collision_path = o.collision_path;
+    r.settings.end_effector_frame = o.end_effector_frame;
+    r.settings.set_end_of_arm(r.plant.end_of_arm());  // the F/T sensor and tool the plant file states
     r.start_q = o.start_q_rad;
     return r;
   }

@@ -46,6 +46,7 @@ struct SafetyFuzzOptions {
   // ---- files (relative paths are relative to the working directory)
   std::string plant_config_path = "configs/plant_gen3.yaml";
   std::string urdf_path = "robots/kinova_gen3/gen3.urdf";
+  std::string end_effector_frame = "end_effector_link";  ///< the URDF's frame the end of arm mounts on
   std::string actuators_path = "robots/kinova_gen3/actuators.yaml";
   std::string collision_path = "robots/kinova_gen3/collision.yaml";
   /// A robot bundle (robots/<robot>) in place of the four files above and of start_q_rad: its

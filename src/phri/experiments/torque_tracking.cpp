@@ -75,8 +75,11 @@ struct Trajectory {
   }
 };
 
-ControllerSettings cycle_settings(const TorqueTrackingOptions& o, TrackingScenario scenario, ComplianceMode mode) {
+ControllerSettings cycle_settings(const TorqueTrackingOptions& o, TrackingScenario scenario, ComplianceMode mode,
+                                  const std::optional<EndOfArm>& end_of_arm) {
   ControllerSettings s;
+  s.end_effector_frame = o.end_effector_frame;
+  s.set_end_of_arm(end_of_arm);
   s.initial_compliance = mode;
   s.initial_loop = LowLevelMode::kPosition;
   s.custom_torque = o.custom_torque;
@@ -86,6 +89,7 @@ ControllerSettings cycle_settings(const TorqueTrackingOptions& o, TrackingScenar
 
 // What the controller is built from, loaded once: every run's Controller starts from a copy.
 struct ControllerRobot {
+  std::optional<EndOfArm> end_of_arm;  ///< as the plant file states it (a payload run adds to the plant's only)
   Model model;
   ActuatorTable actuators;
   std::optional<CollisionModel> collision;
@@ -95,7 +99,8 @@ struct ControllerRobot {
 // thresholds replaced in memory when the options set them.
 ControllerRobot load_controller_robot(const TorqueTrackingOptions& o) {
   // The model options do not depend on the scenario (frame names, F/T offset and payloads only).
-  const ControllerSettings settings = cycle_settings(o, TrackingScenario::kStatic, o.static_compliance);
+  const std::optional<EndOfArm> end_of_arm = SimRobotConfig::from_yaml_file(o.plant_config_path).end_of_arm();
+  const ControllerSettings settings = cycle_settings(o, TrackingScenario::kStatic, o.static_compliance, end_of_arm);
   Model model = Model::from_urdf_file(o.urdf_path, Controller::model_options(settings));
   ActuatorTable actuators = ActuatorTable::from_yaml_file(o.actuators_path);
   for (int i = 0; i < actuators.size(); ++i) {
@@ -107,7 +112,7 @@ ControllerRobot load_controller_robot(const TorqueTrackingOptions& o) {
   }
   std::optional<CollisionModel> collision;
   if (!o.collision_path.empty()) collision = CollisionModel::from_yaml_file(o.collision_path, model);
-  return {std::move(model), std::move(actuators), std::move(collision)};
+  return {end_of_arm, std::move(model), std::move(actuators), std::move(collision)};
 }
 
 SimRobotConfig plant_config(const TorqueTrackingOptions& o, TrackingScenario scenario) {
@@ -284,7 +289,7 @@ TorqueTrackingRun run_one(const TorqueTrackingOptions& o, TrackingScenario scena
   const ComplianceMode mode = scenario == TrackingScenario::kStatic ? o.static_compliance : o.dynamic_compliance;
   SimRobot robot(plant_config(o, scenario));
   Controller cycle(controller_robot.model, controller_robot.actuators, controller_robot.collision,
-                   cycle_settings(o, scenario, mode));
+                   cycle_settings(o, scenario, mode, controller_robot.end_of_arm));
   const RunSchedule schedule = run_schedule(o, scenario, robot.period_s());
   TrackingRecorder recorder(robot.dof(), schedule.test_cycles, schedule.skip);
   TorqueTrackingRun run;

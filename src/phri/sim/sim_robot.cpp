@@ -98,6 +98,7 @@ SimRobot::SimRobot(const SimRobotConfig& config)
   scene_xml_ = SimScene::build_mjcf(config_);
   m_ = load_scene(scene_xml_, config_.arm_file());
   set_physics_options();
+  place_base();
   const std::vector<int> arm_bodies = bind_arm_joints();
   if (config_.mismatch.enabled) perturb_link_inertials(arm_bodies);
   find_ft_sensor();
@@ -113,9 +114,30 @@ SimRobot::~SimRobot() = default;
 
 void SimRobot::set_physics_options() {
   m_->opt.timestep = config_.physics_step_s();
+  for (int k = 0; k < 3; ++k) m_->opt.gravity[k] = config_.gravity_m_s2[k];
   m_->opt.integrator = mjINT_EULER;
   m_->opt.disableflags |= mjDSBL_SENSOR;  // enabled only on F/T sampling steps
   if (!config_.floor.enabled) m_->opt.disableflags |= mjDSBL_CONTACT;
+}
+
+// The arm's root bodies (the world's children but the drop mass, which starts where the tool is)
+// moved as one to config.base_placement. Left untouched at the identity.
+void SimRobot::place_base() {
+  const Eigen::Isometry3d& base = config_.base_placement;
+  if (base.matrix() == Eigen::Matrix4d::Identity()) return;
+  const Eigen::Quaterniond rotation(base.linear());
+  const mjtNum q_base[4] = {rotation.w(), rotation.x(), rotation.y(), rotation.z()};
+  const int drop = mj_name2id(m_.get(), mjOBJ_BODY, SimScene::kDropBody);
+  for (int b = 1; b < m_->nbody; ++b) {
+    if (m_->body_parentid[b] != 0 || b == drop) continue;
+    const Eigen::Vector3d pos(m_->body_pos[3 * b], m_->body_pos[3 * b + 1], m_->body_pos[3 * b + 2]);
+    const Eigen::Vector3d placed = base * pos;
+    for (int k = 0; k < 3; ++k) m_->body_pos[3 * b + k] = placed[k];
+    mjtNum quat[4];
+    mju_mulQuat(quat, q_base, m_->body_quat + 4 * b);
+    mju_normalize4(quat);
+    for (int k = 0; k < 4; ++k) m_->body_quat[4 * b + k] = quat[k];
+  }
 }
 
 std::vector<int> SimRobot::bind_arm_joints() {
@@ -218,6 +240,7 @@ void SimRobot::perturb_link_inertials(const std::vector<int>& arm_bodies) {
 }
 
 void SimRobot::find_ft_sensor() {
+  if (!config_.has_end_of_arm) return;  // a bare flange: no sensor, no tool
   tool_body_ = mj_name2id(m_.get(), mjOBJ_BODY, SimScene::kToolBody);
   sensor_site_ = mj_name2id(m_.get(), mjOBJ_SITE, SimScene::kSensorSite);
   const int force_sensor = mj_name2id(m_.get(), mjOBJ_SENSOR, SimScene::kForceSensor);
@@ -400,6 +423,7 @@ void SimRobot::start_drives_holding(const Eigen::VectorXd& hold) {
 
 // Initial F/T sample with the arm held (qacc ~ 0) and the latch carrying the mass.
 void SimRobot::take_initial_ft_sample(const Eigen::VectorXd& hold) {
+  if (sensor_site_ < 0) return;
   for (int i = 0; i < n_; ++i) d_->qfrc_applied[dadr_[static_cast<std::size_t>(i)]] = hold[i];
   mju_zero(d_->xfrc_applied, 6 * m_->nbody);
   apply_drop_forces(0.0);
@@ -595,7 +619,7 @@ void SimRobot::substep() {
   apply_external_forces(t);
 
   // 5. Step, with the F/T sensor evaluated on its sampling steps only.
-  const bool ft_step = (substep_count_ + 1) % static_cast<std::uint64_t>(ft_decimation_) == 0;
+  const bool ft_step = sensor_site_ >= 0 && (substep_count_ + 1) % static_cast<std::uint64_t>(ft_decimation_) == 0;
   if (ft_step) m_->opt.disableflags &= ~mjDSBL_SENSOR;
   mj_step2(m_.get(), d_.get());
   if (ft_step) m_->opt.disableflags |= mjDSBL_SENSOR;
@@ -749,13 +773,16 @@ void SimRobot::sample_state() {
     state_.wrench.sequence = wrench_sequence_;
     state_.wrench.stamp_s = wrench_stamp_;
   }
-  state_.wrench.valid = wrench_meas_.allFinite() && !fault_;
+  // No F/T sensor: no sample ever, and the wrench is never valid.
+  state_.wrench.valid = sensor_site_ >= 0 && wrench_meas_.allFinite() && !fault_;
 
   truth_.time_s = t;
   truth_.wrench_sensor = wrench_true_;
-  const mjtNum* sp = d_->site_xpos + 3 * sensor_site_;
-  truth_.sensor_position_m = Eigen::Vector3d(sp[0], sp[1], sp[2]);
-  truth_.sensor_rotation = rotation(d_->site_xmat + 9 * sensor_site_);
+  if (sensor_site_ >= 0) {
+    const mjtNum* sp = d_->site_xpos + 3 * sensor_site_;
+    truth_.sensor_position_m = Eigen::Vector3d(sp[0], sp[1], sp[2]);
+    truth_.sensor_rotation = rotation(d_->site_xmat + 9 * sensor_site_);
+  }
   if (drop_body_ >= 0) {
     truth_.drop_mass_position_m = Eigen::Vector3d(d_->qpos[drop_qadr_], d_->qpos[drop_qadr_ + 1], d_->qpos[drop_qadr_ + 2]);
     truth_.drop_mass_velocity_m_s = Eigen::Vector3d(d_->qvel[drop_dadr_], d_->qvel[drop_dadr_ + 1], d_->qvel[drop_dadr_ + 2]);

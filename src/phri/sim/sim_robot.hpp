@@ -123,6 +123,7 @@ private:
   // construction, in this order: the model's options, the arm's joints (their drive constants
   // written into the model), the link mismatch, the scene objects, then the data and the buffers
   void set_physics_options();
+  void place_base();
   std::vector<int> bind_arm_joints();  // returns the joints' bodies, in the order of actuators.yaml
   int bind_joint(int i);               // returns the joint's body
   void bind_elastic(int i);

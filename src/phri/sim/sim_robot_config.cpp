@@ -130,12 +130,12 @@ void parse_noise(const YamlReader& z, int n, SimRobotConfig::Noise& s) {
 void parse_ft_sensor(const YamlReader& f, SimRobotConfig::FtSensor& s) {
   f.allow_keys({"flange_site", "sensor_offset_m", "flange_side_mass_kg", "flange_side_com_m", "flange_side_inertia_kgm2",
                 "rate_Hz", "force_std_N", "torque_std_Nm", "force_bias_N", "torque_bias_Nm"});
-  s.flange_site = f.text_or("flange_site", s.flange_site);
-  s.sensor_offset_m = f.number_or("sensor_offset_m", s.sensor_offset_m, 0.0, 0.5);  // an adapter, not a boom
-  s.flange_side_mass_kg = f.number_or("flange_side_mass_kg", s.flange_side_mass_kg, 1e-4, kMaxCarriedMass_kg);
-  s.flange_side_com_m = f.vector3_or("flange_side_com_m", s.flange_side_com_m, -0.5, 0.5);
-  s.flange_side_inertia_kgm2 =
-      f.vector3_or("flange_side_inertia_kgm2", s.flange_side_inertia_kgm2, 1e-9, kMaxCarriedInertia_kgm2);
+  // The mount and the bodies have no default: they are the arm's (robots/<robot>/robot.yaml says them too).
+  s.flange_site = f.text("flange_site");
+  s.sensor_offset_m = f.number("sensor_offset_m", 0.0, 0.5);  // an adapter, not a boom
+  s.flange_side_mass_kg = f.number("flange_side_mass_kg", 1e-4, kMaxCarriedMass_kg);
+  s.flange_side_com_m = f.vector3("flange_side_com_m", -0.5, 0.5);
+  s.flange_side_inertia_kgm2 = f.vector3("flange_side_inertia_kgm2", 1e-9, kMaxCarriedInertia_kgm2);
   s.rate_Hz = f.number_or("rate_Hz", s.rate_Hz, 1.0, 100000.0);
   // Noise and bias: within the SensONE's range (~±500 N, ±10 N.m) and far above its datasheet noise.
   s.force_std_N = f.number_or("force_std_N", s.force_std_N, 0.0, 10.0);
@@ -146,9 +146,9 @@ void parse_ft_sensor(const YamlReader& f, SimRobotConfig::FtSensor& s) {
 
 void parse_tool(const YamlReader& t, SimRobotConfig::Tool& s) {
   t.allow_keys({"mass_kg", "com_m", "inertia_kgm2"});
-  s.mass_kg = t.number_or("mass_kg", s.mass_kg, 1e-4, kMaxCarriedMass_kg);
-  s.com_m = t.vector3_or("com_m", s.com_m, -0.5, 0.5);
-  s.inertia_kgm2 = t.vector3_or("inertia_kgm2", s.inertia_kgm2, 1e-9, kMaxCarriedInertia_kgm2);
+  s.mass_kg = t.number("mass_kg", 1e-4, kMaxCarriedMass_kg);
+  s.com_m = t.vector3("com_m", -0.5, 0.5);
+  s.inertia_kgm2 = t.vector3("inertia_kgm2", 1e-9, kMaxCarriedInertia_kgm2);
 }
 
 void parse_mismatch(const YamlReader& m, SimRobotConfig::Mismatch& s) {
@@ -301,8 +301,15 @@ SimRobotConfig parse(const YamlReader& root, const std::string& base_dir) {
   c.friction_scale = p.number_or("friction_scale", 1.0, 0.0, 10.0);
   if (p.has("friction")) parse_friction(p.at("friction"), c.friction);
   if (p.has("noise")) parse_noise(p.at("noise"), n, c.noise);
-  if (p.has("ft_sensor")) parse_ft_sensor(p.at("ft_sensor"), c.ft_sensor);
-  if (p.has("tool")) parse_tool(p.at("tool"), c.tool);
+  // The end of arm: both sections or neither (a bare flange).
+  if (p.has("ft_sensor") != p.has("tool")) {
+    throw p.error(p.has("tool") ? "ft_sensor" : "tool", "the end of arm is an F/T sensor and the tool below it: give both sections, or neither (a bare flange)");
+  }
+  c.has_end_of_arm = p.has("tool");
+  if (c.has_end_of_arm) {
+    parse_ft_sensor(p.at("ft_sensor"), c.ft_sensor);
+    parse_tool(p.at("tool"), c.tool);
+  }
   if (p.has("mismatch")) parse_mismatch(p.at("mismatch"), c.mismatch);
   if (p.has("vendor")) parse_vendor(p.at("vendor"), n, c.vendor);
   if (p.has("elasticity")) parse_elasticity(p.at("elasticity"), n, c.elasticity);
@@ -427,6 +434,22 @@ void validate_plant_drives(const SimRobotConfig& c) {
   }
 }
 
+// A configuration built in code names the end of arm's site and gives it mass, as a YAML must.
+void validate_end_of_arm(const SimRobotConfig& c) {
+  const std::string& f = c.source;
+  if (!c.has_end_of_arm) {
+    if (c.drop_test.enabled) throw ConfigError(f, "plant.drop_test.enabled", "the drop test hangs its mass from the tool: the plant has no end of arm (ft_sensor, tool)");
+    return;
+  }
+  if (c.ft_sensor.flange_site.empty()) throw ConfigError(f, "plant.ft_sensor.flange_site", "empty: name the flange's site");
+  if (!(c.ft_sensor.flange_side_mass_kg > 0.0)) throw ConfigError(f, "plant.ft_sensor.flange_side_mass_kg", "must be > 0");
+  if (!(c.tool.mass_kg > 0.0)) throw ConfigError(f, "plant.tool.mass_kg", "must be > 0");
+  if (!(c.ft_sensor.flange_side_inertia_kgm2.minCoeff() > 0.0)) {
+    throw ConfigError(f, "plant.ft_sensor.flange_side_inertia_kgm2", "principal moments must be > 0");
+  }
+  if (!(c.tool.inertia_kgm2.minCoeff() > 0.0)) throw ConfigError(f, "plant.tool.inertia_kgm2", "principal moments must be > 0");
+}
+
 void validate_scripted_forces(const SimRobotConfig& c) {
   const std::string& f = c.source;
   if (c.drop_test.enabled && !(c.drop_test.cable_length_m > 0.0)) {
@@ -467,6 +490,8 @@ void SimRobotConfig::validate() const {
   if (!(ft_sensor.rate_Hz > 0.0) || !is_integer_ratio(physics_rate_Hz, ft_sensor.rate_Hz)) {
     throw ConfigError(f, "plant.ft_sensor.rate_Hz", "must divide the physics rate");
   }
+  if (!gravity_m_s2.allFinite() || !(gravity_m_s2.norm() <= 30.0)) throw ConfigError(f, "gravity_m_s2", "finite, at most 30 m/s^2 (3 g)");
+  if (!base_placement.matrix().allFinite()) throw ConfigError(f, "base_placement", "must be finite");
   check_size(*this, initial_q_rad, "plant.initial.q_rad");
   for (std::size_t i = 0; i < initial_q_rad.size(); ++i) {
     if (!(std::abs(initial_q_rad[i]) <= kMaxJointAngle_rad)) {
@@ -480,7 +505,29 @@ void SimRobotConfig::validate() const {
   validate_vendor(*this);
   check_size(*this, elasticity.stiffness_Nm_per_rad, "plant.elasticity.stiffness_Nm_per_rad");
   validate_plant_drives(*this);
+  validate_end_of_arm(*this);
   validate_scripted_forces(*this);
+}
+
+std::optional<EndOfArm> SimRobotConfig::end_of_arm() const {
+  if (!has_end_of_arm) return std::nullopt;
+  EndOfArm e;
+  e.sensor_offset_m = ft_sensor.sensor_offset_m;
+  e.flange_side = {ft_sensor.flange_side_mass_kg, ft_sensor.flange_side_com_m, ft_sensor.flange_side_inertia_kgm2};
+  e.tool = {tool.mass_kg, tool.com_m, tool.inertia_kgm2};
+  return e;
+}
+
+void SimRobotConfig::set_end_of_arm(const std::optional<EndOfArm>& end_of_arm) {
+  has_end_of_arm = end_of_arm.has_value();
+  const EndOfArm e = end_of_arm.value_or(EndOfArm{});
+  ft_sensor.sensor_offset_m = e.sensor_offset_m;
+  ft_sensor.flange_side_mass_kg = e.flange_side.mass_kg;
+  ft_sensor.flange_side_com_m = e.flange_side.com_m;
+  ft_sensor.flange_side_inertia_kgm2 = e.flange_side.principal_inertia_kgm2;
+  tool.mass_kg = e.tool.mass_kg;
+  tool.com_m = e.tool.com_m;
+  tool.inertia_kgm2 = e.tool.principal_inertia_kgm2;
 }
 
 ActuatorTable SimRobotConfig::plant_actuators() const {

@@ -15,11 +15,12 @@
 // perturbs the plant's link inertials relative to the URDF (model mismatch).
 #include <phri/core/error.hpp>
 #include <phri/robot/actuator_table.hpp>
-#include <phri/robot/paper_end_of_arm.hpp>
+#include <phri/robot/end_of_arm.hpp>
 #include <phri/sim/external_force.hpp>
 #include <phri/sim/random_push_settings.hpp>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 #include <cstdint>
 #include <optional>
@@ -61,6 +62,12 @@ struct SimRobotConfig {
   std::string actuators_path;  ///< actuators.yaml
   ActuatorTable actuators;     ///< nominal drive models, loaded from actuators_path
 
+  // ---- where the arm stands: gravity in the world frame and the placement of the arm's root
+  // body (the URDF's root link, the MJCF's bodies under <worldbody>) in the world; a robot
+  // bundle's gravity_m_s2 and base_placement, which the controller's model gets too.
+  Eigen::Vector3d gravity_m_s2 = Eigen::Vector3d(0.0, 0.0, -9.81);
+  Eigen::Isometry3d base_placement = Eigen::Isometry3d::Identity();
+
   // ---- timing
   double physics_rate_Hz = 4000.0;  ///< MuJoCo step rate; multiple of 1 kHz (the Kortex filter rate)
   double control_period_s = 0.001;  ///< read()/write() period; multiple of the physics step
@@ -97,13 +104,16 @@ struct SimRobotConfig {
     double encoder_counts_per_rev = 262144.0;  ///< position quantum 2 pi / counts; 0: no quantisation
   } noise;
 
-  // ---- F/T sensor between the flange and the tool
+  // ---- the end of arm: an F/T sensor at the flange and the tool below it, or neither (a bare
+  // flange: no F/T sample ever, RobotState::wrench never valid). A plant YAML has one when it
+  // gives the `ft_sensor` and `tool` sections; no default describes a particular arm.
+  bool has_end_of_arm = false;
   struct FtSensor {
-    std::string flange_site = "end_effector";  ///< MJCF site of the tool flange (z out of the flange)
-    double sensor_offset_m = PaperEndOfArm::kSensorOffset_m;  ///< flange -> sensor measuring frame, along flange z
-    double flange_side_mass_kg = PaperEndOfArm::ft_adapter_and_sensor().mass_kg;  ///< not measured by the sensor
-    Eigen::Vector3d flange_side_com_m = PaperEndOfArm::ft_adapter_and_sensor().com_m;  ///< flange frame
-    Eigen::Vector3d flange_side_inertia_kgm2 = PaperEndOfArm::ft_adapter_and_sensor().principal_inertia_kgm2;
+    std::string flange_site;        ///< MJCF site of the tool flange (z out of the flange)
+    double sensor_offset_m = 0.0;   ///< flange -> sensor measuring frame, along flange z
+    double flange_side_mass_kg = 0.0;  ///< not measured by the sensor
+    Eigen::Vector3d flange_side_com_m = Eigen::Vector3d::Zero();  ///< flange frame
+    Eigen::Vector3d flange_side_inertia_kgm2 = Eigen::Vector3d::Zero();
     double rate_Hz = 1000.0;
     double force_std_N = 0.05;
     double torque_std_Nm = 0.002;
@@ -111,12 +121,17 @@ struct SimRobotConfig {
     Eigen::Vector3d torque_bias_Nm = Eigen::Vector3d::Zero();
   } ft_sensor;
 
-  // ---- the tool below the F/T sensor (DS4 gamepad and its mount by default)
+  // ---- the tool below the F/T sensor
   struct Tool {
-    double mass_kg = PaperEndOfArm::tool().mass_kg;
-    Eigen::Vector3d com_m = PaperEndOfArm::tool().com_m;  ///< sensor frame
-    Eigen::Vector3d inertia_kgm2 = PaperEndOfArm::tool().principal_inertia_kgm2;  ///< principal, sensor axes
+    double mass_kg = 0.0;
+    Eigen::Vector3d com_m = Eigen::Vector3d::Zero();         ///< sensor frame
+    Eigen::Vector3d inertia_kgm2 = Eigen::Vector3d::Zero();  ///< principal, sensor axes
   } tool;
+
+  /// The end of arm's bodies (nullopt: a bare flange), and the same the other way; the flange
+  /// site and the sensor's rate, noise and bias are left as they are.
+  std::optional<EndOfArm> end_of_arm() const;
+  void set_end_of_arm(const std::optional<EndOfArm>& end_of_arm);
 
   // ---- link inertial and drive-gain mismatch relative to the URDF and actuators.yaml
   struct Mismatch {

@@ -179,11 +179,13 @@ void insert_before_end_tag(std::string& xml, const std::string& element, const s
 std::string SimScene::build_mjcf(const SimRobotConfig& config) {
   const std::string& file = config.arm_file();
   std::string xml = arm_text(config);
-  const FlangeMount mount = find_flange_mount(config);
   remove_keyframes(xml, file);
-  insert_into_body(xml, mount.body, tool_chain_mjcf(config, mount), file);
+  if (config.has_end_of_arm) {
+    const FlangeMount mount = find_flange_mount(config);
+    insert_into_body(xml, mount.body, tool_chain_mjcf(config, mount), file);
+  }
   insert_before_end_tag(xml, "worldbody", world_additions_mjcf(config), file);
-  insert_before_end_tag(xml, "mujoco", ft_sensors_mjcf(), file);
+  if (config.has_end_of_arm) insert_before_end_tag(xml, "mujoco", ft_sensors_mjcf(), file);
   return xml;
 }
 

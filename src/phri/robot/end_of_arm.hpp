@@ -1,0 +1,24 @@
+#pragma once
+// phri::EndOfArm: what an arm carries beyond its URDF at its flange: an F/T sensor (the adapter
+// and the sensor's own body on the flange side) and the tool below the sensor. The library has
+// no default end of arm (a bare flange): a robot bundle's `end_of_arm` (robots/<robot>/robot.yaml)
+// or a plant YAML's `ft_sensor` and `tool` state it; the controller carries it as payloads
+// (ControllerSettings::set_end_of_arm), the plant as bodies (SimRobotConfig::set_end_of_arm).
+#include <Eigen/Core>
+
+namespace phri {
+
+/// A rigid body given by its mass, centre of mass and principal moments of inertia about it.
+struct RigidBodyData {
+  double mass_kg = 0.0;
+  Eigen::Vector3d com_m = Eigen::Vector3d::Zero();
+  Eigen::Vector3d principal_inertia_kgm2 = Eigen::Vector3d::Zero();
+};
+
+struct EndOfArm {
+  double sensor_offset_m = 0.0;  ///< flange -> F/T measuring frame, along the flange's z axis [m]
+  RigidBodyData flange_side;     ///< adapter + sensor body, COM in the flange frame (not measured by the sensor)
+  RigidBodyData tool;            ///< below the sensor, COM in the sensor frame
+};
+
+}  // namespace phri
