@@ -11,6 +11,15 @@
 namespace phri {
 
 namespace {
+// What the controller may ask of a drive beyond the QP's torque limit (the guards, the safe stop's
+// brake): this fraction of its peak torque. The rest is K_T's spread (5 % on the plant): the robot
+// refuses a torque beyond its own peak, and the refused command leaves the last accepted one
+// running (safety-fuzz seed 31337 with the guards at the full peak; seed 11111,
+// full_body/kinova_torque_high_velocity/0, with the brake at the full peak: 83 refused writes,
+// joint 1 at 1.115x). 0.9 was no reach at all on the Gen3's large joints (QP limit 95 N.m, peak
+// 105): a push taking 98.6 % of joint 2's QP limit left the brake 1.3 N.m (same window, 1.085x).
+constexpr double kDriveReach = 0.94;
+
 void require_end_effector_frame(const ControllerSettings& settings) {
   if (settings.end_effector_frame.empty()) {
     throw ConfigError("ControllerSettings", "end_effector_frame", "empty: name the end-effector frame (a robot bundle's frames.end_effector)");
@@ -376,7 +385,8 @@ void Controller::safe_stop(bool sample_good, RobotCommand& command) {
     // limit), the damping within the QP's torque limit.
     const double damping = std::clamp(-s.brake_rate * inertia * brake_qd_[i], -torque_limit_[i], torque_limit_[i]);
     const double push = brake_against_push_ ? tau_ext_[i] : 0.0;
-    brake_tau_[i] = std::clamp(data_.nonlinear_effects[i] - push + damping, -drive_torque_[i], drive_torque_[i]);
+    const double reach = std::max(torque_limit_[i], kDriveReach * drive_torque_[i]);
+    brake_tau_[i] = std::clamp(data_.nonlinear_effects[i] - push + damping, -reach, reach);
   }
   low_level_.command_torque(brake_tau_, command);
 }
@@ -422,11 +432,8 @@ void Controller::bound_external_torque() {
 //   QP's damper asks the same through the acceleration, but under a strong push the torque loops'
 //   tracking error let a pair through d_s to contact (-1.65 mm, seed 4242, full_body/kinova_torque/21,
 //   the QP feasible throughout; now 10.7 mm at the closest).
-// A guard that acts may go beyond the QP's limit up to kGuardDriveFraction of the drive's peak
-// torque (the rest is K_T's spread: the robot refuses a torque beyond its own peak, safety-fuzz
-// seed 31337 at the full peak).
+// A guard that acts may go beyond the QP's limit up to kDriveReach of the drive's peak torque.
 void Controller::guard_torque(Eigen::VectorXd& tau) {
-  constexpr double kGuardDriveFraction = 0.9;
   // g <= 1.5 in guard_coupling_scale (replays measured before the QP's return gain): 1.0 left
   // joint 3 at 1.08x under a push near the elbow's straight posture (joints 3 and 5 aligned, seed
   // 60606, full_body/custom/23; 1.07x at 1.5); on the two-sample mean, 2.0 let joints 1 and 3 ring
@@ -460,7 +467,7 @@ void Controller::guard_torque(Eigen::VectorXd& tau) {
     const double excess = guard_excess_[i];
     const double above = q_[i] - qp_.safe_upper()[i], below = qp_.safe_lower()[i] - q_[i];
     const double limit = excess > 0.0 || above > 0.0 || below > 0.0 || collision_guard_[i] != 0.0
-                             ? std::max(torque_limit_[i], kGuardDriveFraction * drive_torque_[i])
+                             ? std::max(torque_limit_[i], kDriveReach * drive_torque_[i])
                              : torque_limit_[i];
     if (excess > 0.0) tau[i] -= std::copysign(scale * guard_damping_[i] * excess, qd_[i]);
     if (above > 0.0) tau[i] -= static_friction_[i] + s.limit_guard_stiffness_Nm_per_rad * above;
