@@ -22,19 +22,22 @@ using Bytes = std::vector<std::uint8_t>;
 
 constexpr auto kBootTextPeriod = std::chrono::milliseconds(100);
 
-bool clean_after_header(const std::array<std::uint8_t, kBotaFrameBytes>& bytes) {
-  return std::find(bytes.begin() + 1, bytes.end(), kBotaFrameHeader) == bytes.end();
-}
-
-// The frame's bytes, its temperature nudged until no byte after the header is 0xAA (so that the
-// only sync candidates a test stream holds are the ones the test put there).
+// The frame's bytes, nudged until no byte after the header is 0xAA (so that the only sync
+// candidates a test stream holds are the ones the test put there): a wrench component holding one
+// moves by 1/32, otherwise (CRC, temperature) the temperature by 1/16. Timestamps are clean by
+// construction and non-finite values and status bits never contain 0xAA.
 Bytes encode_clean(BotaFrame& frame) {
-  auto bytes = encode_bota_frame(frame);
-  while (!clean_after_header(bytes)) {
-    frame.temperature += 0.0625f;
-    bytes = encode_bota_frame(frame);
+  for (;;) {
+    const auto bytes = encode_bota_frame(frame);
+    const auto header = std::find(bytes.begin() + 1, bytes.end(), kBotaFrameHeader);
+    if (header == bytes.end()) return Bytes(bytes.begin(), bytes.end());
+    const auto data_offset = static_cast<std::size_t>(header - bytes.begin()) - 1;
+    if (data_offset >= 2 && data_offset < 26) {
+      frame.wrench[(data_offset - 2) / 4] += 0.03125f;
+    } else {
+      frame.temperature += 0.0625f;
+    }
   }
-  return Bytes(bytes.begin(), bytes.end());
 }
 
 // Timestamps in base 128, one digit per byte: increasing with k, and no byte is ever 0xAA.
