@@ -82,7 +82,7 @@ public:
   BotaSensOne& operator=(const BotaSensOne&) = delete;
 
   // ---- the control cycle (one consumer thread): wait-free, no allocation
-  /// The newest sample.
+  /// The newest sample (the reference stays valid until the next latest() or read_into()).
   const WrenchSample& latest() noexcept { return handoff_.latest(); }
   /// Fills the F/T fields of a RobotState: wrench_sensor (the last good wrench), and wrench with
   /// valid = a good frame no older than stale_after_s, sequence, stamp_s = host steady-clock
