@@ -345,7 +345,15 @@ TEST(BotaSerialPort, OpenErrorsNameTheDeviceAndTheRemedy) {
   } catch (const phri::IoError& e) {
     EXPECT_NE(std::string(e.what()).find("not a serial device"), std::string::npos) << e.what();
   }
-  if (::geteuid() != 0) {  // root opens anything: the permission case needs an ordinary user
+  if (::geteuid() != 0) {  // root opens anything: the permission and exclusivity cases need an ordinary user
+    BotaEmulator emulator;
+    phri::SerialPort first(emulator.device(), 460800);
+    try {
+      phri::SerialPort second(emulator.device(), 460800);
+      ADD_FAILURE() << "a second program could open the sensor";
+    } catch (const phri::IoError& e) {
+      EXPECT_NE(std::string(e.what()).find("another program"), std::string::npos) << e.what();
+    }
     ::chmod(regular.c_str(), 0);
     try {
       phri::SerialPort port(regular, 460800);

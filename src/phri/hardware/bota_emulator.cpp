@@ -92,9 +92,10 @@ void BotaEmulator::open_pty() {
   master_fd_ = ::posix_openpt(O_RDWR | O_NOCTTY | O_NONBLOCK | O_CLOEXEC);
   if (master_fd_ < 0 || ::grantpt(master_fd_) != 0 || ::unlockpt(master_fd_) != 0)
     throw IoError("/dev/ptmx", std::string("cannot create a pseudo-terminal: ") + std::strerror(errno));
-  const char* slave = ::ptsname(master_fd_);  // this thread (or the constructor) is the only caller
-  slave_fd_ = slave != nullptr ? ::open(slave, O_RDWR | O_NOCTTY | O_NONBLOCK | O_CLOEXEC) : -1;
-  if (slave_fd_ < 0) throw IoError(slave ? slave : "pty", std::string("cannot open: ") + std::strerror(errno));
+  char slave[128];  // ptsname_r: two emulators in one process (tests) must not share ptsname's buffer
+  if (::ptsname_r(master_fd_, slave, sizeof slave) != 0) throw IoError("/dev/ptmx", "ptsname_r failed");
+  slave_fd_ = ::open(slave, O_RDWR | O_NOCTTY | O_NONBLOCK | O_CLOEXEC);
+  if (slave_fd_ < 0) throw IoError(slave, std::string("cannot open: ") + std::strerror(errno));
   termios tio{};
   ::tcgetattr(slave_fd_, &tio);
   ::cfmakeraw(&tio);  // raw before any byte flows: no echo of our frames back to us

@@ -7,6 +7,7 @@
 #include <cstring>
 #include <fcntl.h>
 #include <poll.h>
+#include <sys/ioctl.h>
 #include <termios.h>
 #include <unistd.h>
 
@@ -69,11 +70,19 @@ SerialPort::SerialPort(const std::string& device, int baud) : device_(device) {
     throw IoError(device, std::string("cannot configure the port (raw, ") + std::to_string(baud) +
                               " baud): " + std::strerror(error));
   }
+  // One owner: a second program opening the sensor would steal half of its bytes (it gets EBUSY).
+  if (::ioctl(fd_, TIOCEXCL) != 0) {
+    const int error = errno;
+    ::close(fd_);
+    throw IoError(device, std::string("cannot take exclusive access: ") + std::strerror(error));
+  }
   ::tcflush(fd_, TCIOFLUSH);
 }
 
 SerialPort::~SerialPort() {
-  if (fd_ >= 0) ::close(fd_);
+  if (fd_ < 0) return;
+  ::ioctl(fd_, TIOCNXCL);  // the device may stay open elsewhere (a pty's other end): let us reopen it
+  ::close(fd_);
 }
 
 SerialResult SerialPort::read_some(std::uint8_t* buffer, std::size_t capacity, int timeout_ms) noexcept {
