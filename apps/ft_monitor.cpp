@@ -7,6 +7,8 @@
 #include <csignal>
 #include <cstdio>
 #include <memory>
+#include <string>
+#include <utility>
 #include <thread>
 
 namespace {
@@ -80,10 +82,15 @@ int ft_monitor_command(const FtMonitorArguments& args) {
   phri::BotaSensOne sensor(settings);
   const auto start = phri::BotaSensOne::Clock::now();
   const auto period = std::chrono::duration<double>(1.0 / args.print_hz);
+  std::string shown_error;
   for (auto next = start + period; g_interrupted == 0; next += std::chrono::duration_cast<phri::BotaSensOne::Clock::duration>(period)) {
     std::this_thread::sleep_until(next);
     const double t_s = std::chrono::duration<double>(phri::BotaSensOne::Clock::now() - start).count();
     print_reading(t_s, sensor);
+    if (std::string error = sensor.last_error(); error != shown_error) {  // each new error once
+      if (!error.empty()) std::printf("phri ft-monitor: %s\n", error.c_str());
+      shown_error = std::move(error);
+    }
     if (args.duration_s > 0.0 && t_s >= args.duration_s) break;
   }
   sensor.stop();
