@@ -13,8 +13,11 @@
 //   phri experiment dual-compliance [options]  guiding the end effector by hand, release, drift
 //   phri evaluate [--out DIR] [--quick]        all five of the paper's evaluations and report.md/.html
 //   phri experiment dashboard-load [options]   loop cycle time with vs without the dashboard and its clients
+//   phri ft-monitor [--device DEV | --emulate] the Bota F/T sensor's wrench and counters (apps/ft_monitor.cpp)
 // Every bad argument or file, and every failure of a run or an experiment (phri::Error: ConfigError,
 // IoError, ExperimentError), gives one line on stderr naming what is wrong and a non-zero exit status.
+#include "ft_monitor.hpp"
+
 #include <phri/app/config.hpp>
 #include <phri/app/robot_bundle.hpp>
 #include <phri/model/capsule_fit.hpp>
@@ -613,6 +616,8 @@ int main(int argc, char** argv) {
   evaluate->add_option("--jobs", evaluation.jobs, "threads for the drops")->check(CLI::Range(1, 64))->capture_default_str();
   FitCollisionArguments fit_args;
   const CLI::App* fit_collision = add_fit_collision_command(app, fit_args);
+  FtMonitorArguments ft_args;
+  const CLI::App* ft_monitor = add_ft_monitor_command(app, ft_args);
 
   if (const std::string error = command_word_error(app, argc, argv); !error.empty()) return print_error(error.c_str());
   try {
@@ -624,6 +629,7 @@ int main(int argc, char** argv) {
     if (run->parsed()) return run_command(run_args);
     if (info->parsed()) return print_model_summary(info_args.urdf_path, info_args.tip, info_args.frame);
     if (fit_collision->parsed()) return fit_collision_command(fit_args);
+    if (ft_monitor->parsed()) return ft_monitor_command(ft_args);
     if (identify->parsed() || friction_alias->parsed()) return friction_identification_command(friction);
     if (tracking->parsed()) return torque_tracking_command(tracking_args);
     if (fuzz->parsed()) return safety_fuzz_command(fuzz_args);

@@ -31,6 +31,7 @@ MODULE_DEPENDENCIES = {
     "control": ["model", "qp", "robot", "lowlevel", "safety"],
     "trajectory": ["control"],
     "sim": ["robot"],
+    "hardware": ["robot"],
     "app": ["control", "trajectory", "sim"],
     "experiments": ["app", "control", "sim"],
     "dashboard": ["app"],
