@@ -37,6 +37,7 @@ void LowLevelController::command_torque(const Eigen::VectorXd& tau, RobotCommand
     case LowLevelMode::kPosition: return;
     case LowLevelMode::kKinovaTorque:
     case LowLevelMode::kKinovaTorqueHighVelocity:
+    case LowLevelMode::kTorque:
       command.mode = loop_;
       command.tau_Nm = tau;
       return;
@@ -89,8 +90,8 @@ void LowLevelController::update(const RobotState& state, const Eigen::VectorXd& 
       break;
     case LowLevelMode::kKinovaTorque:
     case LowLevelMode::kKinovaTorqueHighVelocity:
-      command.mode = loop_ == LowLevelMode::kKinovaTorque ? LowLevelMode::kKinovaTorque
-                                                          : LowLevelMode::kKinovaTorqueHighVelocity;
+    case LowLevelMode::kTorque:  // a generic drive's plain torque: the same set-point, no vendor loop
+      command.mode = loop_;
       // Bumpless: start from the torque the motors produce now, fade into tau_d. That torque is
       // the measured current in the vendor's own units (nominal K_T G_r, the constant its loop
       // converts with), so the first command asks for the present current even when the drives'

@@ -10,7 +10,8 @@
 //                             follow (a push it cannot resist), so q_ref never runs away
 //   kKinovaTorque             tau_d to the vendor's torque loop
 //   kKinovaTorqueHighVelocity tau_d to the vendor's high-velocity torque loop
-//                             (both entered at the torque the motors produce: the set-point
+//   kTorque                   tau_d to a generic drive's plain torque mode
+//                             (all three entered at the torque the motors produce: the set-point
 //                             starts at the measured current x K_T G_r, or at tau_s without a
 //                             current reading, and blends into tau_d, time constant 50 ms)
 //   kCustom                   CustomTorqueController: motor current (reset bumplessly on entry
