@@ -60,7 +60,7 @@ void bind_command(py::module_& m) {
       .def("copy", [](const RobotCommand& command) { return RobotCommand(command); }, "A deep copy.")
       .def_readwrite("mode", &RobotCommand::mode);
   vector_property(c, "q_rad", &RobotCommand::q_rad, true, "Position set-point [rad] (kPosition).");
-  vector_property(c, "tau_Nm", &RobotCommand::tau_Nm, true, "Torque set-point [N m] (Kinova torque loops).");
+  vector_property(c, "tau_Nm", &RobotCommand::tau_Nm, true, "Torque set-point [N m] (Kinova torque loops, plain torque).");
   vector_property(c, "current_A", &RobotCommand::current_A, true, "Motor current set-point [A] (custom loop).");
 }
 
@@ -69,7 +69,8 @@ void bind_command(py::module_& m) {
 void bind_robot(py::module_& m) {
   bind_enum<LowLevelMode, kLowLevelModeCount>(m, "LowLevelMode",
                                               "Which actuator loop runs: position, kinova_torque, "
-                                              "kinova_torque_high_velocity, custom (the paper's loop, drives in current mode).");
+                                              "kinova_torque_high_velocity, custom (the paper's loop, drives in current mode), "
+                                              "torque (a generic drive's plain torque).");
   py::enum_<WriteStatus>(m, "WriteStatus", "The answer of RobotInterface.write; anything but ok refused the command.")
       .value("ok", WriteStatus::kOk)
       .value("invalid_mode", WriteStatus::kInvalidMode)

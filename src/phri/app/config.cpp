@@ -319,7 +319,11 @@ void parse_low_level(const YamlReader& r, ControllerSettings& c, FsmSettings& fs
   r.allow_keys({"torque_loop", "custom"});
   if (r.has("torque_loop")) {
     fsm.torque_loop = *low_level_mode_from_string(
-        r.choice("torque_loop", {"kinova_torque", "kinova_torque_high_velocity", "custom"}));
+        r.choice("torque_loop", {"kinova_torque", "kinova_torque_high_velocity", "custom", "torque"}));
+    if (!c.offered_loops.contains(fsm.torque_loop)) {
+      throw r.error("torque_loop", "'" + std::string(to_string(fsm.torque_loop)) + "' is not a loop the robot's drives offer (" +
+                                       c.offered_loops.names() + ")");
+    }
   }
   if (r.has("custom")) {
     const YamlReader k = r.at("custom");
@@ -408,7 +412,7 @@ void parse_fsm(const YamlReader& r, int dof, FsmSettings& f) {
   }
 }
 
-std::vector<TimedEvent> parse_events(const YamlReader& list, double duration_s) {
+std::vector<TimedEvent> parse_events(const YamlReader& list, double duration_s, const LowLevelModeSet& offered_loops) {
   list.expect_sequence();
   std::vector<TimedEvent> out;
   for (std::size_t i = 0; i < list.size(); ++i) {
@@ -424,6 +428,11 @@ std::vector<TimedEvent> parse_events(const YamlReader& list, double duration_s) 
       std::string names;
       for (std::string_view n : kEventNames) names += (names.empty() ? "" : ", ") + std::string(n);
       throw e.error("event", "unknown event '" + name + "' (one of " + names + ")");
+    }
+    const std::optional<LowLevelMode> loop = loop_of(*event);
+    if (loop && !offered_loops.contains(*loop)) {
+      throw e.error("event", "'" + std::string(to_string(*loop)) + "' is not a loop the robot's drives offer (" +
+                                 offered_loops.names() + ")");
     }
     timed.event = *event;
     out.push_back(timed);
@@ -538,7 +547,7 @@ Config parse(const YamlReader& root, const std::string& base_dir, const std::str
   c.logging.dof = std::min(dof, kLogMaxJoints);
   if (root.has("gamepad")) parse_gamepad(root.at("gamepad"), c.gamepad);
   if (root.has("run")) parse_run(root.at("run"), c.run);
-  if (root.has("events")) c.fsm.timeline = parse_events(root.at("events"), c.run.duration_s);
+  if (root.has("events")) c.fsm.timeline = parse_events(root.at("events"), c.run.duration_s, c.controller.offered_loops);
   check_config_against_robot(c);
   return c;
 }

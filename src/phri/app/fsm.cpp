@@ -82,6 +82,11 @@ Fsm::Fsm(const FsmSettings& settings, const Controller& cycle)
       dynamic_(settings.dynamic_scenario) {
   const int nv = model_.nv();
   check_settings(settings_, nv);
+  if (!cycle.settings().offered_loops.contains(settings_.torque_loop)) {
+    throw ConfigError("FsmSettings", "torque_loop",
+                      "'" + std::string(to_string(settings_.torque_loop)) + "' is not a loop the robot's drives offer (" +
+                          cycle.settings().offered_loops.names() + ")");
+  }
   std::stable_sort(settings_.timeline.begin(), settings_.timeline.end(),
                    [](const TimedEvent& a, const TimedEvent& b) { return a.time_s < b.time_s; });
   home_q_ = to_vector(settings_.startup.home_q_rad);
@@ -173,6 +178,12 @@ void Fsm::handle(Event event, double t, const RobotState& /*state*/, const Contr
     return;
   }
   if (const auto loop = loop_of(event)) {
+    // A loop the drives lack goes on to the controller, which rejects it (the cycle's status says
+    // so); it never becomes the loop start-up or toggle_loop hands over to.
+    if (!cycle.settings().offered_loops.contains(*loop)) {
+      targets_.low_level_mode = *loop;
+      return;
+    }
     if (*loop != LowLevelMode::kPosition) torque_loop_ = *loop;
     if (starting) {
       startup_handover_ = *loop;  // the start-up move itself stays in Position

@@ -80,7 +80,8 @@ std::string Logger::legend_yaml() {
                                         ComplianceMode::kDual});
   out += "touched:\n  0: free\n  1: touched\n";
   legend_entry(out, "low_level_loop", {LowLevelMode::kPosition, LowLevelMode::kKinovaTorque,
-                                       LowLevelMode::kKinovaTorqueHighVelocity, LowLevelMode::kCurrent});
+                                       LowLevelMode::kKinovaTorqueHighVelocity, LowLevelMode::kCurrent,
+                                       LowLevelMode::kTorque});
   out += "fsm_state:\n  -1: none\n";
   for (FsmState st : {FsmState::kStartup, FsmState::kStatic, FsmState::kDynamic, FsmState::kStopped}) {
     out += "  " + std::to_string(static_cast<int>(st)) + ": " + std::string(to_string(st)) + "\n";

@@ -155,8 +155,7 @@ RobotBundle parse(const YamlReader& r, const std::string& folder) {
   const int dof = ActuatorTable::from_yaml_file(b.actuators_path).size();
   b.home_q_rad = r.per_joint<std::vector<double>>("home_q_rad", dof, -kMaxJointAngle_rad, kMaxJointAngle_rad);
   b.compliance_deadband_Nm = r.per_joint<Eigen::VectorXd>("compliance_deadband_Nm", dof, 0.0, kMaxDeadband_Nm);
-  // Only Kinova's actuator loops are emulated so far; a generic drive is future work (issue 16).
-  (void)r.choice("drive", {"kinova"});
+  b.drive = r.choice("drive", {"kinova", "generic"}) == "generic" ? DriveKind::kGeneric : DriveKind::kKinova;
   if (r.has("custom_loop_filter")) parse_custom_loop_filter(r.at("custom_loop_filter"), b);
   if (r.has("end_of_arm")) b.end_of_arm = parse_end_of_arm(r.at("end_of_arm"));
   parse_plant(r.has("plant") ? r.at("plant") : YamlReader(YAML::Node(YAML::NodeType::Map), r.file(), "plant"), folder, b);
@@ -251,6 +250,7 @@ void RobotBundle::apply_to(ControllerSettings& s) const {
   s.base_placement = base_placement;
   s.custom_torque.filter_numerator = custom_loop_numerator;
   s.custom_torque.filter_denominator = custom_loop_denominator;
+  s.offered_loops = offered_loops(drive);
 }
 
 void RobotBundle::apply_to(SimRobotConfig& c) const {
@@ -265,6 +265,7 @@ void RobotBundle::apply_to(SimRobotConfig& c) const {
   c.set_end_of_arm(end_of_arm);
   c.gravity_m_s2 = gravity_m_s2;
   c.base_placement = base_placement;
+  c.drive = drive;
 }
 
 }  // namespace phri

@@ -17,6 +17,7 @@
 // `phri run --robot DIR` replaces whatever robot the YAML names. Errors are phri::ConfigError
 // naming robot.yaml and the key path (e.g. "end_of_arm.tool.mass_kg").
 #include <phri/control/controller_settings.hpp>
+#include <phri/robot/drive_kind.hpp>
 #include <phri/sim/sim_robot_config.hpp>
 
 #include <Eigen/Core>
@@ -51,7 +52,9 @@ struct RobotBundle {
   Eigen::Vector3d gravity_m_s2 = Eigen::Vector3d(0.0, 0.0, -9.81);
   Eigen::Isometry3d base_placement = Eigen::Isometry3d::Identity();
   Eigen::VectorXd compliance_deadband_Nm;  ///< per joint
-  enum class Drive { kKinova } drive = Drive::kKinova;
+  /// `drive: kinova | generic`: whose drives, hence the loops offered (robot/drive_kind.hpp); the
+  /// controller gets the offered loops, the plant the matching drive loops.
+  DriveKind drive = DriveKind::kKinova;
   /// The custom torque loop's H(z) (b, a in powers of z^-1); both empty: Kinova's (the library's).
   std::vector<double> custom_loop_numerator, custom_loop_denominator;
 

@@ -100,6 +100,11 @@ const ActuatorTable& checked(const ActuatorTable& table, const Model& model, con
 
 const ControllerSettings& checked(const ControllerSettings& settings) {
   if (!(settings.period_s > 0)) throw ConfigError("ControllerSettings", "period_s", "must be > 0");
+  if (!settings.offered_loops.contains(settings.initial_loop)) {
+    throw ConfigError("ControllerSettings", "initial_loop",
+                      "'" + std::string(to_string(settings.initial_loop)) + "' is not a loop the robot's drives offer (" +
+                          settings.offered_loops.names() + ")");
+  }
   // The discrete observer r_k = K_O (p_k - p_0 - sum T (... + r_{k-1})) has the pole 1 - K_O T:
   // unstable for K_O T >= 2, ringing above 1.
   if (!(settings.observer_gain > 0 && settings.observer_gain * settings.period_s < 1.0)) {
@@ -269,7 +274,10 @@ bool Controller::apply(const ControllerTargets& targets) {
                                         static_cast<int>(*targets.compliance_mode) < kComplianceModeCount)) {
     pending_mode_ = targets.compliance_mode;
   }
-  if (targets.low_level_mode && accept(is_valid(*targets.low_level_mode))) low_level_.request(*targets.low_level_mode);
+  // A loop the drives do not offer is refused like an invalid one: the running loop stays.
+  if (targets.low_level_mode && accept(settings_.offered_loops.contains(*targets.low_level_mode))) {
+    low_level_.request(*targets.low_level_mode);
+  }
   return rejected_targets_ == rejected_before;
 }
 

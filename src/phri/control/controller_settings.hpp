@@ -160,6 +160,10 @@ struct ControllerSettings {
   SafetySettings safety;
   ComplianceMode initial_compliance = ComplianceMode::kNullSpace;
   LowLevelMode initial_loop = LowLevelMode::kCurrent;
+  /// The loops the robot's drives offer (a robot bundle's `drive:`, robot/drive_kind.hpp); a target
+  /// asking for another is rejected, an initial_loop outside it is a ConfigError. Default: every
+  /// loop (settings built in code, no bundle).
+  LowLevelModeSet offered_loops = LowLevelModeSet::all();
 };
 
 }  // namespace phri

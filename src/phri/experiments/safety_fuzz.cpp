@@ -160,7 +160,8 @@ bool setpoint_finite(const RobotCommand& c) {
   switch (c.mode) {
     case LowLevelMode::kPosition: return c.q_rad.allFinite();
     case LowLevelMode::kKinovaTorque:
-    case LowLevelMode::kKinovaTorqueHighVelocity: return c.tau_Nm.allFinite();
+    case LowLevelMode::kKinovaTorqueHighVelocity:
+    case LowLevelMode::kTorque: return c.tau_Nm.allFinite();
     case LowLevelMode::kCurrent: return c.current_A.allFinite();
   }
   return false;

@@ -24,8 +24,12 @@ LowLevelController::LowLevelController(const ActuatorTable& actuators, const Cus
       entry_current_(Eigen::VectorXd::Zero(actuators.size())),
       breakaway_(Eigen::VectorXd::Zero(actuators.size())),
       breakaway_share_(Eigen::VectorXd::Constant(actuators.size(), kVendorBreakawayShare)),
+      reflected_inertia_(Eigen::VectorXd::Zero(actuators.size())),
+      feedforward_(Eigen::VectorXd::Zero(actuators.size())),
+      entry_torque_(Eigen::VectorXd::Zero(actuators.size())),
       offset_decay_(std::exp(-custom.period_s / kTorqueBlendTime)) {
   for (int i = 0; i < actuators.size(); ++i) {
+    reflected_inertia_[i] = actuators[i].reflected_inertia_kgm2;
     torque_per_amp_[i] = actuators[i].torque_per_amp();
     current_limit_[i] = actuators[i].current_limit_A;
     friction_.push_back(actuators[i].friction);
@@ -37,6 +41,7 @@ void LowLevelController::command_torque(const Eigen::VectorXd& tau, RobotCommand
     case LowLevelMode::kPosition: return;
     case LowLevelMode::kKinovaTorque:
     case LowLevelMode::kKinovaTorqueHighVelocity:
+    case LowLevelMode::kTorque:
       command.mode = loop_;
       command.tau_Nm = tau;
       return;
@@ -89,8 +94,7 @@ void LowLevelController::update(const RobotState& state, const Eigen::VectorXd& 
       break;
     case LowLevelMode::kKinovaTorque:
     case LowLevelMode::kKinovaTorqueHighVelocity:
-      command.mode = loop_ == LowLevelMode::kKinovaTorque ? LowLevelMode::kKinovaTorque
-                                                          : LowLevelMode::kKinovaTorqueHighVelocity;
+      command.mode = loop_;
       // Bumpless: start from the torque the motors produce now, fade into tau_d. That torque is
       // the measured current in the vendor's own units (nominal K_T G_r, the constant its loop
       // converts with), so the first command asks for the present current even when the drives'
@@ -105,6 +109,15 @@ void LowLevelController::update(const RobotState& state, const Eigen::VectorXd& 
       }
       update_friction_assist(state.qd_rad_s, qdd_desired);
       command.tau_Nm = tau_desired + torque_offset_ + breakaway_;
+      torque_offset_ *= offset_decay_;
+      break;
+    case LowLevelMode::kTorque:
+      // A plain torque drive applies the set-point as it is: no sensor feedback rejects the gear
+      // friction or drives the rotor, so the custom loop's feed-forward terms are added here.
+      command.mode = LowLevelMode::kTorque;
+      if (entering) torque_offset_ = entry_torque(state) - tau_desired;  // bumpless, as above
+      plain_torque_feedforward(state.qd_rad_s, qdd_desired);
+      command.tau_Nm = tau_desired + torque_offset_ + feedforward_;
       torque_offset_ *= offset_decay_;
       break;
     case LowLevelMode::kCurrent:
@@ -123,6 +136,27 @@ void LowLevelController::update(const RobotState& state, const Eigen::VectorXd& 
       command.mode = LowLevelMode::kCurrent;
       command.current_A = custom_.current();
       break;
+  }
+}
+
+const Eigen::VectorXd& LowLevelController::entry_torque(const RobotState& state) {
+  if (state.current.valid && state.current_A.size() == torque_per_amp_.size()) {
+    entry_torque_ = torque_per_amp_.cwiseProduct(state.current_A);
+  } else {
+    entry_torque_ = state.tau_sensor_Nm;
+  }
+  return entry_torque_;
+}
+
+// The plain torque mode's feed-forward: the paper's friction model and the rotor's inertia torque,
+// each as the custom loop's settings switch it.
+void LowLevelController::plain_torque_feedforward(const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd_desired) {
+  const CustomTorqueSettings& settings = custom_.settings();
+  for (Eigen::Index i = 0; i < feedforward_.size(); ++i) {
+    const std::size_t j = static_cast<std::size_t>(i);
+    const double friction = settings.friction_compensation ? friction_compensation(friction_[j], qd[i], qdd_desired[i]) : 0.0;
+    const double rotor = settings.rotor_inertia_compensation ? reflected_inertia_[i] * qdd_desired[i] : 0.0;
+    feedforward_[i] = friction + rotor;
   }
 }
 

@@ -10,7 +10,9 @@
 //                             follow (a push it cannot resist), so q_ref never runs away
 //   kKinovaTorque             tau_d to the vendor's torque loop
 //   kKinovaTorqueHighVelocity tau_d to the vendor's high-velocity torque loop
-//                             (both entered at the torque the motors produce: the set-point
+//   kTorque                   tau_d to a generic drive's plain torque mode, plus the custom loop's
+//                             friction and rotor-inertia feed-forward (no loop in the drive does it)
+//                             (all three entered at the torque the motors produce: the set-point
 //                             starts at the measured current x K_T G_r, or at tau_s without a
 //                             current reading, and blends into tau_d, time constant 50 ms)
 //   kCustom                   CustomTorqueController: motor current (reset bumplessly on entry
@@ -52,6 +54,8 @@ public:
 
   /// Position-loop reference clamps so far (joint-cycles where the servo could not follow).
   long resync_count() const { return resyncs_; }
+  /// The plain torque mode's feed-forward of this cycle (friction and rotor inertia) [N.m].
+  const Eigen::VectorXd& plain_torque_feedforward() const { return feedforward_; }
   /// Vendor torque loops: the share of static friction added to tau_d at breakaway (stuck joint,
   /// desired acceleration beyond the friction model's threshold). Kinova's torque loop rejects only
   /// part of the gear friction through its torque-sensor feedback; without this a soft spring
@@ -78,6 +82,10 @@ public:
 
 private:
   void update_friction_assist(const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd_desired);
+  void plain_torque_feedforward(const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd_desired);
+  // The torque the motors produce now, as the Kinova loops' entry reads it: measured current x
+  // K_T G_r (nominal), else tau_s.
+  const Eigen::VectorXd& entry_torque(const RobotState& state);
   CustomTorqueController custom_;
   double period_s_;
   LowLevelMode loop_;
@@ -94,6 +102,9 @@ private:
   Eigen::VectorXd entry_current_;  // the current the custom loop starts from
   Eigen::VectorXd breakaway_;      // the vendor loops' breakaway feed-forward of this cycle [N.m]
   Eigen::VectorXd breakaway_share_;  // its share of the static friction, per joint
+  Eigen::VectorXd reflected_inertia_;  // I_r per joint [kg.m^2]
+  Eigen::VectorXd feedforward_;        // the plain torque mode's friction + rotor torque [N.m]
+  Eigen::VectorXd entry_torque_;
   bool breakaway_ramp_ = true;
   double offset_decay_ = 0.0;
 };

@@ -18,7 +18,7 @@ struct RobotCommand {
 
   LowLevelMode mode = LowLevelMode::kPosition;
   Eigen::VectorXd q_rad;      ///< kPosition: joint position set-point [rad] (continuous joints unwrapped)
-  Eigen::VectorXd tau_Nm;     ///< kKinovaTorque, kKinovaTorqueHighVelocity: joint torque set-point [N.m]
+  Eigen::VectorXd tau_Nm;     ///< kKinovaTorque, kKinovaTorqueHighVelocity, kTorque: joint torque set-point [N.m]
   Eigen::VectorXd current_A;  ///< kCurrent: motor current set-point [A] (motor side; tau = K_T G_r i)
 
   /// The mode of `from` and the set-point that mode uses; the other set-points keep their values
@@ -28,7 +28,8 @@ struct RobotCommand {
     switch (from.mode) {
       case LowLevelMode::kPosition: q_rad = from.q_rad; break;
       case LowLevelMode::kKinovaTorque:
-      case LowLevelMode::kKinovaTorqueHighVelocity: tau_Nm = from.tau_Nm; break;
+      case LowLevelMode::kKinovaTorqueHighVelocity:
+      case LowLevelMode::kTorque: tau_Nm = from.tau_Nm; break;
       case LowLevelMode::kCurrent: current_A = from.current_A; break;
     }
   }

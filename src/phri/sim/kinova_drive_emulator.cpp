@@ -58,6 +58,7 @@ void KinovaDriveEmulator::enter(LowLevelMode mode, const Eigen::VectorXd& q_meas
       break;
     case LowLevelMode::kKinovaTorque:
     case LowLevelMode::kCurrent:
+    case LowLevelMode::kTorque:  // not offered
       break;
   }
 }
@@ -86,6 +87,8 @@ void KinovaDriveEmulator::begin_cycle(const RobotCommand& command, bool fresh, c
     case LowLevelMode::kCurrent:
       current_des_ = command.current_A;
       break;
+    case LowLevelMode::kTorque:  // not offered (SimRobot::validate refuses it)
+      break;
   }
   if (mode_change) enter(command.mode, q_meas, tau_motor);
 }
@@ -113,6 +116,8 @@ void KinovaDriveEmulator::tick(const Eigen::VectorXd& q_meas, const Eigen::Vecto
       case LowLevelMode::kCurrent:
         current_out[i] = std::clamp(current_des_[i], -current_limit_[i], current_limit_[i]);
         continue;
+      case LowLevelMode::kTorque:  // not offered: no torque rather than a loop Kinova lacks
+        break;
     }
     current_out[i] = std::clamp(tau / torque_per_amp_[i], -current_limit_[i], current_limit_[i]);
   }

@@ -28,11 +28,15 @@
 //   H is clocked at its design rate (1 kHz, the Kortex cycle at which the coefficients were read);
 //   its output is held between its ticks. H's DC gain is 1, so it halves static torque errors.
 // * kCurrent — i = i_d (saturated only).
+// kTorque (a generic drive's plain torque) is not offered: SimRobot refuses it before it reaches
+// the drives.
 //
 // All buffers are sized at construction; begin_cycle() and tick() do not allocate.
 #include <phri/core/discrete_transfer_function.hpp>
 #include <phri/robot/actuator_table.hpp>
+#include <phri/robot/drive_kind.hpp>
 #include <phri/robot/robot_command.hpp>
+#include <phri/sim/drive_loops.hpp>
 #include <phri/sim/sim_robot_config.hpp>
 
 #include <Eigen/Core>
@@ -41,7 +45,7 @@
 
 namespace phri {
 
-class KinovaDriveEmulator {
+class KinovaDriveEmulator final : public DriveLoops {
 public:
   /// `drives`: the plant's actuators (K_T, G_r, current and velocity limits); `tick_s`: period of
   /// tick() (the physics step); `control_period_s`: period of begin_cycle().
@@ -49,21 +53,22 @@ public:
                       double control_period_s);
 
   int dof() const { return static_cast<int>(kp_.size()); }
-  LowLevelMode mode() const { return mode_; }
+  LowLevelModeSet offered() const override { return offered_loops(DriveKind::kKinova); }
+  LowLevelMode mode() const override { return mode_; }
 
   /// Start of a control cycle. `command` is the command in force for this cycle (already
   /// validated); `fresh` says whether it was written since the previous cycle. `q_meas` and
   /// `tau_motor` (the motor torque of the previous tick) initialise a newly entered mode.
   void begin_cycle(const RobotCommand& command, bool fresh, const Eigen::VectorXd& q_meas,
-                   const Eigen::VectorXd& tau_motor);
+                   const Eigen::VectorXd& tau_motor) override;
   /// One inner-loop tick: measured q, qd, tau_s in; saturated motor current out. `filter_tick`
   /// clocks the high-velocity filter H(z).
   void tick(const Eigen::VectorXd& q_meas, const Eigen::VectorXd& qd_meas, const Eigen::VectorXd& tau_meas,
-            bool filter_tick, Eigen::VectorXd& current_out);
+            bool filter_tick, Eigen::VectorXd& current_out) override;
 
   /// Which measurements the running mode reads (the plant draws sensor noise only for those).
-  bool uses_velocity() const { return mode_ == LowLevelMode::kPosition || mode_ == LowLevelMode::kKinovaTorque; }
-  bool uses_torque() const {
+  bool uses_velocity() const override { return mode_ == LowLevelMode::kPosition || mode_ == LowLevelMode::kKinovaTorque; }
+  bool uses_torque() const override {
     return mode_ == LowLevelMode::kKinovaTorque || mode_ == LowLevelMode::kKinovaTorqueHighVelocity;
   }
   /// Integrator of the position servo [N.m] (for tests and logs).
@@ -71,6 +76,8 @@ public:
   /// Sets the position servo's integrator, e.g. to the gravity torque of the initial pose (the
   /// arm is already holding itself when the simulation starts).
   void set_position_integral(const Eigen::VectorXd& integral);
+  /// The position servo's integrator carries the initial pose's holding torque.
+  void start_holding(const Eigen::VectorXd& tau) override { set_position_integral(tau); }
 
 private:
   void enter(LowLevelMode mode, const Eigen::VectorXd& q_meas, const Eigen::VectorXd& tau_motor);

@@ -1,5 +1,7 @@
 #include <phri/core/error.hpp>
 #include <phri/sim/sim_robot.hpp>
+#include <phri/sim/generic_drive.hpp>
+#include <phri/sim/kinova_drive_emulator.hpp>
 #include <phri/sim/link_inertial.hpp>
 #include <phri/sim/mujoco_handles.hpp>
 #include <phri/sim/sim_scene.hpp>
@@ -84,13 +86,25 @@ RandomPushGenerator::LinkSurface capsule_surface(const mjModel* m, int body, int
   return s;
 }
 
+// The drives' own loops, fresh (no mode entered yet).
+std::unique_ptr<DriveLoops> make_drive_loops(const SimRobotConfig& c) {
+  switch (c.drive) {
+    case DriveKind::kGeneric:
+      return std::make_unique<GenericDrive>(c.actuators, c.vendor.position_kp_Nm_per_rad, c.vendor.position_kd_Nms_per_rad,
+                                            c.control_period_s);
+    case DriveKind::kKinova:
+      break;
+  }
+  return std::make_unique<KinovaDriveEmulator>(c.actuators, c.vendor, c.physics_step_s(), c.control_period_s);
+}
+
 }  // namespace
 
 SimRobot::SimRobot(const SimRobotConfig& config)
     : config_(completed(config)),
       plant_actuators_(config_.plant_actuators()),
       n_(config_.dof()),
-      drive_(config_.actuators, config_.vendor, config_.physics_step_s(), config_.control_period_s) {
+      drive_(make_drive_loops(config_)) {
   substeps_ = config_.substeps_per_cycle();
   filter_decimation_ = static_cast<int>(std::lround(config_.physics_rate_Hz / config_.vendor.high_velocity_rate_Hz));
   ft_decimation_ = static_cast<int>(std::lround(config_.physics_rate_Hz / config_.ft_sensor.rate_Hz));
@@ -416,9 +430,9 @@ void SimRobot::start_drives_holding(const Eigen::VectorXd& hold) {
     command_.q_rad[i] = elastic() ? servo_position(i) : config_.initial_q_rad[static_cast<std::size_t>(i)];
     q_meas_[i] = quantize(servo_position(i));
   }
-  drive_ = KinovaDriveEmulator(config_.actuators, config_.vendor, config_.physics_step_s(), config_.control_period_s);
-  drive_.begin_cycle(command_, false, q_meas_, vendor_torque());
-  drive_.set_position_integral(vendor_torque());
+  drive_ = make_drive_loops(config_);
+  drive_->begin_cycle(command_, false, q_meas_, vendor_torque());
+  drive_->start_holding(vendor_torque());
 }
 
 // Initial F/T sample with the arm held (qacc ~ 0) and the latch carrying the mass.
@@ -458,11 +472,13 @@ constexpr double kMaxFollowingError_rad = 5.0 * 3.14159265358979323846 / 180.0;
 WriteStatus SimRobot::validate(const RobotCommand& c) const {
   if (fault_) return WriteStatus::kFault;
   if (!is_valid(c.mode)) return WriteStatus::kInvalidMode;
+  if (!drive_->offered().contains(c.mode)) return WriteStatus::kInvalidMode;  // a loop these drives lack
   const Eigen::VectorXd* v = nullptr;
   switch (c.mode) {
     case LowLevelMode::kPosition: v = &c.q_rad; break;
     case LowLevelMode::kKinovaTorque:
-    case LowLevelMode::kKinovaTorqueHighVelocity: v = &c.tau_Nm; break;
+    case LowLevelMode::kKinovaTorqueHighVelocity:
+    case LowLevelMode::kTorque: v = &c.tau_Nm; break;
     case LowLevelMode::kCurrent: v = &c.current_A; break;
   }
   if (v->size() != n_) return WriteStatus::kSizeMismatch;
@@ -481,6 +497,7 @@ WriteStatus SimRobot::validate(const RobotCommand& c) const {
         break;
       case LowLevelMode::kKinovaTorque:
       case LowLevelMode::kKinovaTorqueHighVelocity:
+      case LowLevelMode::kTorque:
         if (std::abs(x) > max_torque_[i]) return WriteStatus::kOutOfRange;
         break;
       case LowLevelMode::kCurrent:
@@ -513,7 +530,7 @@ const RobotState& SimRobot::read() {
     command_.copy_setpoint(pending_);
     has_pending_ = false;
   }
-  drive_.begin_cycle(command_, fresh, q_meas_, vendor_torque());
+  drive_->begin_cycle(command_, fresh, q_meas_, vendor_torque());
   for (int s = 0; s < substeps_; ++s) substep();
   if (d_->warning[mjWARN_BADQACC].number > 0 || d_->warning[mjWARN_BADQVEL].number > 0 ||
       d_->warning[mjWARN_BADQPOS].number > 0) {
@@ -596,8 +613,8 @@ void SimRobot::substep() {
   const double t = d_->time;
 
   // 2. The drives' sensors and the vendor loop.
-  const bool noisy_velocity = drive_.uses_velocity();
-  const bool noisy_torque = drive_.uses_torque();
+  const bool noisy_velocity = drive_->uses_velocity();
+  const bool noisy_torque = drive_->uses_torque();
   const double sv = config_.noise.velocity_std_rad_s;
   const double st = config_.noise.torque_sensor_std_Nm;
   for (int i = 0; i < n_; ++i) {
@@ -605,7 +622,7 @@ void SimRobot::substep() {
     qd_meas_[i] = servo_velocity(i) + (noisy_velocity ? joint_noise_.normal(sv) : 0.0);
     tau_meas_[i] = tau_s_[i] + offsets_[i] + (noisy_torque ? joint_noise_.normal(st) : 0.0);
   }
-  drive_.tick(q_meas_, qd_meas_, tau_meas_, substep_count_ % static_cast<std::uint64_t>(filter_decimation_) == 0, current_);
+  drive_->tick(q_meas_, qd_meas_, tau_meas_, substep_count_ % static_cast<std::uint64_t>(filter_decimation_) == 0, current_);
 
   // 3. Joint torques: rigid, motor and the explicit part of the dry friction; elastic, the spring.
   for (int i = 0; i < n_; ++i) {
@@ -759,7 +776,7 @@ void SimRobot::sample_state() {
   if (!joints_ok || !torque_ok || !current_ok || !wrench_meas_.allFinite()) fault_ = true;
   state_.time_s = t;
   ++state_.cycle;
-  state_.mode = drive_.mode();
+  state_.mode = drive_->mode();
   state_.fault = fault_;
   for (SignalStatus* s : {&state_.joints, &state_.torque, &state_.current}) {
     ++s->sequence;

@@ -2,7 +2,7 @@
 // phri::SimRobot: the simulated Kinova Gen3 behind phri::RobotInterface — MuJoCo 2.2.2 rigid-body
 // physics plus what makes a torque-controlled arm hard to control: the drives (current
 // saturation, reflected rotor inertia, Coulomb/viscous/static joint friction), the vendor's own
-// actuator loops (KinovaDriveEmulator), realistic sensors, model mismatch and disturbances.
+// actuator loops (KinovaDriveEmulator, or GenericDrive for `drive: generic`), realistic sensors, model mismatch and disturbances.
 //
 //   phri::SimRobot robot(phri::SimRobotConfig::from_yaml_file("configs/plant_gen3.yaml"));
 //   phri::LoopClock clock(robot.period_s(), phri::LoopClock::Pacing::kLockstep);  // or kRealTime
@@ -41,8 +41,8 @@
 // A divergence of the physics (MuJoCo reports bad accelerations) latches RobotState::fault.
 #include <phri/core/random_generator.hpp>
 #include <phri/robot/actuator_table.hpp>
+#include <phri/sim/drive_loops.hpp>
 #include <phri/sim/elastic_transmission.hpp>
-#include <phri/sim/kinova_drive_emulator.hpp>
 #include <phri/sim/mujoco_handles.hpp>
 #include <phri/sim/random_push_generator.hpp>
 #include <phri/robot/robot_interface.hpp>
@@ -52,6 +52,7 @@
 #include <Eigen/Core>
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 namespace phri {
@@ -99,7 +100,8 @@ public:
   /// Position limits used to validate kPosition set-points (+-100 rad for continuous joints).
   const Eigen::VectorXd& position_lower_rad() const { return lower_; }
   const Eigen::VectorXd& position_upper_rad() const { return upper_; }
-  const KinovaDriveEmulator& drive() const { return drive_; }
+  /// The drives' own loops (config().drive: Kinova's, emulated, or a generic drive's).
+  const DriveLoops& drive() const { return *drive_; }
   /// Back to the initial state: same configuration and seeds, so the same run again (the live
   /// disturbance cleared).
   void reset();
@@ -186,7 +188,7 @@ private:
   Eigen::VectorXd q_before_;                  // link angles at a physics step's start
   double quantum_ = 0.0;
 
-  KinovaDriveEmulator drive_;
+  std::unique_ptr<DriveLoops> drive_;  // made at reset() (not in the cycle)
   RobotCommand command_, pending_;
   bool has_pending_ = false;
   bool fault_ = false;

@@ -15,6 +15,7 @@
 // perturbs the plant's link inertials relative to the URDF (model mismatch).
 #include <phri/core/error.hpp>
 #include <phri/robot/actuator_table.hpp>
+#include <phri/robot/drive_kind.hpp>
 #include <phri/robot/end_of_arm.hpp>
 #include <phri/sim/external_force.hpp>
 #include <phri/sim/random_push_settings.hpp>
@@ -145,6 +146,11 @@ struct SimRobotConfig {
     /// vendor's loops keep converting with the nominal value, as real firmware does.
     double torque_constant_fraction = 0.0;
   } mismatch;
+
+  // ---- whose drives: Kinova's loops, emulated (KinovaDriveEmulator, the `vendor` section), or a
+  // generic current/torque drive (GenericDrive: position hold with the vendor section's position
+  // kp and kd, no integrator; plain torque; current). A robot bundle's `drive:` sets it.
+  DriveKind drive = DriveKind::kKinova;
 
   // ---- the vendor's actuator loops, emulated inside the plant (see KinovaDriveEmulator)
   struct Vendor {

@@ -1,0 +1,43 @@
+#pragma once
+// phri::DriveLoops: the loops a simulated arm's drives run below the RobotInterface (in the
+// actuator firmware on a real arm), one implementation per robot.yaml `drive:`:
+//   kinova  KinovaDriveEmulator: position servo, Kinova's two torque loops, current
+//   generic GenericDrive: PD position hold, plain torque, current
+// Every mode ends in a motor current, saturated at the drive's limit; the plant turns it into
+// joint torque K_T G_r i. begin_cycle() and tick() do not allocate.
+#include <phri/robot/low_level_mode.hpp>
+#include <phri/robot/robot_command.hpp>
+
+#include <Eigen/Core>
+
+namespace phri {
+
+class DriveLoops {
+public:
+  virtual ~DriveLoops() = default;
+
+  /// The modes these drives run; SimRobot refuses a write in any other mode.
+  virtual LowLevelModeSet offered() const = 0;
+  virtual LowLevelMode mode() const = 0;
+
+  /// Start of a control cycle. `command` is the command in force for this cycle (already
+  /// validated, in an offered mode); `fresh` says whether it was written since the previous
+  /// cycle. `q_meas` and `tau_motor` (the motor torque of the previous tick) initialise a newly
+  /// entered mode.
+  virtual void begin_cycle(const RobotCommand& command, bool fresh, const Eigen::VectorXd& q_meas,
+                           const Eigen::VectorXd& tau_motor) = 0;
+  /// One inner-loop tick: measured q, qd, tau_s in; saturated motor current out. `filter_tick`
+  /// clocks loops that run slower than the physics (Kinova's H(z)).
+  virtual void tick(const Eigen::VectorXd& q_meas, const Eigen::VectorXd& qd_meas, const Eigen::VectorXd& tau_meas,
+                    bool filter_tick, Eigen::VectorXd& current_out) = 0;
+
+  /// Which measurements the running mode reads (the plant draws sensor noise only for those).
+  virtual bool uses_velocity() const = 0;
+  virtual bool uses_torque() const = 0;
+
+  /// The arm starts the simulation already holding itself: the position hold carries `tau` [N.m]
+  /// (the gravity torque of the initial pose) from the first tick.
+  virtual void start_holding(const Eigen::VectorXd& tau) = 0;
+};
+
+}  // namespace phri

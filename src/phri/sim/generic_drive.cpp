@@ -1,0 +1,96 @@
+#include <phri/sim/generic_drive.hpp>
+
+#include <algorithm>
+
+namespace phri {
+
+GenericDrive::GenericDrive(const ActuatorTable& drives, const std::vector<double>& kp, const std::vector<double>& kd,
+                           double control_period_s)
+    : control_period_s_(control_period_s) {
+  const int n = drives.size();
+  auto vec = [n](const std::vector<double>& v) {
+    Eigen::VectorXd out = Eigen::VectorXd::Zero(n);
+    for (int i = 0; i < n && i < static_cast<int>(v.size()); ++i) out[i] = v[static_cast<std::size_t>(i)];
+    return out;
+  };
+  torque_per_amp_.resize(n);
+  current_limit_.resize(n);
+  torque_limit_.resize(n);
+  velocity_limit_.resize(n);
+  for (int i = 0; i < n; ++i) {
+    torque_per_amp_[i] = drives[i].torque_per_amp();
+    current_limit_[i] = drives[i].current_limit_A;
+    torque_limit_[i] = drives[i].torque_limit_Nm;
+    velocity_limit_[i] = drives[i].velocity_limit_rad_s;
+  }
+  kp_ = vec(kp);
+  kd_ = vec(kd);
+  q_des_ = Eigen::VectorXd::Zero(n);
+  qd_des_ = Eigen::VectorXd::Zero(n);
+  hold_torque_ = Eigen::VectorXd::Zero(n);
+  tau_des_ = Eigen::VectorXd::Zero(n);
+  current_des_ = Eigen::VectorXd::Zero(n);
+  last_qd_meas_ = Eigen::VectorXd::Zero(n);
+}
+
+void GenericDrive::begin_cycle(const RobotCommand& command, bool fresh, const Eigen::VectorXd& q_meas,
+                               const Eigen::VectorXd& tau_motor) {
+  const bool mode_change = !entered_ || command.mode != mode_;
+  mode_ = command.mode;
+  entered_ = true;
+  switch (command.mode) {
+    case LowLevelMode::kPosition:
+      if (mode_change) {
+        // Bumpless: the hold starts with the torque the motor produced last, moving as the arm
+        // moves (the D term starts at zero).
+        q_des_ = command.q_rad;
+        qd_des_ = last_qd_meas_.cwiseMax(-velocity_limit_).cwiseMin(velocity_limit_);
+        hold_torque_ = tau_motor - kp_.cwiseProduct(q_des_ - q_meas);
+      } else if (fresh) {
+        for (int i = 0; i < dof(); ++i) {
+          const double v = (command.q_rad[i] - q_des_[i]) / control_period_s_;
+          qd_des_[i] = std::clamp(v, -velocity_limit_[i], velocity_limit_[i]);
+        }
+        q_des_ = command.q_rad;
+      } else {
+        qd_des_.setZero();  // no new set-point: hold
+      }
+      break;
+    case LowLevelMode::kTorque:
+      tau_des_ = command.tau_Nm;
+      break;
+    case LowLevelMode::kCurrent:
+      current_des_ = command.current_A;
+      break;
+    case LowLevelMode::kKinovaTorque:
+    case LowLevelMode::kKinovaTorqueHighVelocity:
+      // Not offered (SimRobot::validate refuses them): no torque rather than a loop we lack.
+      tau_des_.setZero();
+      break;
+  }
+}
+
+void GenericDrive::tick(const Eigen::VectorXd& q_meas, const Eigen::VectorXd& qd_meas,
+                        const Eigen::VectorXd& /*tau_meas*/, bool /*filter_tick*/, Eigen::VectorXd& current_out) {
+  last_qd_meas_ = qd_meas;
+  for (int i = 0; i < dof(); ++i) {
+    double tau = 0.0;
+    switch (mode_) {
+      case LowLevelMode::kPosition:
+        tau = hold_torque_[i] + kp_[i] * (q_des_[i] - q_meas[i]) + kd_[i] * (qd_des_[i] - qd_meas[i]);
+        break;
+      case LowLevelMode::kTorque:
+        tau = std::clamp(tau_des_[i], -torque_limit_[i], torque_limit_[i]);
+        break;
+      case LowLevelMode::kCurrent:
+        current_out[i] = std::clamp(current_des_[i], -current_limit_[i], current_limit_[i]);
+        continue;
+      case LowLevelMode::kKinovaTorque:
+      case LowLevelMode::kKinovaTorqueHighVelocity:
+        break;
+    }
+    current_out[i] = std::clamp(tau / torque_per_amp_[i], -current_limit_[i], current_limit_[i]);
+  }
+}
+
+}  // namespace phri

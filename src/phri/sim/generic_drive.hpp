@@ -1,0 +1,58 @@
+#pragma once
+// phri::GenericDrive: the drives of an arm that is not a Kinova (robot.yaml `drive: generic`): a
+// plain current/torque drive with the friction and limits of actuators.yaml (the plant applies
+// the friction), and no vendor torque loop. Per joint:
+//
+// * kPosition — the drive's position hold (the safe stop's and the start-up's), a PD servo about
+//   the torque the motor carried when the mode was entered:
+//     tau = tau_entry + Kp (q_d - q) + Kd (qd_d - qd)
+//   qd_d = (q_d[k] - q_d[k-1]) / T_control from streamed set-points (0 when none is new), clipped
+//   to the joint velocity limit. tau_entry = the motor torque of the previous tick minus the P
+//   term: entering is bumpless, and an arm entering at rest keeps holding its weight with no
+//   integrator (a load changed afterwards leaves an error of delta_tau / Kp).
+// * kTorque — the joint torque set-point applied directly: tau = clamp(tau_d, torque_limit),
+//   no sensor feedback; friction is the controller's to compensate.
+// * kCurrent — i = i_d (phri's custom torque loop).
+// Every mode: i = tau / (K_T G_r) with the nominal constant, saturated at current_limit_A.
+// Kinova's torque loops are not offered (SimRobot refuses them before they reach the drive).
+#include <phri/robot/actuator_table.hpp>
+#include <phri/robot/drive_kind.hpp>
+#include <phri/sim/drive_loops.hpp>
+
+#include <vector>
+
+namespace phri {
+
+class GenericDrive final : public DriveLoops {
+public:
+  /// `kp`, `kd`: the position hold's gains per joint [N.m/rad], [N.m.s/rad]; `control_period_s`:
+  /// the period of begin_cycle().
+  GenericDrive(const ActuatorTable& drives, const std::vector<double>& kp, const std::vector<double>& kd,
+               double control_period_s);
+
+  LowLevelModeSet offered() const override { return offered_loops(DriveKind::kGeneric); }
+  LowLevelMode mode() const override { return mode_; }
+  void begin_cycle(const RobotCommand& command, bool fresh, const Eigen::VectorXd& q_meas,
+                   const Eigen::VectorXd& tau_motor) override;
+  void tick(const Eigen::VectorXd& q_meas, const Eigen::VectorXd& qd_meas, const Eigen::VectorXd& tau_meas,
+            bool filter_tick, Eigen::VectorXd& current_out) override;
+  bool uses_velocity() const override { return mode_ == LowLevelMode::kPosition; }
+  bool uses_torque() const override { return false; }
+  void start_holding(const Eigen::VectorXd& tau) override { hold_torque_ = tau; }
+
+  /// The position hold's torque offset [N.m] (tests, logs).
+  const Eigen::VectorXd& hold_torque() const { return hold_torque_; }
+
+private:
+  int dof() const { return static_cast<int>(kp_.size()); }
+
+  double control_period_s_;
+  Eigen::VectorXd torque_per_amp_, current_limit_, torque_limit_, velocity_limit_, kp_, kd_;
+
+  LowLevelMode mode_ = LowLevelMode::kPosition;
+  bool entered_ = false;
+  Eigen::VectorXd q_des_, qd_des_, hold_torque_, tau_des_, current_des_;
+  Eigen::VectorXd last_qd_meas_;  // the velocity the drive last measured (bumpless position entry)
+};
+
+}  // namespace phri
