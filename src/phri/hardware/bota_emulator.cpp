@@ -126,11 +126,13 @@ void BotaEmulator::set_streaming(bool streaming) {
 }
 
 BotaEmulatorStats BotaEmulator::stats() const {
+  std::lock_guard<std::mutex> emitting(emit_mutex_);
   std::lock_guard<std::mutex> lock(mutex_);
   return stats_;
 }
 
 std::vector<BotaFrame> BotaEmulator::good_frames() const {
+  std::lock_guard<std::mutex> emitting(emit_mutex_);
   std::lock_guard<std::mutex> lock(mutex_);
   return good_frames_;
 }
@@ -166,7 +168,10 @@ void BotaEmulator::run() {
     if (!streaming) {
       next_frame = now;
     } else if (now >= next_frame) {
-      send_slot();
+      {
+        std::lock_guard<std::mutex> emitting(emit_mutex_);
+        send_slot();
+      }
       next_frame += period;
       // Behind after a stall, a disconnect or a preemption: go on from now, no catching up.
       if (Clock::now() - next_frame > 10 * period) next_frame = Clock::now();
@@ -230,13 +235,19 @@ void BotaEmulator::send(const std::uint8_t* bytes, std::size_t count, bool strea
   stats_.write_overflows += count - written;
 }
 
+// A good frame is on record before its bytes leave: the driver may publish it before write()
+// returns here (a test that compares what was published with what was sent raced on that). The
+// whole slot is one step for observers (emit_mutex_, held by run()): stats() and good_frames()
+// never see a frame recorded but not yet written.
 void BotaEmulator::send_good(const BotaFrame& frame) {
   BotaFrame copy = frame;
   const Bytes bytes = encode_clean(copy);
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    good_frames_.push_back(copy);
+    ++stats_.good_frames;
+  }
   send(bytes.data(), bytes.size(), true);
-  std::lock_guard<std::mutex> lock(mutex_);
-  good_frames_.push_back(copy);
-  ++stats_.good_frames;
 }
 
 void BotaEmulator::send_slot() {
@@ -282,11 +293,13 @@ void BotaEmulator::send_burst(int count) {
     bytes.insert(bytes.end(), one.begin(), one.end());
     frames.push_back(frame);
   }
+  {
+    std::lock_guard<std::mutex> lock(mutex_);  // on record before the bytes leave (send_good)
+    good_frames_.insert(good_frames_.end(), frames.begin(), frames.end());
+    stats_.good_frames += frames.size();
+    stats_.slots += frames.size();
+  }
   send(bytes.data(), bytes.size(), true);
-  std::lock_guard<std::mutex> lock(mutex_);
-  good_frames_.insert(good_frames_.end(), frames.begin(), frames.end());
-  stats_.good_frames += frames.size();
-  stats_.slots += frames.size();
 }
 
 void BotaEmulator::apply_fault(const Pending& f, const BotaFrame& frame) {

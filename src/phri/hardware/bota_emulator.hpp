@@ -105,7 +105,8 @@ private:
   bool booting_ = false;
   std::mt19937 random_;
 
-  mutable std::mutex mutex_;  // guards everything below
+  mutable std::mutex emit_mutex_;  // one slot's emission (record, write, count) is atomic to observers
+  mutable std::mutex mutex_;       // guards everything below
   std::deque<Pending> faults_;
   std::vector<BotaFrame> good_frames_;
   BotaEmulatorStats stats_;
