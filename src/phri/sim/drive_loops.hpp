@@ -10,7 +10,20 @@
 
 #include <Eigen/Core>
 
+#include <algorithm>
+
 namespace phri {
+
+/// A position servo's velocity feed-forward from consecutive set-points (what the arm was asked
+/// to move per period), each joint clamped to its velocity limit; the set-point becomes `q_des`.
+inline void follow_set_point(const Eigen::VectorXd& q_new, double period_s, const Eigen::VectorXd& velocity_limit,
+                             Eigen::VectorXd& q_des, Eigen::VectorXd& qd_ff) {
+  for (Eigen::Index i = 0; i < q_des.size(); ++i) {
+    const double v = (q_new[i] - q_des[i]) / period_s;
+    qd_ff[i] = std::clamp(v, -velocity_limit[i], velocity_limit[i]);
+  }
+  q_des = q_new;
+}
 
 class DriveLoops {
 public:

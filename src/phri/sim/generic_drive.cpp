@@ -47,11 +47,7 @@ void GenericDrive::begin_cycle(const RobotCommand& command, bool fresh, const Ei
         qd_des_ = last_qd_meas_.cwiseMax(-velocity_limit_).cwiseMin(velocity_limit_);
         hold_torque_ = tau_motor - kp_.cwiseProduct(q_des_ - q_meas);
       } else if (fresh) {
-        for (int i = 0; i < dof(); ++i) {
-          const double v = (command.q_rad[i] - q_des_[i]) / control_period_s_;
-          qd_des_[i] = std::clamp(v, -velocity_limit_[i], velocity_limit_[i]);
-        }
-        q_des_ = command.q_rad;
+        follow_set_point(command.q_rad, control_period_s_, velocity_limit_, q_des_, qd_des_);
       } else {
         qd_des_.setZero();  // no new set-point: hold
       }

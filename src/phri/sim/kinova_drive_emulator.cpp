@@ -71,11 +71,7 @@ void KinovaDriveEmulator::begin_cycle(const RobotCommand& command, bool fresh, c
       if (mode_change) {
         q_des_ = command.q_rad;
       } else if (fresh) {
-        for (int i = 0; i < dof(); ++i) {
-          const double v = (command.q_rad[i] - q_des_[i]) / control_period_s_;
-          qd_ff_[i] = std::clamp(v, -velocity_limit_[i], velocity_limit_[i]);
-        }
-        q_des_ = command.q_rad;
+        follow_set_point(command.q_rad, control_period_s_, velocity_limit_, q_des_, qd_ff_);
       } else {
         qd_ff_.setZero();  // no new set-point: hold
       }
