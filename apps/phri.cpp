@@ -19,6 +19,7 @@
 #include "ft_monitor.hpp"
 
 #include <phri/app/config.hpp>
+#include <phri/app/config_checks.hpp>
 #include <phri/app/robot_bundle.hpp>
 #include <phri/model/capsule_fit.hpp>
 #include <phri/app/run_session.hpp>
@@ -195,6 +196,7 @@ int run_command(const RunArguments& args) {
   // naming the link): odd inertias, a base inertial ignored, inertias MuJoCo balanced.
   for (const std::string& warning : cycle.model().warnings()) std::fprintf(stderr, "phri: warning: %s\n", warning.c_str());
   for (const std::string& warning : generated_plant_warnings(config.plant)) std::fprintf(stderr, "phri: warning: %s\n", warning.c_str());
+  for (const std::string& warning : phri::config_warnings(config)) std::fprintf(stderr, "phri: warning: %s\n", warning.c_str());
   phri::Fsm fsm(config.fsm, cycle);
   std::printf("phri run: %s, %.1f s, %s\n", args.config_path.c_str(), config.run.duration_s,
               config.run.pacing == phri::LoopClock::Pacing::kLockstep ? "lockstep" : "real time");

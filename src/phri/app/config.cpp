@@ -256,7 +256,7 @@ Eigen::VectorXd parse_torque_limits(const YamlReader& q, const ActuatorTable& dr
 void parse_qp(const YamlReader& q, const ActuatorTable& drives, WholeBodyQpSettings& s) {
   q.allow_keys({"torque_limit_Nm", "velocity_limit_rad_s", "velocity_limit_fraction", "joint_limits",
                 "velocity_limit_gain", "braking_reserve", "collision", "collision_braking", "regularization", "brake_damping",
-                "smoothing_time_constant_s"});
+                "smoothing_time_constant_s", "singular_value_threshold"});
   const int dof = drives.size();
   if (q.has("torque_limit_Nm")) s.torque_limit = parse_torque_limits(q, drives);
   if (q.has("velocity_limit_rad_s")) {
@@ -280,6 +280,7 @@ void parse_qp(const YamlReader& q, const ActuatorTable& drives, WholeBodyQpSetti
     s.collision_braking.gain = positive_or(b, "gain_per_s", s.collision_braking.gain, kMaxTaskDamping_per_s);
   }
   s.regularization = non_negative_or(q, "regularization", s.regularization, 1.0);
+  s.singular_value_threshold = non_negative_or(q, "singular_value_threshold", s.singular_value_threshold, 0.5);
   s.brake_damping = positive_or(q, "brake_damping", s.brake_damping, kMaxTaskDamping_per_s);
   s.smoothing_time_constant = non_negative_or(q, "smoothing_time_constant_s", s.smoothing_time_constant, 10.0);
 }

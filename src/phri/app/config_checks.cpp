@@ -7,6 +7,8 @@
 #include <phri/model/collision_model.hpp>
 #include <phri/sim/sim_scene.hpp>
 
+#include <Eigen/SVD>
+
 #include <cmath>
 #include <string>
 #include <vector>
@@ -136,6 +138,36 @@ void check_config_against_robot(const Config& config) {
     if (static_cast<int>(q->size()) != model.nq()) continue;  // sizes: checked where they are read
     check_clear_of_collision(model, collision, *q, settings.qp.collision.safety_distance, config.source, key);
   }
+}
+
+std::vector<std::string> config_warnings(const Config& config) {
+  std::vector<std::string> warnings;
+  const ControllerSettings& settings = config.controller;
+  const double threshold = settings.qp.singular_value_threshold;
+  if (threshold <= 0.0) return warnings;
+  const Model model = Model::from_urdf_file(settings.urdf_path, Controller::model_options(settings));
+  if (!model.has_frame(settings.end_effector_frame)) return warnings;  // refused elsewhere
+  Data data(model);
+  const int frame = model.frame_id(settings.end_effector_frame);
+  Eigen::MatrixXd jacobian(6, model.nv());
+  const std::vector<std::pair<std::string, const std::vector<double>*>> postures = {
+      {"fsm.startup.home_q_rad", &config.fsm.startup.home_q_rad},
+      {"fsm.static.posture_q_rad", &config.fsm.static_scenario.posture_q_rad}};
+  for (const auto& [key, q] : postures) {
+    if (static_cast<int>(q->size()) != model.nq()) continue;
+    const Eigen::VectorXd posture = Eigen::Map<const Eigen::VectorXd>(q->data(), model.nq());
+    forward_kinematics(model, data, posture);
+    update_frame_placements(model, data);
+    frame_jacobian(model, data, frame, ReferenceFrame::kLocalWorldAligned, jacobian);
+    const double sigma_min = Eigen::JacobiSVD<Eigen::MatrixXd>(jacobian).singularValues().minCoeff();
+    if (sigma_min >= threshold) continue;
+    warnings.push_back(config.source + ": " + key + ": near a kinematic singularity (smallest singular value of the " +
+                       settings.end_effector_frame + " Jacobian " + format_general(sigma_min, 3) + " < " +
+                       format_general(threshold, 3) +
+                       "): the end-effector task holds its weak direction only through the posture; a better-"
+                       "conditioned posture holds the pose stiffer");
+  }
+  return warnings;
 }
 
 }  // namespace phri

@@ -11,8 +11,16 @@
 //     capsule pair closer than controller.qp.collision.safety_distance_m.
 #include <phri/app/config.hpp>
 
+#include <string>
+#include <vector>
+
 namespace phri {
 
 void check_config_against_robot(const Config& config);
+
+/// What the configuration allows but the user should know, one line each: the postures above
+/// near a kinematic singularity (the end-effector Jacobian's smallest singular value below
+/// controller.qp.singular_value_threshold, where the task gives its weak directions to the posture).
+std::vector<std::string> config_warnings(const Config& config);
 
 }  // namespace phri

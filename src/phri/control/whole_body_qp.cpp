@@ -81,6 +81,7 @@ WholeBodyQp::WholeBodyQp(const Model& model, const CollisionModel* collision, co
       last_good_tau_(Eigen::VectorXd::Zero(nv_)),
       hold_torque_(Eigen::VectorXd::Zero(nv_)),
       inertia_diagonal_(Eigen::VectorXd::Zero(nv_)),
+      singular_weight_(settings.singular_value_threshold),
       weighted_jacobian_(Eigen::MatrixXd::Zero(6, nv_)) {
   if (collision) self_collision_.emplace(model, *collision, settings.collision, settings.collision_braking);
   // Rows: nv torque rows (A = M), then one row per collision pair. Bounds: qdd.
@@ -119,9 +120,17 @@ WholeBodyQpStatus WholeBodyQp::update(const Model& model, const Data& data, cons
   // Objective: 1/2 qdd' H qdd + g' qdd from the weighted least squares (factor 2 dropped).
   const double w_ee = end_effector_.weight();
   const double w_0 = posture_.weight();
-  problem_.H.noalias() = w_ee * end_effector_.jacobian().transpose() * end_effector_.jacobian();
+  const Eigen::MatrixXd& jacobian = end_effector_.jacobian();
+  if (singular_weight_.update(jacobian)) {
+    // Near a singularity: w_ee || W^1/2 (J qdd - reference) ||^2 (singular_direction_weight.hpp).
+    weighted_jacobian_.noalias() = singular_weight_.weight() * jacobian;
+    problem_.H.noalias() = w_ee * jacobian.transpose() * weighted_jacobian_;
+    problem_.g.noalias() = -w_ee * weighted_jacobian_.transpose() * end_effector_.reference();
+  } else {
+    problem_.H.noalias() = w_ee * jacobian.transpose() * jacobian;
+    problem_.g.noalias() = -w_ee * jacobian.transpose() * end_effector_.reference();
+  }
   problem_.H.diagonal().array() += w_0 + settings_.regularization;
-  problem_.g.noalias() = -w_ee * end_effector_.jacobian().transpose() * end_effector_.reference();
   problem_.g.noalias() -= w_0 * posture_.reference();
 
   joint_bounds(data, q, qd, tau_ext);

@@ -23,6 +23,7 @@
 #include <phri/control/joint_limit_constraint.hpp>
 #include <phri/control/posture_task.hpp>
 #include <phri/control/self_collision_constraint.hpp>
+#include <phri/control/singular_direction_weight.hpp>
 #include <phri/control/torque_limit_constraint.hpp>
 #include <phri/control/velocity_damper.hpp>
 #include <phri/control/velocity_limit_constraint.hpp>
@@ -62,6 +63,10 @@ struct WholeBodyQpSettings {
   /// constraints keep the full estimate. The dead band is continuous: x -> sign(x) max(|x| - b, 0).
   Eigen::VectorXd compliance_deadband;
   double regularization = 1e-9;   ///< added to the Hessian's diagonal
+  /// Singular value of the end-effector Jacobian below which the task's direction fades out
+  /// (singular_direction_weight.hpp; not in the paper) [m/rad, rad/rad]; 0: off. The Gen3's demo
+  /// stays above 0.05, so its figures are the paper's; the outstretched elbow (q4 = 0) is below.
+  double singular_value_threshold = 0.03;
   double brake_damping = 20.0;    ///< 1/s, the fallback's joint damping brake
   double smoothing_time_constant = 0.1;  ///< s, of the tasks' gain filters
 };
@@ -141,7 +146,8 @@ private:
   Eigen::VectorXd deadband_;
   Eigen::VectorXd qdd_external_, qdd_desired_, tau_desired_, last_good_tau_;
   Eigen::VectorXd hold_torque_, inertia_diagonal_;  // the braking reserve's scratch
-  Eigen::MatrixXd weighted_jacobian_;  // 6 x nv scratch
+  SingularDirectionWeight singular_weight_;
+  Eigen::MatrixXd weighted_jacobian_;  // W J, 6 x nv scratch
   WholeBodyQpStatus status_ = WholeBodyQpStatus::kOk;
   bool warm_ = false;
 };
