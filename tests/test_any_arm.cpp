@@ -4,6 +4,9 @@
 //    has a bare flange and no F/T sensor, and the arm still holds its pose;
 //  * gravity and the base placement (`gravity_m_s2`, `base_placement`): the controller's model and
 //    the plant agree on them, checked against MuJoCo's own bias forces and site placements;
+//  * a tool without an F/T sensor (`end_of_arm: {tool: ...}`): carried by both, no wrench signal;
+//  * a base link below the URDF's root (frames.base): placed alike in the model and the plant, and
+//    refused when a joint could move it;
 //  * each new key's mistakes are one-line errors naming robot.yaml and the key.
 // The arm is robots/example_6dof, copied and its robot.yaml edited.
 #include <phri/app/config.hpp>
@@ -169,6 +172,256 @@ TEST(AnyArm, MistakesInTheNewKeysAreOneLineErrorsNamingTheKey) {
     if (error) {
       EXPECT_EQ(std::string(error->what()).find('\n'), std::string::npos) << error->what();
     }
+  }
+}
+
+// ------------------------------------------------------------------ model against plant
+struct Agreement {
+  double gravity_Nm = 0.0;  ///< max |g_model(q) - MuJoCo's qfrc_bias| at rest
+  double gravity_max_Nm = 0.0;
+  double flange_m = 0.0;    ///< |flange (model) - flange site (plant)|
+};
+
+// The controller's model (its options: chain, payloads, base placement, gravity) against the plant
+// at the plant's present posture, at rest: MuJoCo's bias force is then the gravity torque alone.
+Agreement model_against_plant(const phri::ControllerSettings& settings, const phri::SimRobot& robot) {
+  const phri::Model model = phri::Model::from_urdf_file(settings.urdf_path, phri::Controller::model_options(settings));
+  phri::Data data(model);
+  const Eigen::VectorXd q = robot.truth().q_rad;
+  const Eigen::VectorXd g = phri::compute_gravity(model, data, q);
+  const mjModel* m = robot.mujoco_model();
+  const mjData* d = robot.mujoco_data();
+  Agreement a;
+  for (int i = 0; i < model.nv(); ++i) {
+    const int joint = mj_name2id(m, mjOBJ_JOINT, model.joint(i).name.c_str());
+    EXPECT_GE(joint, 0);
+    a.gravity_Nm = std::max(a.gravity_Nm, std::abs(d->qfrc_bias[m->jnt_dofadr[joint]] - g[i]));
+  }
+  a.gravity_max_Nm = g.cwiseAbs().maxCoeff();
+  phri::forward_kinematics(model, data, q);
+  phri::update_frame_placements(model, data);
+  const Eigen::Vector3d flange = data.frame_placements[static_cast<std::size_t>(model.frame_id("flange"))].translation();
+  a.flange_m = (flange - site_position(robot, "flange")).norm();
+  return a;
+}
+
+// Read, step, write for `seconds`: the flange's largest drift, and whether a wrench ever came.
+struct Held {
+  double drift_m = 0.0;
+  bool wrench_ever_valid = false;
+  phri::CycleStatus status = phri::CycleStatus::kOk;
+};
+Held hold_pose(const phri::Config& config, double seconds) {
+  phri::SimRobot robot(config.plant);
+  phri::Controller cycle(config.controller);
+  phri::RobotCommand command(robot.dof());
+  const Eigen::Vector3d start = site_position(robot, "flange");
+  Held out;
+  for (long k = 0; k < std::lround(seconds / robot.period_s()); ++k) {
+    const phri::RobotState& state = robot.read();
+    out.wrench_ever_valid |= state.wrench.valid;
+    cycle.step(state, command);
+    EXPECT_EQ(robot.write(command), phri::WriteStatus::kOk) << "cycle " << k;
+    out.drift_m = std::max(out.drift_m, (site_position(robot, "flange") - start).norm());
+  }
+  out.status = cycle.status();
+  return out;
+}
+
+// ------------------------------------------------------------------ a tool, no F/T sensor
+// end_of_arm: {tool: {...}} with no ft_sensor: the tool sits on the flange (its COM in the flange
+// frame); the controller carries it as its one payload, the plant as a body welded at the flange
+// site; no adapter, no F/T sensor, no wrench signal.
+const std::string kToolOnly = "{tool: {mass_kg: 0.8, com_m: [0.01, -0.02, 0.06], inertia_kgm2: [2.0e-3, 2.5e-3, 1.5e-3]}}";
+
+TEST(AnyArm, AToolWithoutAnFtSensorIsCarriedByTheControllerAndThePlant) {
+  const std::string folder = example_bundle("tool_only", kToolOnly);
+  const phri::Config config = run_config(folder);
+  EXPECT_TRUE(config.plant.has_end_of_arm);
+  EXPECT_FALSE(config.plant.ft_sensor_present());
+  ASSERT_EQ(config.controller.payloads.size(), 1u);
+  EXPECT_EQ(config.controller.payloads[0].name, "tool");
+  EXPECT_EQ(config.controller.payloads[0].inertia.com, Eigen::Vector3d(0.01, -0.02, 0.06));  // on the flange: no offset
+  EXPECT_EQ(config.controller.ft_sensor_offset_m, 0.0);
+  EXPECT_EQ(config.controller.wrench.tool_mass_kg, 0.0);  // no F/T reading to remove it from
+
+  const phri::SimRobot robot(config.plant);
+  const phri::Controller cycle(config.controller);
+  phri::ModelOptions chain;
+  chain.tip_link = "flange";
+  chain.locked_joints = {"left_finger_joint", "right_finger_joint"};
+  const double bare = phri::Model::from_urdf_file(folder + "/example_6dof.urdf", chain).total_mass();
+  const mjModel* m = robot.mujoco_model();
+  const double plant_moving = m->body_subtreemass[mj_name2id(m, mjOBJ_BODY, "link_1")];
+  std::printf("tool without F/T sensor: moving mass %.4f kg in the controller's model, %.4f kg in the plant (bare arm %.4f kg)\n",
+              cycle.model().total_mass(), plant_moving, bare);
+  EXPECT_NEAR(cycle.model().total_mass(), bare + 0.8, 1e-12);
+  EXPECT_NEAR(plant_moving, bare + 0.8, 1e-12);
+  const int tool = mj_name2id(m, mjOBJ_BODY, phri::SimScene::kToolBody);
+  ASSERT_GE(tool, 0);
+  EXPECT_EQ(std::string(mj_id2name(m, mjOBJ_BODY, m->body_parentid[tool])), "flange");  // the flange site's body
+  EXPECT_LT(mj_name2id(m, mjOBJ_BODY, phri::SimScene::kAdapterBody), 0);
+  EXPECT_EQ(m->nsensor, 0);
+
+  // The tool's weight: the same torques in the controller's model and the plant, and they matter.
+  const Agreement with_tool = model_against_plant(config.controller, robot);
+  phri::ControllerSettings unaware = config.controller;
+  unaware.set_end_of_arm(std::nullopt);
+  const Agreement without_tool = model_against_plant(unaware, robot);
+  std::printf("tool without F/T sensor: |g_model - qfrc_bias| max %.2e N.m (%.2f N.m with the tool left out of the model)\n",
+              with_tool.gravity_Nm, without_tool.gravity_Nm);
+  EXPECT_LT(with_tool.gravity_Nm, 1e-9);
+  EXPECT_LT(with_tool.flange_m, 1e-12);
+  EXPECT_GT(without_tool.gravity_Nm, 0.3);
+
+  const Held held = hold_pose(config, 3.0);
+  std::printf("tool without F/T sensor: flange drift max %.3f mm over 3 s\n", 1e3 * held.drift_m);
+  EXPECT_LT(held.drift_m, 1e-3);
+  EXPECT_FALSE(held.wrench_ever_valid);
+  EXPECT_EQ(held.status, phri::CycleStatus::kOk);
+}
+
+TEST(AnyArm, AnFtSourceWithAToolButNoSensorIsRefused) {
+  const std::string folder = example_bundle("tool_only_ft", kToolOnly);
+  for (const char* source : {"ft", "fused"}) {
+    SCOPED_TRACE(source);
+    const auto error = expect_config_error(
+        [&] { (void)run_config(folder, std::string("controller: {external_torque_source: ") + source + "}\n"); },
+        {.element = "controller.external_torque_source", .mentions = {"F/T sensor", "a tool without a sensor"},
+         .file = "any_arm_run.yaml"});
+    if (error) {
+      EXPECT_EQ(std::string(error->what()).find('\n'), std::string::npos) << error->what();
+    }
+  }
+}
+
+// A plant YAML's `tool` without `ft_sensor`: the tool names the flange site it sits on.
+std::string example_plant_yaml(const std::string& more) {
+  return "plant:\n  robot: {urdf: " + kExample + "/example_6dof.urdf, locked_joints: [left_finger_joint, right_finger_joint], "
+         "actuators: " + kExample + "/actuators.yaml}\n  initial: {q_rad: [0.07, 0.59, -0.19, 0.49, -0.12, 0.39]}\n" + more;
+}
+
+TEST(AnyArm, APlantYamlCarriesAToolWithoutAnFtSensor) {
+  const std::string tool = "  tool: {flange_site: flange, mass_kg: 0.8, com_m: [0.01, -0.02, 0.06], inertia_kgm2: [2.0e-3, 2.5e-3, 1.5e-3]}\n";
+  const phri::SimRobotConfig plant = phri::SimRobotConfig::from_yaml_string(example_plant_yaml(tool), "plant.yaml", kExample);
+  EXPECT_TRUE(plant.has_end_of_arm);
+  EXPECT_FALSE(plant.ft_sensor_present());
+  ASSERT_TRUE(plant.end_of_arm().has_value());
+  EXPECT_FALSE(plant.end_of_arm()->has_ft_sensor);
+  EXPECT_EQ(plant.end_of_arm()->tool.mass_kg, 0.8);
+  const phri::SimRobot robot(plant);
+  EXPECT_GE(mj_name2id(robot.mujoco_model(), mjOBJ_BODY, phri::SimScene::kToolBody), 0);
+  EXPECT_FALSE(robot.state().wrench.valid);
+
+  const std::string sensor =
+      "  ft_sensor: {flange_site: flange, sensor_offset_m: 0.065, flange_side_mass_kg: 0.27, flange_side_com_m: [0, 0, 0.03], "
+      "flange_side_inertia_kgm2: [2.0e-4, 2.0e-4, 2.2e-4]}\n";
+  const struct {
+    std::string more, key;
+  } cases[] = {
+      {"  tool: {mass_kg: 0.8, com_m: [0, 0, 0.06], inertia_kgm2: [2.0e-3, 2.5e-3, 1.5e-3]}\n", "plant.tool.flange_site"},
+      {sensor, "plant.tool"},
+      {sensor + tool, "plant.tool.flange_site"},  // the sensor's section places the tool
+      {"  tool: {flange_site: nowhere, mass_kg: 0.8, com_m: [0, 0, 0.06], inertia_kgm2: [2.0e-3, 2.5e-3, 1.5e-3]}\n", "plant.tool.flange_site"},
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.more);
+    const auto error = expect_config_error(
+        [&] { phri::SimRobot r(phri::SimRobotConfig::from_yaml_string(example_plant_yaml(c.more), "plant.yaml", kExample)); },
+        {.element = c.key});
+    if (error) {
+      EXPECT_EQ(std::string(error->what()).find('\n'), std::string::npos) << error->what();
+    }
+  }
+}
+
+// ------------------------------------------------------------ a base below the URDF's root
+// The example arm standing on a pedestal: a new root link (5 kg) with base_link below it, offset
+// and tilted (joint `pedestal_joint`, fixed unless `joint` says otherwise); frames.base stays
+// base_link. base_placement places base_link in the world for the controller's model; the plant
+// must move the URDF's root so that base_link lands there too.
+std::string pedestal_bundle(const std::string& name, const std::string& joint, const std::string& extra,
+                            const std::string& locked = "") {
+  const std::string folder = example_bundle(name, std::nullopt, extra);
+  std::string urdf = read_file(folder + "/example_6dof.urdf");
+  const std::string limit = joint == "fixed" ? "" : "<axis xyz=\"0 0 1\"/><limit lower=\"-1\" upper=\"1\" effort=\"40\" velocity=\"1\"/>";
+  const std::string pedestal =
+      "<link name=\"pedestal\"><inertial><origin xyz=\"0 0 0.2\"/><mass value=\"5\"/>"
+      "<inertia ixx=\"0.1\" ixy=\"0\" ixz=\"0\" iyy=\"0.1\" iyz=\"0\" izz=\"0.05\"/></inertial></link>\n"
+      "<joint name=\"pedestal_joint\" type=\"" + joint + "\"><parent link=\"pedestal\"/><child link=\"base_link\"/>"
+      "<origin xyz=\"0.12 -0.05 0.4\" rpy=\"0.3 -0.2 0.6\"/>" + limit + "</joint>\n";
+  urdf.insert(urdf.find("<link name=\"base_link\">"), pedestal);
+  std::ofstream(folder + "/example_6dof.urdf") << urdf;
+  if (!locked.empty()) {
+    std::string robot = read_file(folder + "/robot.yaml");
+    const std::string key = "locked_joints: [left_finger_joint, right_finger_joint]";
+    robot.replace(robot.find(key), key.size(), "locked_joints: [left_finger_joint, right_finger_joint, " + locked + "]");
+    std::ofstream(folder + "/robot.yaml") << robot;
+  }
+  return folder;
+}
+
+const std::string kTilted = "gravity_m_s2: [1.2, -0.7, -9.6]\nbase_placement: {xyz_m: [0.3, -0.2, 0.5], rpy_rad: [0.4, -0.3, 0.8]}\n";
+
+TEST(AnyArm, ABaseBelowTheUrdfsRootIsPlacedAlikeInTheControllerModelAndThePlant) {
+  const std::string folder = pedestal_bundle("pedestal", "fixed", kTilted);
+  const phri::Config config = run_config(folder);
+  EXPECT_EQ(config.plant.base_link, "base_link");
+  const phri::SimRobot robot(config.plant);
+  const Agreement a = model_against_plant(config.controller, robot);
+  std::printf("base below the URDF's root (tilted, shifted, gravity off the vertical): |g_model - qfrc_bias| max %.2e N.m "
+              "(|g| max %.2f N.m), flange %.1e m apart\n", a.gravity_Nm, a.gravity_max_Nm, a.flange_m);
+  EXPECT_LT(a.gravity_Nm, 1e-9);
+  EXPECT_GT(a.gravity_max_Nm, 1.0);
+  EXPECT_LT(a.flange_m, 1e-12);
+  // base_link itself where base_placement says.
+  const mjModel* m = robot.mujoco_model();
+  const mjData* d = robot.mujoco_data();
+  const int base = mj_name2id(m, mjOBJ_BODY, "base_link");
+  Eigen::Matrix3d rotation;
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) rotation(r, c) = d->xmat[9 * base + 3 * r + c];
+  }
+  EXPECT_LT((Eigen::Vector3d(d->xpos[3 * base], d->xpos[3 * base + 1], d->xpos[3 * base + 2]) -
+             config.controller.base_placement.translation()).norm(), 1e-14);
+  EXPECT_LT((rotation - config.controller.base_placement.linear()).norm(), 1e-14);
+
+  // The plant placing the URDF's root there instead (what it did before it knew the base link):
+  // the arm stands 0.4 m off and tilted, and the torques disagree.
+  phri::SimRobotConfig root_placed = config.plant;
+  root_placed.base_link.clear();
+  const phri::SimRobot wrong(root_placed);
+  const Agreement b = model_against_plant(config.controller, wrong);
+  std::printf("the same with the plant placing the URDF's root instead: |g_model - qfrc_bias| max %.2f N.m, flange %.3f m apart\n",
+              b.gravity_Nm, b.flange_m);
+  EXPECT_GT(b.flange_m, 0.1);
+  EXPECT_GT(b.gravity_Nm, 0.1);
+}
+
+TEST(AnyArm, ABaseAJointCouldMoveIsRefusedUnlessTheJointIsLocked) {
+  const std::string folder = pedestal_bundle("pedestal_revolute", "revolute", kTilted);
+  const auto error = expect_config_error([&] { (void)phri::RobotBundle::from_folder(folder); },
+                                         {.element = "frames.base", .mentions = {"pedestal_joint", "fixed in the world"},
+                                          .file = folder + "/robot.yaml"});
+  if (error) {
+    EXPECT_EQ(std::string(error->what()).find('\n'), std::string::npos) << error->what();
+  }
+
+  // Locked (welded at 0 in both): the pedestal is rigid again, and both agree.
+  const std::string locked = pedestal_bundle("pedestal_locked", "revolute", kTilted, "pedestal_joint");
+  const phri::Config config = run_config(locked);
+  const phri::SimRobot robot(config.plant);
+  const Agreement a = model_against_plant(config.controller, robot);
+  EXPECT_LT(a.gravity_Nm, 1e-9);
+  EXPECT_LT(a.flange_m, 1e-12);
+
+  // A plant made in code, the joint neither locked nor fixed: refused where the plant is made.
+  phri::SimRobotConfig plant = config.plant;
+  plant.locked_joints = {"left_finger_joint", "right_finger_joint"};
+  const auto plant_error = expect_config_error([&] { phri::SimRobot r(plant); },
+                                               {.element = "base_link", .mentions = {"base_link", "fixed in the world"}});
+  if (plant_error) {
+    EXPECT_EQ(std::string(plant_error->what()).find('\n'), std::string::npos) << plant_error->what();
   }
 }
 

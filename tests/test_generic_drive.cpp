@@ -4,6 +4,8 @@
 // torque loop), with the friction and limits of actuators.yaml; Kinova's torque loops are not
 // offered, and asking for one is refused (a ConfigError in a run YAML, a rejected target at run
 // time) while the arm keeps running. The arm is robots/example_6dof, copied with `drive: generic`.
+// The hold has its own gains (drive.position_hold, or a default rule on the arm's inertia), and a
+// plant YAML says which drives it emulates (`drive:`), which must agree with the robot's.
 #include <phri/app/config.hpp>
 #include <phri/app/fsm.hpp>
 #include <phri/app/robot_bundle.hpp>
@@ -19,8 +21,11 @@
 
 #include <gtest/gtest.h>
 
+#include <phri/sim/generic_drive.hpp>
+
 #include <cmath>
 #include <cstdio>
+#include <numbers>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -35,9 +40,10 @@ using M = phri::ComplianceMode;
 const std::string kRoot = PHRI_SOURCE_DIR;
 const std::string kExample = kRoot + "/robots/example_6dof";
 
-// robots/example_6dof copied with its `drive: kinova` replaced by `drive: <drive>`.
-std::string example_with_drive(const std::string& drive) {
-  const std::string folder = phri::test::temp_path("phri_test_generic_drive", "example_" + drive);
+// robots/example_6dof copied with its `drive: kinova` replaced by `drive: <drive>` (a scalar or a
+// flow map), in a folder named after `name` (default: the drive).
+std::string example_with_drive(const std::string& drive, const std::string& name = "") {
+  const std::string folder = phri::test::temp_path("phri_test_generic_drive", "example_" + (name.empty() ? drive : name));
   std::filesystem::create_directories(folder);
   for (const char* file : {"example_6dof.urdf", "actuators.yaml"}) {
     std::filesystem::copy_file(kExample + "/" + file, folder + "/" + file, std::filesystem::copy_options::overwrite_existing);
@@ -68,12 +74,12 @@ phri::Config run_config(const std::string& folder, const std::string& more = "")
 // As `phri run` steps it: read, step, write; records what must never happen on the plant's true state.
 class Session {
 public:
-  Session(M mode, L loop, std::vector<phri::ExternalForce> pushes = {})
-      : config_(make_config(mode, loop, std::move(pushes))), robot_(config_.plant), cycle_(config_.controller),
+  Session(M mode, L loop, std::vector<phri::ExternalForce> pushes = {}, const std::string& folder = generic_folder())
+      : config_(make_config(mode, loop, std::move(pushes), folder)), robot_(config_.plant), cycle_(config_.controller),
         command_(robot_.dof()), targets_(robot_.dof()) {}
 
-  static phri::Config make_config(M mode, L loop, std::vector<phri::ExternalForce> pushes) {
-    phri::Config c = run_config(generic_folder());
+  static phri::Config make_config(M mode, L loop, std::vector<phri::ExternalForce> pushes, const std::string& folder) {
+    phri::Config c = run_config(folder);
     c.controller.initial_compliance = mode;
     c.controller.initial_loop = loop;
     c.plant.disturbances = std::move(pushes);
@@ -298,6 +304,253 @@ TEST(GenericDrive, PlainTorqueGivesTheRigidBodyAcceleration) {
       EXPECT_GT((truth.qdd_rad_s2 - qdd_wanted).cwiseAbs().maxCoeff(), 0.1);
     }
   }
+}
+
+
+// ------------------------------------------------------------------------ the hold's own gains
+// drive: {kind: generic, position_hold: {kp_Nm_per_rad, kd_Nms_per_rad}} in robot.yaml, or by
+// default GenericDrive::hold_gains' rule (critically damped at 30 Hz on each joint's inertia at the
+// start posture): the drive's own, no longer Kinova's servo gains (12000 / 3000 N.m/rad by size).
+const std::string kOwnGains =
+    "{kind: generic, position_hold: {kp_Nm_per_rad: [3000, 2500, 2000, 1500, 600, 400], "
+    "kd_Nms_per_rad: [60, 50, 40, 30, 8, 6]}}";
+
+const std::string& own_gains_folder() {
+  static const std::string folder = example_with_drive(kOwnGains, "own_gains");
+  return folder;
+}
+
+const phri::GenericDrive& generic_drive_of(const phri::SimRobot& robot) {
+  const auto* drive = dynamic_cast<const phri::GenericDrive*>(&robot.drive());
+  if (drive == nullptr) throw std::runtime_error("the plant's drive is not a GenericDrive");
+  return *drive;
+}
+
+Eigen::VectorXd start_posture(const phri::SimRobotConfig& plant) {
+  return Eigen::Map<const Eigen::VectorXd>(plant.initial_q_rad.data(), static_cast<Eigen::Index>(plant.initial_q_rad.size()));
+}
+
+// phri's model of the arm the plant simulates (same URDF, end of arm, base), rotor inertia as armature.
+phri::Model plant_model(const phri::Config& config, const phri::SimRobot& robot) {
+  phri::ModelOptions options = phri::Controller::model_options(config.controller);
+  for (int i = 0; i < robot.dof(); ++i) options.armature.push_back(robot.plant_actuators()[i].reflected_inertia_kgm2);
+  return phri::Model::from_urdf_file(config.controller.urdf_path, options);
+}
+
+TEST(GenericDrive, TheHoldsDefaultGainsAreCriticallyDampedAt30HzOnTheArmsInertia) {
+  const phri::Config config = run_config(generic_folder());
+  EXPECT_TRUE(config.plant.generic_hold.kp_Nm_per_rad.empty());
+  const phri::SimRobot robot(config.plant);
+  const phri::GenericDrive& drive = generic_drive_of(robot);
+  const phri::Model model = plant_model(config, robot);
+  phri::Data data(model);
+  const Eigen::MatrixXd mass = phri::crba(model, data, start_posture(config.plant));
+  const double w = 2.0 * std::numbers::pi * 30.0;
+  std::printf("generic drive, default hold gains (kp N.m/rad / kd N.m.s/rad):");
+  for (int i = 0; i < robot.dof(); ++i) {
+    std::printf(" %.0f/%.1f", drive.kp()[i], drive.kd()[i]);
+    EXPECT_NEAR(drive.kp()[i], mass(i, i) * w * w, 1e-8 * drive.kp()[i]) << "joint " << i;
+    EXPECT_NEAR(drive.kd()[i], 2.0 * mass(i, i) * w, 1e-8 * drive.kd()[i]) << "joint " << i;
+    EXPECT_NE(drive.kp()[i], robot.config().vendor.position_kp_Nm_per_rad[static_cast<std::size_t>(i)]);
+  }
+  std::printf("\n");
+  // Stated gains are the drive's.
+  const phri::Config own = run_config(own_gains_folder());
+  const phri::SimRobot own_robot(own.plant);
+  const std::vector<double> kp = {3000, 2500, 2000, 1500, 600, 400}, kd = {60, 50, 40, 30, 8, 6};
+  for (int i = 0; i < own_robot.dof(); ++i) {
+    EXPECT_EQ(generic_drive_of(own_robot).kp()[i], kp[static_cast<std::size_t>(i)]);
+    EXPECT_EQ(generic_drive_of(own_robot).kd()[i], kd[static_cast<std::size_t>(i)]);
+  }
+}
+
+// The plant alone holding its start posture in the drive's position hold (no friction, no sensor
+// noise), a steady 12 N on link_4: the arm gives way by (diag(kp) + dg/dq)^-1 J^T F, kp the drive's
+// own gains, dg/dq the gravity's stiffness (phri's model, finite differences): the hold's
+// stiffness is the one the robot states, or the default rule's.
+TEST(GenericDrive, TheHoldGivesWayUnderALoadAsItsOwnGainsSay) {
+  double deflection_default = 0.0, deflection_own = 0.0;
+  for (const std::string* folder : {&generic_folder(), &own_gains_folder()}) {
+    const bool own = folder == &own_gains_folder();
+    SCOPED_TRACE(own ? "stated gains" : "default gains");
+    phri::Config config = run_config(*folder);
+    config.plant.friction_scale = 0.0;
+    config.plant.noise.torque_sensor_std_Nm = config.plant.noise.velocity_std_rad_s = config.plant.noise.current_std_A = 0.0;
+    config.plant.noise.encoder_counts_per_rev = 0.0;
+    const Eigen::Vector3d force(4.0, 10.0, -6.0);
+    config.plant.disturbances = {phri::test::hand_push("link_4", Eigen::Vector3d::Zero(), force, 0.1, 10.0)};
+    phri::SimRobot robot(config.plant);
+    const Eigen::VectorXd q0 = start_posture(config.plant);
+    phri::RobotCommand hold(robot.dof());
+    hold.mode = L::kPosition;
+    hold.q_rad = q0;
+    for (int k = 0; k < 800; ++k) {
+      robot.read();
+      ASSERT_EQ(robot.write(hold), phri::WriteStatus::kOk);
+    }
+    const Eigen::VectorXd moved = robot.truth().q_rad - q0;
+    EXPECT_LT(robot.truth().qd_rad_s.cwiseAbs().maxCoeff(), 1e-4);  // settled
+
+    const phri::Model model = plant_model(config, robot);
+    phri::Data data(model);
+    phri::forward_kinematics(model, data, q0);
+    phri::update_frame_placements(model, data);
+    Eigen::MatrixXd jacobian(6, model.nv());
+    phri::frame_jacobian(model, data, model.frame_id("link_4"), phri::ReferenceFrame::kLocalWorldAligned, jacobian);
+    const Eigen::VectorXd push = jacobian.topRows<3>().transpose() * force;
+    Eigen::MatrixXd stiffness = Eigen::MatrixXd::Zero(model.nv(), model.nv());
+    const phri::GenericDrive& drive = generic_drive_of(robot);
+    for (int j = 0; j < model.nv(); ++j) {
+      const double h = 1e-6;
+      Eigen::VectorXd plus = q0, minus = q0;
+      plus[j] += h;
+      minus[j] -= h;
+      const Eigen::VectorXd g_plus = phri::compute_gravity(model, data, plus);
+      stiffness.col(j) = (g_plus - phri::compute_gravity(model, data, minus)) / (2.0 * h);
+      stiffness(j, j) += drive.kp()[j];
+    }
+    const Eigen::VectorXd predicted = stiffness.partialPivLu().solve(push);
+    const double error = (moved - predicted).cwiseAbs().maxCoeff() / predicted.cwiseAbs().maxCoeff();
+    std::printf("generic drive hold, %s, 12.3 N on link_4: deflection max %.3f mrad, predicted from kp %.3f mrad (%.2f %% off)\n",
+                own ? "stated gains" : "default gains", 1e3 * moved.cwiseAbs().maxCoeff(), 1e3 * predicted.cwiseAbs().maxCoeff(),
+                100.0 * error);
+    EXPECT_LT(error, 0.02);
+    (own ? deflection_own : deflection_default) = moved.cwiseAbs().maxCoeff();
+  }
+  EXPECT_GT(deflection_own, 1.5 * deflection_default);  // the softer stated hold gives way more
+}
+
+TEST(GenericDrive, HoldsItsPoseWithinOneMillimetreWithItsStatedGains) {
+  Session s(M::kNullSpace, L::kPosition, {}, own_gains_folder());
+  const Eigen::Vector3d start = s.flange();
+  double drift = 0.0;
+  s.run(1.5, [&]() { drift = std::max(drift, (s.flange() - start).norm()); });
+  std::printf("generic drive, stated hold gains, position loop at rest: flange drift max %.3f mm\n", 1e3 * drift);
+  EXPECT_LT(drift, 1e-3);
+  EXPECT_EQ(s.cycle_.status(), phri::CycleStatus::kOk);
+  EXPECT_EQ(s.refused_, 0);
+}
+
+TEST(GenericDrive, ABadHoldGainIsAOneLineErrorNamingTheKey) {
+  const struct {
+    std::string drive, key, mention;
+  } cases[] = {
+      {"{kind: generic, position_hold: {kp_Nm_per_rad: [3000, 2500, 2e7, 1500, 600, 400]}}", "drive.position_hold.kp_Nm_per_rad[2]", "1000000"},
+      {"{kind: generic, position_hold: {kp_Nm_per_rad: [3000, 0.1, 2000, 1500, 600, 400]}}", "drive.position_hold.kp_Nm_per_rad[1]", ""},
+      {"{kind: generic, position_hold: {kp_Nm_per_rad: [3000, 2500]}}", "drive.position_hold.kp_Nm_per_rad", "6"},
+      {"{kind: generic, position_hold: {kd_Nms_per_rad: [60, 50, 40, 30, 8, -6]}}", "drive.position_hold.kd_Nms_per_rad[5]", ""},
+      {"{kind: generic, position_hold: {ki_Nm_per_rad_s: [1, 1, 1, 1, 1, 1]}}", "drive.position_hold.ki_Nm_per_rad_s", ""},
+      {"{kind: kinova, position_hold: {kp_Nm_per_rad: [3000, 2500, 2000, 1500, 600, 400]}}", "drive.position_hold", "vendor"},
+      {"{position_hold: {}}", "drive.kind", ""},
+  };
+  int n = 0;
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.drive);
+    const std::string folder = example_with_drive(c.drive, "bad_gain_" + std::to_string(n++));
+    const auto error = expect_config_error([&] { (void)phri::RobotBundle::from_folder(folder); },
+                                           {.element = c.key, .file = folder + "/robot.yaml"});
+    if (error) {
+      EXPECT_EQ(std::string(error->what()).find('\n'), std::string::npos) << error->what();
+      if (!c.mention.empty()) {
+        EXPECT_NE(std::string(error->what()).find(c.mention), std::string::npos) << error->what();
+      }
+    }
+  }
+  // Within range but unstable on the wrist's small inertia at the plant's 4 kHz step: refused where
+  // the plant is made, where the inertia is known.
+  const std::string folder =
+      example_with_drive("{kind: generic, position_hold: {kd_Nms_per_rad: [60, 50, 40, 30, 8, 900]}}", "bad_gain_unstable");
+  const phri::Config config = run_config(folder);
+  const auto error = expect_config_error([&] { phri::SimRobot robot(config.plant); },
+                                         {.element = "drive.position_hold.kd_Nms_per_rad[5]", .mentions = {"joint_6", "unstable"}});
+  if (error) {
+    EXPECT_EQ(std::string(error->what()).find('\n'), std::string::npos) << error->what();
+  }
+}
+
+// ------------------------------------------------------------------- the plant YAML's `drive`
+// A plant YAML says which drives it emulates (default kinova) with robot.yaml's grammar; with a
+// robot bundle both must agree (a one-line error at plant.drive otherwise); without one, the
+// controller may ask only for the loops the plant's drives offer.
+std::string example_plant_yaml(const std::string& more) {
+  std::string q = "[";
+  const phri::RobotBundle bundle = phri::RobotBundle::from_folder(kExample);
+  for (std::size_t i = 0; i < bundle.home_q_rad.size(); ++i) q += (i ? ", " : "") + std::to_string(bundle.home_q_rad[i]);
+  return "plant:\n  robot: {urdf: " + kExample + "/example_6dof.urdf, locked_joints: [left_finger_joint, right_finger_joint], "
+         "actuators: " + kExample + "/actuators.yaml}\n  initial: {q_rad: " + q + "]}\n" + more;
+}
+
+TEST(GenericDrive, APlantYamlSaysWhichDrivesItEmulates) {
+  const phri::SimRobotConfig kinova = phri::SimRobotConfig::from_yaml_string(example_plant_yaml(""), "plant.yaml", kExample);
+  EXPECT_EQ(kinova.drive, phri::DriveKind::kKinova);
+  EXPECT_FALSE(kinova.drive_stated);
+  EXPECT_EQ(dynamic_cast<const phri::GenericDrive*>(&phri::SimRobot(kinova).drive()), nullptr);
+
+  const phri::SimRobotConfig generic = phri::SimRobotConfig::from_yaml_string(
+      example_plant_yaml("  drive: {kind: generic, position_hold: {kp_Nm_per_rad: [3000, 2500, 2000, 1500, 600, 400]}}\n"),
+      "plant.yaml", kExample);
+  EXPECT_EQ(generic.drive, phri::DriveKind::kGeneric);
+  EXPECT_TRUE(generic.drive_stated);
+  phri::SimRobot robot(generic);
+  EXPECT_EQ(generic_drive_of(robot).kp()[3], 1500.0);
+  // kd: critical damping of the stated kp on the joint's inertia.
+  EXPECT_GT(generic_drive_of(robot).kd()[3], 0.0);
+  phri::RobotCommand command(robot.dof());
+  command.mode = L::kKinovaTorque;
+  EXPECT_EQ(robot.write(command), phri::WriteStatus::kInvalidMode);
+  command.mode = L::kTorque;
+  command.tau_Nm = robot.truth().tau_motor_Nm;
+  EXPECT_EQ(robot.write(command), phri::WriteStatus::kOk);
+
+  const struct {
+    std::string more, key;
+  } cases[] = {
+      {"  drive: franka\n", "plant.drive"},
+      {"  drive: generic\n  vendor: {position: {kp_Nm_per_rad: [1, 1, 1, 1, 1, 1]}}\n", "plant.vendor"},
+      {"  drive: {kind: kinova, position_hold: {kd_Nms_per_rad: [1, 1, 1, 1, 1, 1]}}\n", "plant.drive.position_hold"},
+      {"  drive: {kind: generic, position_hold: {kd_Nms_per_rad: [1, 1, 1e5, 1, 1, 1]}}\n", "plant.drive.position_hold.kd_Nms_per_rad[2]"},
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.more);
+    const auto error = expect_config_error(
+        [&] { (void)phri::SimRobotConfig::from_yaml_string(example_plant_yaml(c.more), "plant.yaml", kExample); },
+        {.element = c.key, .file = "plant.yaml"});
+    if (error) {
+      EXPECT_EQ(std::string(error->what()).find('\n'), std::string::npos) << error->what();
+    }
+  }
+}
+
+TEST(GenericDrive, TheRunRefusesAPlantWhoseDrivesAreNotTheRobots) {
+  // Mismatches, both ways.
+  expect_config_error([&] { (void)run_config(generic_folder(), "plant: {drive: kinova}\n"); },
+                      {.element = "plant.drive", .mentions = {"plant emulates kinova", "robot's are generic"},
+                       .file = "generic_drive_run.yaml"});
+  const std::string gen3 = kRoot + "/robots/kinova_gen3";
+  expect_config_error([&] { (void)run_config(gen3, "plant: {drive: generic}\n"); },
+                      {.element = "plant.drive", .mentions = {"plant emulates generic", "robot's are kinova"}});
+  // The Gen3's plant file says kinova, as its bundle.
+  const phri::Config gen3_run = run_config(gen3, "plant: {file: " + kRoot + "/configs/plant_gen3.yaml}\n");
+  EXPECT_TRUE(gen3_run.plant.drive_stated);
+  EXPECT_EQ(gen3_run.plant.drive, phri::DriveKind::kKinova);
+  // Agreeing: the plant's stated gains are the simulated drive's, the robot's fill the rest.
+  const phri::Config agreed =
+      run_config(own_gains_folder(), "plant: {drive: {kind: generic, position_hold: {kp_Nm_per_rad: [1, 2, 3, 4, 5, 6]}}}\n");
+  EXPECT_EQ(agreed.plant.generic_hold.kp_Nm_per_rad, (std::vector<double>{1, 2, 3, 4, 5, 6}));
+  EXPECT_EQ(agreed.plant.generic_hold.kd_Nms_per_rad, (std::vector<double>{60, 50, 40, 30, 8, 6}));
+
+  // Without a bundle: the plant's drives decide the loops offered to the controller.
+  const std::string gen3_q = "[0.0, 0.26179939, 3.14159265, -2.26892803, 0.0, 0.95993109, 1.57079633]";
+  const std::string run = "robot: {urdf: " + gen3 + "/gen3.urdf, actuators: " + gen3 + "/actuators.yaml, end_effector_frame: end_effector_link}\n"
+                          "plant: {robot: {mjcf: " + gen3 + "/gen3_plant.xml, actuators: " + gen3 + "/actuators.yaml}, drive: generic, "
+                          "initial: {q_rad: " + gen3_q + "}}\n"
+                          "run: {duration_s: 3}\nfsm: {startup: {enabled: false}}\nlogging: {enabled: false}\ngamepad: {enabled: false}\n";
+  const phri::Config no_bundle = phri::Config::from_yaml_string(run, "no_bundle.yaml", kRoot);
+  EXPECT_EQ(no_bundle.plant.drive, phri::DriveKind::kGeneric);
+  EXPECT_TRUE(no_bundle.controller.offered_loops.contains(L::kTorque));
+  EXPECT_FALSE(no_bundle.controller.offered_loops.contains(L::kKinovaTorque));
+  expect_config_error([&] { (void)phri::Config::from_yaml_string(run + "low_level: {torque_loop: kinova_torque}\n", "no_bundle.yaml", kRoot); },
+                      {.element = "low_level.torque_loop", .mentions = {"kinova_torque"}});
 }
 
 }  // namespace

@@ -155,8 +155,18 @@ TEST(RobotBundle, FramesChainDrivesAndHomeAreCheckedAgainstTheUrdf) {
   expect_bundle_error("  end_effector: end_effector_link", "  end_effector: hand_link", "frames.end_effector", {"hand_link"});
   expect_bundle_error("  tip: bracelet_link", "  tip: nowhere", "frames.tip", {"nowhere"});
   expect_bundle_error("  base: base_link", "  base: end_effector_link", "frames.tip", {"not below base"});
-  // A shorter chain is a valid choice, but then the drives no longer match it.
-  expect_bundle_error("  base: base_link", "  base: forearm_link", "actuators", {"joint_5"});
+  // A base below joints that move: they would carry it, the base is fixed in the world.
+  expect_bundle_error("  base: base_link", "  base: forearm_link", "frames.base", {"joint_4", "fixed in the world"});
+  // Those joints locked, a shorter chain is a valid choice, but then the drives no longer match it.
+  {
+    const std::string folder = gen3_bundle_with("  base: base_link", "  base: forearm_link");
+    std::string yaml = read_file(folder + "/robot.yaml");
+    const std::string key = "locked_joints: []";
+    yaml.replace(yaml.find(key), key.size(), "locked_joints: [joint_1, joint_2, joint_3, joint_4]");
+    std::ofstream(folder + "/robot.yaml") << yaml;
+    expect_config_error([&] { (void)phri::RobotBundle::from_folder(folder); },
+                        {.element = "actuators", .mentions = {"joint_5"}, .file = folder + "/robot.yaml"});
+  }
   expect_bundle_error("locked_joints: []", "locked_joints: [joint_9]", "locked_joints", {"joint_9"});
   expect_bundle_error("home_q_rad: [0.0, 0.26179939,", "home_q_rad: [0.0, 2.5,", "home_q_rad[1]", {"joint_2", "2.24"});
   // A run through the CLI's path gets the same error.

@@ -103,6 +103,12 @@ CASES = [
     ("vendor_torque_damping_1e3", PLANT, ("set", "plant.vendor.torque.velocity_damping_Nms_per_rad[0]", 1000),
      ["plant.vendor.torque.velocity_damping_Nms_per_rad[0]"]),
     ("plant_tool_100kg", PLANT, ("set", "plant.tool.mass_kg", 100), ["plant.tool.mass_kg"]),
+    # -- the plant's drives (issue 16): whose, and a generic hold's gains
+    ("plant_drive_unknown", PLANT, ("set", "plant.drive", "franka"), ["plant.drive", "kinova, generic"]),
+    ("plant_drive_generic_with_vendor", PLANT, ("set", "plant.drive", "generic"), ["plant.vendor", "generic"]),
+    ("plant_drive_kinova_with_hold_gains", PLANT,
+     ("set", "plant.drive", {"kind": "kinova", "position_hold": {"kp_Nm_per_rad": [3000] * 7}}),
+     ["plant.drive.position_hold", "vendor"]),
     ("drop_mass_100kg", PLANT, ("set", "plant.drop_test.mass_kg", 100), ["plant.drop_test.mass_kg"]),
     ("push_force_1e4N", DEMO, ("set", "plant.disturbances[0].force_N[1]", 1e4), ["plant.disturbances[0].force_N[1]"]),
     # -- actuators.yaml

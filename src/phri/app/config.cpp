@@ -520,6 +520,8 @@ Config parse(const YamlReader& root, const std::string& base_dir, const std::str
     c.plant = parse_plant(root.at("plant"), base_dir, bundle ? &*bundle : nullptr);
   }
   if (bundle) bundle->apply_to(c.plant);
+  // Without a bundle, a plant that names its drives decides the loops the controller may ask for.
+  if (!bundle && c.plant.drive_stated) c.controller.offered_loops = offered_loops(c.plant.drive);
   if (c.plant.dof() != dof) {
     throw ConfigError(source, "plant.robot.actuators",
                       "the plant has " + std::to_string(c.plant.dof()) + " joints, the controller's robot.actuators " +
@@ -527,9 +529,10 @@ Config parse(const YamlReader& root, const std::string& base_dir, const std::str
   }
 
   if (root.has("controller")) parse_controller(root.at("controller"), drives, c.controller);
-  if (!c.plant.has_end_of_arm && c.controller.external_torque_source != ExternalTorqueSource::kObserver) {
+  if (!c.plant.ft_sensor_present() && c.controller.external_torque_source != ExternalTorqueSource::kObserver) {
     throw ConfigError(source, "controller.external_torque_source",
-                      std::string(to_string(c.controller.external_torque_source)) + " needs an F/T sensor, and the plant has none (no end of arm)");
+                      std::string(to_string(c.controller.external_torque_source)) + " needs an F/T sensor, and the plant has none (" +
+                          (c.plant.has_end_of_arm ? "a tool without a sensor" : "no end of arm") + ")");
   }
   if (std::abs(c.controller.period_s - c.plant.control_period_s) > 1e-12) {
     throw ConfigError(source, "controller.period_s",

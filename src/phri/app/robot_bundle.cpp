@@ -84,18 +84,21 @@ Eigen::Isometry3d parse_base_placement(const YamlReader& b) {
   return placement;
 }
 
-// `end_of_arm: none` (or no key): a bare flange.
+// `end_of_arm: none` (or no key): a bare flange; `tool` alone: a tool on the flange, no F/T sensor.
 std::optional<EndOfArm> parse_end_of_arm(const YamlReader& e) {
   if (e.node().IsScalar()) {
     if (e.as_text() != "none") throw e.error("", "a map (ft_sensor, tool) or `none`");
     return std::nullopt;
   }
   e.allow_keys({"ft_sensor", "tool"});
-  const YamlReader sensor = e.at("ft_sensor");
-  sensor.allow_keys({"offset_m", "flange_side"});
   EndOfArm end;
-  end.sensor_offset_m = sensor.number("offset_m", 0.0, 0.5);
-  end.flange_side = rigid_body(sensor.at("flange_side"));
+  end.has_ft_sensor = e.has("ft_sensor");
+  if (end.has_ft_sensor) {
+    const YamlReader sensor = e.at("ft_sensor");
+    sensor.allow_keys({"offset_m", "flange_side"});
+    end.sensor_offset_m = sensor.number("offset_m", 0.0, 0.5);
+    end.flange_side = rigid_body(sensor.at("flange_side"));
+  }
   end.tool = rigid_body(e.at("tool"));
   return end;
 }
@@ -155,7 +158,7 @@ RobotBundle parse(const YamlReader& r, const std::string& folder) {
   const int dof = ActuatorTable::from_yaml_file(b.actuators_path).size();
   b.home_q_rad = r.per_joint<std::vector<double>>("home_q_rad", dof, -kMaxJointAngle_rad, kMaxJointAngle_rad);
   b.compliance_deadband_Nm = r.per_joint<Eigen::VectorXd>("compliance_deadband_Nm", dof, 0.0, kMaxDeadband_Nm);
-  b.drive = r.choice("drive", {"kinova", "generic"}) == "generic" ? DriveKind::kGeneric : DriveKind::kKinova;
+  b.drive = parse_drive(r.at("drive"), dof, b.generic_hold);
   if (r.has("custom_loop_filter")) parse_custom_loop_filter(r.at("custom_loop_filter"), b);
   if (r.has("end_of_arm")) b.end_of_arm = parse_end_of_arm(r.at("end_of_arm"));
   parse_plant(r.has("plant") ? r.at("plant") : YamlReader(YAML::Node(YAML::NodeType::Map), r.file(), "plant"), folder, b);
@@ -263,9 +266,20 @@ void RobotBundle::apply_to(SimRobotConfig& c) const {
   if (c.initial_q_rad.size() != home_q_rad.size()) c.initial_q_rad = home_q_rad;
   c.ft_sensor.flange_site = plant.flange_site;
   c.set_end_of_arm(end_of_arm);
+  c.base_link = base_link;
   c.gravity_m_s2 = gravity_m_s2;
   c.base_placement = base_placement;
+  // A plant that says which drives it emulates must say the robot's: a Kinova emulation under an
+  // arm whose drives are generic (or the reverse) would run loops the robot does not have.
+  if (c.drive_stated && c.drive != drive) {
+    throw ConfigError(c.source, "plant.drive", "the plant emulates " + std::string(to_string(c.drive)) +
+                                                   " drives, the robot's are " + std::string(to_string(drive)) +
+                                                   " (drive in " + source + "): they must agree");
+  }
   c.drive = drive;
+  // The hold's gains the plant states are the simulated drive's (as actuator_overrides); else the robot's.
+  if (c.generic_hold.kp_Nm_per_rad.empty()) c.generic_hold.kp_Nm_per_rad = generic_hold.kp_Nm_per_rad;
+  if (c.generic_hold.kd_Nms_per_rad.empty()) c.generic_hold.kd_Nms_per_rad = generic_hold.kd_Nms_per_rad;
 }
 
 }  // namespace phri

@@ -55,6 +55,9 @@ struct RobotBundle {
   /// `drive: kinova | generic`: whose drives, hence the loops offered (robot/drive_kind.hpp); the
   /// controller gets the offered loops, the plant the matching drive loops.
   DriveKind drive = DriveKind::kKinova;
+  /// `drive: {kind: generic, position_hold: {kp_Nm_per_rad, kd_Nms_per_rad}}`: the generic drive's
+  /// position hold (sim/generic_drive.hpp; empty: its default rule on the arm's inertia).
+  GenericHoldGains generic_hold;
   /// The custom torque loop's H(z) (b, a in powers of z^-1); both empty: Kinova's (the library's).
   std::vector<double> custom_loop_numerator, custom_loop_denominator;
 

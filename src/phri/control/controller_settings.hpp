@@ -114,19 +114,23 @@ struct ControllerSettings {
   }
   /// The controller's view of an end of arm (none: a bare flange): the F/T frame's offset, the
   /// adapter and the tool as payloads on the end-effector frame, the tool's weight removed from
-  /// the F/T reading.
+  /// the F/T reading; a tool without a sensor: the tool alone, on the end-effector frame.
   void set_end_of_arm(const std::optional<EndOfArm>& end_of_arm) {
     const EndOfArm none;
     const EndOfArm& e = end_of_arm ? *end_of_arm : none;
-    ft_sensor_offset_m = e.sensor_offset_m;
+    const bool sensor = end_of_arm && e.has_ft_sensor;
+    ft_sensor_offset_m = sensor ? e.sensor_offset_m : 0.0;
     payloads.clear();
-    if (end_of_arm) {
+    if (sensor) {
       // The tool's COM is given below the sensor: shift it by the sensor's offset.
       payloads = {end_of_arm_payload("ft_adapter_and_sensor", e.flange_side, 0.0),
                   end_of_arm_payload("tool", e.tool, e.sensor_offset_m)};
+    } else if (end_of_arm) {
+      payloads = {end_of_arm_payload("tool", e.tool, 0.0)};  // on the flange, nothing between
     }
-    wrench.tool_mass_kg = e.tool.mass_kg;
-    wrench.tool_com_m = e.tool.com_m;
+    // What the F/T reading carries below the sensor: nothing to remove without a sensor.
+    wrench.tool_mass_kg = sensor ? e.tool.mass_kg : 0.0;
+    wrench.tool_com_m = sensor ? e.tool.com_m : Eigen::Vector3d::Zero();
   }
   double period_s = 1e-3;
   /// Momentum observer bandwidth K_O [rad/s]. The paper's code uses 10; 50 follows a push 5x

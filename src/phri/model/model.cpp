@@ -123,6 +123,7 @@ public:
     if (model_.joints_.empty()) {
       fail("", "no movable joint between base '" + base->name + "' and tip '" + tip->name + "'");
     }
+    check_base_fixed(*base);
     for (std::size_t i = 0; i < model_.bodies_.size(); ++i) check_body(static_cast<int>(i));
     add_extra_frames();
     add_payloads();
@@ -162,6 +163,18 @@ private:
           fail("link '" + name + "'", "its chain of parent joints comes back to itself: a kinematic loop "
                                       "(a URDF describes a tree)");
         }
+      }
+    }
+  }
+
+  // The model starts at the base, fixed in the world (at ModelOptions.base_placement): a joint that
+  // moves between the URDF's root and the base would carry the base, and the model would be wrong.
+  void check_base_fixed(const urdf::Link& base) const {
+    for (const urdf::Link* link = &base; link->parent_joint; link = link->getParent().get()) {
+      if (moves(*link->parent_joint)) {
+        fail("ModelOptions.base_link", "joint '" + link->parent_joint->name + "' moves between the URDF's root '" +
+                                           urdf_.getRoot()->name + "' and the base link '" + base.name +
+                                           "': the base must be fixed in the world (lock that joint, or take the base at or above it)");
       }
     }
   }

@@ -1,6 +1,8 @@
 #include <phri/sim/generic_drive.hpp>
 
 #include <algorithm>
+#include <cmath>
+#include <numbers>
 
 namespace phri {
 
@@ -31,6 +33,19 @@ GenericDrive::GenericDrive(const ActuatorTable& drives, const std::vector<double
   tau_des_ = Eigen::VectorXd::Zero(n);
   current_des_ = Eigen::VectorXd::Zero(n);
   last_qd_meas_ = Eigen::VectorXd::Zero(n);
+}
+
+void GenericDrive::hold_gains(const Eigen::VectorXd& inertia, const GenericHoldGains& given, std::vector<double>& kp,
+                              std::vector<double>& kd) {
+  const double w = 2.0 * std::numbers::pi * kDefaultHoldFrequency_Hz;
+  const auto n = static_cast<std::size_t>(inertia.size());
+  kp.assign(n, 0.0);
+  kd.assign(n, 0.0);
+  for (std::size_t i = 0; i < n; ++i) {
+    const double j = inertia[static_cast<Eigen::Index>(i)];
+    kp[i] = i < given.kp_Nm_per_rad.size() ? given.kp_Nm_per_rad[i] : j * w * w;
+    kd[i] = i < given.kd_Nms_per_rad.size() ? given.kd_Nms_per_rad[i] : 2.0 * std::sqrt(kp[i] * j);
+  }
 }
 
 void GenericDrive::begin_cycle(const RobotCommand& command, bool fresh, const Eigen::VectorXd& q_meas,

@@ -1,4 +1,5 @@
 #include <phri/core/error.hpp>
+#include <phri/core/format.hpp>
 #include <phri/sim/sim_robot.hpp>
 #include <phri/sim/generic_drive.hpp>
 #include <phri/sim/kinova_drive_emulator.hpp>
@@ -86,12 +87,12 @@ RandomPushGenerator::LinkSurface capsule_surface(const mjModel* m, int body, int
   return s;
 }
 
-// The drives' own loops, fresh (no mode entered yet).
-std::unique_ptr<DriveLoops> make_drive_loops(const SimRobotConfig& c) {
+// The drives' own loops, fresh (no mode entered yet); `hold_kp`, `hold_kd`: a generic drive's gains.
+std::unique_ptr<DriveLoops> make_drive_loops(const SimRobotConfig& c, const std::vector<double>& hold_kp,
+                                             const std::vector<double>& hold_kd) {
   switch (c.drive) {
     case DriveKind::kGeneric:
-      return std::make_unique<GenericDrive>(c.actuators, c.vendor.position_kp_Nm_per_rad, c.vendor.position_kd_Nms_per_rad,
-                                            c.control_period_s);
+      return std::make_unique<GenericDrive>(c.actuators, hold_kp, hold_kd, c.control_period_s);
     case DriveKind::kKinova:
       break;
   }
@@ -104,7 +105,7 @@ SimRobot::SimRobot(const SimRobotConfig& config)
     : config_(completed(config)),
       plant_actuators_(config_.plant_actuators()),
       n_(config_.dof()),
-      drive_(make_drive_loops(config_)) {
+      drive_(make_drive_loops(config_, {}, {})) {
   substeps_ = config_.substeps_per_cycle();
   filter_decimation_ = static_cast<int>(std::lround(config_.physics_rate_Hz / config_.vendor.high_velocity_rate_Hz));
   ft_decimation_ = static_cast<int>(std::lround(config_.physics_rate_Hz / config_.ft_sensor.rate_Hz));
@@ -120,6 +121,7 @@ SimRobot::SimRobot(const SimRobotConfig& config)
   find_disturbance_bodies();
   if (config_.random_pushes.enabled) find_push_links(arm_bodies);
   make_data();
+  if (config_.drive == DriveKind::kGeneric) set_generic_hold_gains();
   allocate_buffers();
   reset();
 }
@@ -135,20 +137,39 @@ void SimRobot::set_physics_options() {
 }
 
 // The arm's root bodies (the world's children but the drop mass, which starts where the tool is)
-// moved as one to config.base_placement. Left untouched at the identity.
+// moved as one so that the base body lands at config.base_placement: by placement x P^-1, P the
+// base's pose in the arm's own description (the identity when the base is an unplaced root, as
+// the URDF's root link and the Gen3's base_link are). Left untouched when that is the identity.
 void SimRobot::place_base() {
-  const Eigen::Isometry3d& base = config_.base_placement;
-  if (base.matrix() == Eigen::Matrix4d::Identity()) return;
-  const Eigen::Quaterniond rotation(base.linear());
-  const mjtNum q_base[4] = {rotation.w(), rotation.x(), rotation.y(), rotation.z()};
+  Eigen::Isometry3d base_in_arm = Eigen::Isometry3d::Identity();
+  if (!config_.base_link.empty()) {
+    const int base = mj_name2id(m_.get(), mjOBJ_BODY, config_.base_link.c_str());
+    if (base < 0) throw ConfigError(config_.source, "base_link", "no body '" + config_.base_link + "' in " + config_.arm_file());
+    for (int b = base; b != 0; b = m_->body_parentid[b]) {
+      if (m_->body_jntnum[b] > 0) {
+        throw ConfigError(config_.source, "base_link",
+                          std::string("body '") + mj_id2name(m_.get(), mjOBJ_BODY, b) + "' between the world and the base '" +
+                              config_.base_link + "' has a joint in " + config_.arm_file() + ": the base must be fixed in the world");
+      }
+      Eigen::Isometry3d body = Eigen::Isometry3d::Identity();
+      body.translation() = Eigen::Vector3d(m_->body_pos[3 * b], m_->body_pos[3 * b + 1], m_->body_pos[3 * b + 2]);
+      body.linear() = Eigen::Quaterniond(m_->body_quat[4 * b], m_->body_quat[4 * b + 1], m_->body_quat[4 * b + 2],
+                                         m_->body_quat[4 * b + 3]).normalized().toRotationMatrix();
+      base_in_arm = body * base_in_arm;
+    }
+  }
+  const Eigen::Isometry3d move = config_.base_placement * base_in_arm.inverse();
+  if (move.matrix() == Eigen::Matrix4d::Identity()) return;
+  const Eigen::Quaterniond rotation(move.linear());
+  const mjtNum q_move[4] = {rotation.w(), rotation.x(), rotation.y(), rotation.z()};
   const int drop = mj_name2id(m_.get(), mjOBJ_BODY, SimScene::kDropBody);
   for (int b = 1; b < m_->nbody; ++b) {
     if (m_->body_parentid[b] != 0 || b == drop) continue;
     const Eigen::Vector3d pos(m_->body_pos[3 * b], m_->body_pos[3 * b + 1], m_->body_pos[3 * b + 2]);
-    const Eigen::Vector3d placed = base * pos;
+    const Eigen::Vector3d placed = move * pos;
     for (int k = 0; k < 3; ++k) m_->body_pos[3 * b + k] = placed[k];
     mjtNum quat[4];
-    mju_mulQuat(quat, q_base, m_->body_quat + 4 * b);
+    mju_mulQuat(quat, q_move, m_->body_quat + 4 * b);
     mju_normalize4(quat);
     for (int k = 0; k < 4; ++k) m_->body_quat[4 * b + k] = quat[k];
   }
@@ -256,6 +277,10 @@ void SimRobot::perturb_link_inertials(const std::vector<int>& arm_bodies) {
 void SimRobot::find_ft_sensor() {
   if (!config_.has_end_of_arm) return;  // a bare flange: no sensor, no tool
   tool_body_ = mj_name2id(m_.get(), mjOBJ_BODY, SimScene::kToolBody);
+  if (!config_.has_ft_sensor) {  // a tool on the flange: no sensor to read
+    if (tool_body_ < 0) throw ConfigError(config_.source, "scene", "tool body missing from the composed scene");
+    return;
+  }
   sensor_site_ = mj_name2id(m_.get(), mjOBJ_SITE, SimScene::kSensorSite);
   const int force_sensor = mj_name2id(m_.get(), mjOBJ_SENSOR, SimScene::kForceSensor);
   const int torque_sensor = mj_name2id(m_.get(), mjOBJ_SENSOR, SimScene::kTorqueSensor);
@@ -307,6 +332,39 @@ void SimRobot::make_data() {
   d_.reset(mj_makeData(m_.get()));
   if (!d_) throw ConfigError(config_.source, "scene", "MuJoCo could not allocate its data");
   mj_setConst(m_.get(), d_.get());  // derived constants after the inertial and armature edits
+}
+
+// The generic drive's hold gains (GenericDrive::hold_gains' rule where none are given), on each
+// joint's inertia at the start posture: MuJoCo's M_ii (armature included) on the link side, plus
+// the rotor where an elastic transmission keeps it off the link. Refused where the explicit PD
+// step would come near its stability bound at the physics step h: w h or kd h / J_i above 1.
+void SimRobot::set_generic_hold_gains() {
+  for (int i = 0; i < n_; ++i) d_->qpos[qadr_[static_cast<std::size_t>(i)]] = config_.initial_q_rad[static_cast<std::size_t>(i)];
+  mj_forward(m_.get(), d_.get());
+  Eigen::VectorXd inertia(n_);
+  for (int i = 0; i < n_; ++i) {
+    const int dof = dadr_[static_cast<std::size_t>(i)];
+    inertia[i] = d_->qM[m_->dof_Madr[dof]] + (config_.elasticity.enabled ? plant_actuators_[i].reflected_inertia_kgm2 : 0.0);
+  }
+  GenericDrive::hold_gains(inertia, config_.generic_hold, hold_kp_, hold_kd_);
+  const double h = config_.physics_step_s();
+  for (int i = 0; i < n_; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    const bool kp_rings = hold_kp_[k] * h * h > inertia[i], kd_unstable = hold_kd_[k] * h > inertia[i];
+    if (!kp_rings && !kd_unstable) continue;
+    // (Appended piece by piece: GCC 12 warns falsely on "literal" + std::to_string.)
+    std::string key = kp_rings ? "drive.position_hold.kp_Nm_per_rad[" : "drive.position_hold.kd_Nms_per_rad[";
+    key += std::to_string(i);
+    key += ']';
+    std::string reason = format_general(kp_rings ? hold_kp_[k] : hold_kd_[k], 6);
+    reason += kp_rings ? " N.m/rad on " : " N.m.s/rad on ";
+    reason += plant_actuators_[i].joint_name;
+    reason += " (inertia ";
+    reason += format_general(inertia[i], 4);
+    reason += kp_rings ? " kg.m^2 at the start posture): the hold would ring at the plant's step (kp h^2 / J > 1)"
+                       : " kg.m^2 at the start posture): the hold would be unstable at the plant's step (kd h / J > 1)";
+    throw ConfigError(config_.source, key, reason);
+  }
 }
 
 void SimRobot::allocate_buffers() {
@@ -430,7 +488,7 @@ void SimRobot::start_drives_holding(const Eigen::VectorXd& hold) {
     command_.q_rad[i] = elastic() ? servo_position(i) : config_.initial_q_rad[static_cast<std::size_t>(i)];
     q_meas_[i] = quantize(servo_position(i));
   }
-  drive_ = make_drive_loops(config_);
+  drive_ = make_drive_loops(config_, hold_kp_, hold_kd_);
   drive_->begin_cycle(command_, false, q_meas_, vendor_torque());
   drive_->start_holding(vendor_torque());
 }

@@ -135,6 +135,7 @@ private:
   void find_disturbance_bodies();
   void find_push_links(const std::vector<int>& arm_bodies);
   void make_data();
+  void set_generic_hold_gains();
   void allocate_buffers();
   // reset(), in this order
   void restart_noise_and_counters();
@@ -189,6 +190,7 @@ private:
   double quantum_ = 0.0;
 
   std::unique_ptr<DriveLoops> drive_;  // made at reset() (not in the cycle)
+  std::vector<double> hold_kp_, hold_kd_;  // drive generic: the position hold's gains (set_generic_hold_gains)
   RobotCommand command_, pending_;
   bool has_pending_ = false;
   bool fault_ = false;

@@ -38,6 +38,14 @@ constexpr double kMaxVendorDamping_Nms_per_rad = 100.0;
 // order <= 5 normalised by a0 has |a_i| <= C(5, i) <= 10.
 constexpr double kMaxFilterCoefficient = 10.0;
 
+// A generic drive's position hold. Kp: at least 1 N.m/rad (below, 1 N.m moves the joint a whole
+// radian: no hold), at most 1e6 N.m/rad (the torsional stiffness of the largest robot gearboxes; a
+// servo cannot be stiffer than the gearbox it acts through). Kd: at most 1e4 N.m.s/rad (1e3 x the
+// viscous friction of a large joint).
+constexpr double kMinHoldKp_Nm_per_rad = 1.0;
+constexpr double kMaxHoldKp_Nm_per_rad = 1.0e6;
+constexpr double kMaxHoldKd_Nms_per_rad = 1.0e4;
+
 ExternalForce::Profile parse_profile(const std::string& name) {
   if (name == "step") return ExternalForce::Profile::kStep;
   if (name == "ramp") return ExternalForce::Profile::kRamp;
@@ -144,8 +152,16 @@ void parse_ft_sensor(const YamlReader& f, SimRobotConfig::FtSensor& s) {
   s.torque_bias_Nm = f.vector3_or("torque_bias_Nm", s.torque_bias_Nm, -10.0, 10.0);
 }
 
-void parse_tool(const YamlReader& t, SimRobotConfig::Tool& s) {
-  t.allow_keys({"mass_kg", "com_m", "inertia_kgm2"});
+// `with_sensor`: below an F/T sensor (its section places it); otherwise on the flange, whose site
+// the tool section names.
+void parse_tool(const YamlReader& t, bool with_sensor, SimRobotConfig& c) {
+  SimRobotConfig::Tool& s = c.tool;
+  if (with_sensor) {
+    t.allow_keys({"mass_kg", "com_m", "inertia_kgm2"});
+  } else {
+    t.allow_keys({"flange_site", "mass_kg", "com_m", "inertia_kgm2"});
+    c.ft_sensor.flange_site = t.text("flange_site");
+  }
   s.mass_kg = t.number("mass_kg", 1e-4, kMaxCarriedMass_kg);
   s.com_m = t.vector3("com_m", -0.5, 0.5);
   s.inertia_kgm2 = t.vector3("inertia_kgm2", 1e-9, kMaxCarriedInertia_kgm2);
@@ -287,13 +303,19 @@ void parse_elasticity(const YamlReader& e, int n, SimRobotConfig::Elasticity& s)
 SimRobotConfig parse(const YamlReader& root, const std::string& base_dir) {
   root.allow_keys({"plant"});
   const YamlReader p = root.at("plant");
-  p.allow_keys({"robot", "timing", "initial", "seed", "actuator_overrides", "friction_scale", "friction", "noise",
+  p.allow_keys({"robot", "drive", "timing", "initial", "seed", "actuator_overrides", "friction_scale", "friction", "noise",
                 "ft_sensor", "tool", "mismatch", "vendor", "elasticity", "drop_test", "floor", "disturbances",
                 "random_pushes"});
   SimRobotConfig c;
   c.source = root.file();
   parse_robot_files(p.at("robot"), base_dir, c);
   const int n = c.actuators.size();
+  c.drive_stated = p.has("drive");
+  if (c.drive_stated) c.drive = parse_drive(p.at("drive"), n, c.generic_hold);
+  // The vendor section tunes Kinova's loops: under a generic drive it would be silently unused.
+  if (c.drive == DriveKind::kGeneric && p.has("vendor")) {
+    throw p.error("vendor", "Kinova's drive loops; the plant's drive is generic (its gains: drive.position_hold)");
+  }
   if (p.has("timing")) parse_timing(p.at("timing"), c);
   c.initial_q_rad = parse_initial_q(p.at("initial"), n);
   c.seed = static_cast<std::uint64_t>(p.integer_or("seed", 1, 0, (1LL << 62)));
@@ -301,15 +323,14 @@ SimRobotConfig parse(const YamlReader& root, const std::string& base_dir) {
   c.friction_scale = p.number_or("friction_scale", 1.0, 0.0, 10.0);
   if (p.has("friction")) parse_friction(p.at("friction"), c.friction);
   if (p.has("noise")) parse_noise(p.at("noise"), n, c.noise);
-  // The end of arm: both sections or neither (a bare flange).
-  if (p.has("ft_sensor") != p.has("tool")) {
-    throw p.error(p.has("tool") ? "ft_sensor" : "tool", "the end of arm is an F/T sensor and the tool below it: give both sections, or neither (a bare flange)");
+  // The end of arm: an F/T sensor and the tool below it, a tool alone on the flange, or neither (a bare flange).
+  if (p.has("ft_sensor") && !p.has("tool")) {
+    throw p.error("tool", "the F/T sensor carries a tool: give its section (a bare flange has neither)");
   }
   c.has_end_of_arm = p.has("tool");
-  if (c.has_end_of_arm) {
-    parse_ft_sensor(p.at("ft_sensor"), c.ft_sensor);
-    parse_tool(p.at("tool"), c.tool);
-  }
+  c.has_ft_sensor = p.has("ft_sensor");
+  if (c.has_ft_sensor) parse_ft_sensor(p.at("ft_sensor"), c.ft_sensor);
+  if (c.has_end_of_arm) parse_tool(p.at("tool"), c.has_ft_sensor, c);
   if (p.has("mismatch")) parse_mismatch(p.at("mismatch"), c.mismatch);
   if (p.has("vendor")) parse_vendor(p.at("vendor"), n, c.vendor);
   if (p.has("elasticity")) parse_elasticity(p.at("elasticity"), n, c.elasticity);
@@ -335,6 +356,27 @@ bool is_integer_ratio(double a, double b) {
 }
 
 }  // namespace
+
+DriveKind parse_drive(const YamlReader& drive, int dof, GenericHoldGains& hold) {
+  hold = GenericHoldGains{};
+  if (!drive.is_map()) {
+    const std::string text = drive.as_text();
+    if (text == "kinova") return DriveKind::kKinova;
+    if (text == "generic") return DriveKind::kGeneric;
+    throw drive.error("", "'" + text + "': one of kinova, generic (or a map {kind, position_hold})");
+  }
+  drive.allow_keys({"kind", "position_hold"});
+  const DriveKind kind = drive.choice("kind", {"kinova", "generic"}) == "generic" ? DriveKind::kGeneric : DriveKind::kKinova;
+  if (!drive.has("position_hold")) return kind;
+  if (kind != DriveKind::kGeneric) {
+    throw drive.error("position_hold", "a generic drive's key; the kinova drive's position servo is the plant's vendor.position");
+  }
+  const YamlReader h = drive.at("position_hold");
+  h.allow_keys({"kp_Nm_per_rad", "kd_Nms_per_rad"});
+  if (h.has("kp_Nm_per_rad")) hold.kp_Nm_per_rad = h.per_joint("kp_Nm_per_rad", dof, kMinHoldKp_Nm_per_rad, kMaxHoldKp_Nm_per_rad);
+  if (h.has("kd_Nms_per_rad")) hold.kd_Nms_per_rad = h.per_joint("kd_Nms_per_rad", dof, 0.0, kMaxHoldKd_Nms_per_rad);
+  return kind;
+}
 
 SimRobotConfig SimRobotConfig::from_yaml_file(const std::string& path) {
   const std::string base = std::filesystem::path(path).parent_path().string();
@@ -415,6 +457,28 @@ void validate_vendor(const SimRobotConfig& c) {
   }
 }
 
+// A generic drive's gains, one per joint where given; a Kinova drive has none (its vendor section).
+void validate_generic_hold(const SimRobotConfig& c) {
+  const auto& h = c.generic_hold;
+  if (c.drive != DriveKind::kGeneric && !(h.kp_Nm_per_rad.empty() && h.kd_Nms_per_rad.empty())) {
+    throw ConfigError(c.source, "drive.position_hold", "a generic drive's gains, and the plant's drive is kinova");
+  }
+  if (!h.kp_Nm_per_rad.empty()) check_size(c, h.kp_Nm_per_rad, "drive.position_hold.kp_Nm_per_rad");
+  if (!h.kd_Nms_per_rad.empty()) check_size(c, h.kd_Nms_per_rad, "drive.position_hold.kd_Nms_per_rad");
+  for (std::size_t i = 0; i < h.kp_Nm_per_rad.size(); ++i) {
+    const double kp = h.kp_Nm_per_rad[i];
+    if (!(kp >= kMinHoldKp_Nm_per_rad && kp <= kMaxHoldKp_Nm_per_rad)) {
+      throw ConfigError(c.source, "drive.position_hold.kp_Nm_per_rad[" + std::to_string(i) + "]", "must be in [1, 1e6] N.m/rad");
+    }
+  }
+  for (std::size_t i = 0; i < h.kd_Nms_per_rad.size(); ++i) {
+    const double kd = h.kd_Nms_per_rad[i];
+    if (!(kd >= 0.0 && kd <= kMaxHoldKd_Nms_per_rad)) {
+      throw ConfigError(c.source, "drive.position_hold.kd_Nms_per_rad[" + std::to_string(i) + "]", "must be in [0, 1e4] N.m.s/rad");
+    }
+  }
+}
+
 // The plant's drives after the overrides.
 void validate_plant_drives(const SimRobotConfig& c) {
   for (const auto& o : c.actuator_overrides) {
@@ -441,9 +505,12 @@ void validate_end_of_arm(const SimRobotConfig& c) {
     if (c.drop_test.enabled) throw ConfigError(f, "plant.drop_test.enabled", "the drop test hangs its mass from the tool: the plant has no end of arm (ft_sensor, tool)");
     return;
   }
-  if (c.ft_sensor.flange_site.empty()) throw ConfigError(f, "plant.ft_sensor.flange_site", "empty: name the flange's site");
-  if (!(c.ft_sensor.flange_side_mass_kg > 0.0)) throw ConfigError(f, "plant.ft_sensor.flange_side_mass_kg", "must be > 0");
+  if (c.ft_sensor.flange_site.empty()) {
+    throw ConfigError(f, c.has_ft_sensor ? "plant.ft_sensor.flange_site" : "plant.tool.flange_site", "empty: name the flange's site");
+  }
   if (!(c.tool.mass_kg > 0.0)) throw ConfigError(f, "plant.tool.mass_kg", "must be > 0");
+  if (!c.has_ft_sensor) return;
+  if (!(c.ft_sensor.flange_side_mass_kg > 0.0)) throw ConfigError(f, "plant.ft_sensor.flange_side_mass_kg", "must be > 0");
   if (!(c.ft_sensor.flange_side_inertia_kgm2.minCoeff() > 0.0)) {
     throw ConfigError(f, "plant.ft_sensor.flange_side_inertia_kgm2", "principal moments must be > 0");
   }
@@ -503,6 +570,7 @@ void SimRobotConfig::validate() const {
     throw ConfigError(f, "plant.noise.encoder_counts_per_rev", "must be 0 (no quantisation) or >= 4096");
   }
   validate_vendor(*this);
+  validate_generic_hold(*this);
   check_size(*this, elasticity.stiffness_Nm_per_rad, "plant.elasticity.stiffness_Nm_per_rad");
   validate_plant_drives(*this);
   validate_end_of_arm(*this);
@@ -512,6 +580,11 @@ void SimRobotConfig::validate() const {
 std::optional<EndOfArm> SimRobotConfig::end_of_arm() const {
   if (!has_end_of_arm) return std::nullopt;
   EndOfArm e;
+  e.has_ft_sensor = has_ft_sensor;
+  if (!has_ft_sensor) {
+    e.tool = {tool.mass_kg, tool.com_m, tool.inertia_kgm2};
+    return e;
+  }
   e.sensor_offset_m = ft_sensor.sensor_offset_m;
   e.flange_side = {ft_sensor.flange_side_mass_kg, ft_sensor.flange_side_com_m, ft_sensor.flange_side_inertia_kgm2};
   e.tool = {tool.mass_kg, tool.com_m, tool.inertia_kgm2};
@@ -521,8 +594,10 @@ std::optional<EndOfArm> SimRobotConfig::end_of_arm() const {
 void SimRobotConfig::set_end_of_arm(const std::optional<EndOfArm>& end_of_arm) {
   has_end_of_arm = end_of_arm.has_value();
   const EndOfArm e = end_of_arm.value_or(EndOfArm{});
-  ft_sensor.sensor_offset_m = e.sensor_offset_m;
-  ft_sensor.flange_side_mass_kg = e.flange_side.mass_kg;
+  has_ft_sensor = e.has_ft_sensor;
+  const bool sensor = has_end_of_arm && has_ft_sensor;
+  ft_sensor.sensor_offset_m = sensor ? e.sensor_offset_m : 0.0;
+  ft_sensor.flange_side_mass_kg = sensor ? e.flange_side.mass_kg : 0.0;
   ft_sensor.flange_side_com_m = e.flange_side.com_m;
   ft_sensor.flange_side_inertia_kgm2 = e.flange_side.principal_inertia_kgm2;
   tool.mass_kg = e.tool.mass_kg;

@@ -30,6 +30,22 @@
 
 namespace phri {
 
+class YamlReader;
+
+/// A generic drive's position hold (GenericDrive), per joint; a list left empty takes the default
+/// rule of GenericDrive::hold_gains (critically damped at 30 Hz on the joint's inertia).
+struct GenericHoldGains {
+  std::vector<double> kp_Nm_per_rad;
+  std::vector<double> kd_Nms_per_rad;
+};
+
+/// The `drive:` key of robot.yaml and of a plant YAML, one grammar for both:
+///   drive: kinova | generic
+///   drive: {kind: generic, position_hold: {kp_Nm_per_rad: [...], kd_Nms_per_rad: [...]}}
+/// `drive` is the key's node; `dof` the joints. Gains of a `kinova` drive are refused (its
+/// position servo is the plant's vendor.position). Throws ConfigError naming the key path.
+DriveKind parse_drive(const YamlReader& drive, int dof, GenericHoldGains& hold);
+
 struct SimRobotConfig {
   static SimRobotConfig from_yaml_file(const std::string& path);
   /// `base_dir` resolves relative file names; `source_name` stands for the file in errors.
@@ -63,9 +79,13 @@ struct SimRobotConfig {
   std::string actuators_path;  ///< actuators.yaml
   ActuatorTable actuators;     ///< nominal drive models, loaded from actuators_path
 
-  // ---- where the arm stands: gravity in the world frame and the placement of the arm's root
-  // body (the URDF's root link, the MJCF's bodies under <worldbody>) in the world; a robot
-  // bundle's gravity_m_s2 and base_placement, which the controller's model gets too.
+  // ---- where the arm stands: gravity in the world frame and the placement in the world of the
+  // base link (the body `base_link`; '' : the arm's root bodies, the URDF's root link or the
+  // MJCF's bodies under <worldbody>); a robot bundle's frames.base, gravity_m_s2 and
+  // base_placement, which the controller's model gets too. The arm's root bodies move as one so
+  // that the base lands at base_placement, whatever fixed links lie between them and the base
+  // (a body with a joint there is refused: the base is fixed in the world).
+  std::string base_link;
   Eigen::Vector3d gravity_m_s2 = Eigen::Vector3d(0.0, 0.0, -9.81);
   Eigen::Isometry3d base_placement = Eigen::Isometry3d::Identity();
 
@@ -105,12 +125,18 @@ struct SimRobotConfig {
     double encoder_counts_per_rev = 262144.0;  ///< position quantum 2 pi / counts; 0: no quantisation
   } noise;
 
-  // ---- the end of arm: an F/T sensor at the flange and the tool below it, or neither (a bare
-  // flange: no F/T sample ever, RobotState::wrench never valid). A plant YAML has one when it
-  // gives the `ft_sensor` and `tool` sections; no default describes a particular arm.
+  // ---- the end of arm: an F/T sensor at the flange and the tool below it, a tool alone on the
+  // flange, or neither (a bare flange). Without a sensor there is no F/T sample ever
+  // (RobotState::wrench never valid). A plant YAML has one when it gives the `ft_sensor` and
+  // `tool` sections, or `tool` alone (with its flange_site); no default describes a particular arm.
   bool has_end_of_arm = false;
+  bool has_ft_sensor = true;  ///< with has_end_of_arm: false for a tool on the flange, no sensor
+  /// An F/T sensor is there to be read (external_torque_source ft or fused needs one).
+  bool ft_sensor_present() const { return has_end_of_arm && has_ft_sensor; }
   struct FtSensor {
-    std::string flange_site;        ///< MJCF site of the tool flange (z out of the flange)
+    /// MJCF site of the tool flange (z out of the flange), where the end of arm mounts (the tool
+    /// itself when there is no sensor)
+    std::string flange_site;
     double sensor_offset_m = 0.0;   ///< flange -> sensor measuring frame, along flange z
     double flange_side_mass_kg = 0.0;  ///< not measured by the sensor
     Eigen::Vector3d flange_side_com_m = Eigen::Vector3d::Zero();  ///< flange frame
@@ -148,9 +174,12 @@ struct SimRobotConfig {
   } mismatch;
 
   // ---- whose drives: Kinova's loops, emulated (KinovaDriveEmulator, the `vendor` section), or a
-  // generic current/torque drive (GenericDrive: position hold with the vendor section's position
-  // kp and kd, no integrator; plain torque; current). A robot bundle's `drive:` sets it.
+  // generic current/torque drive (GenericDrive: a PD position hold with generic_hold's gains, no
+  // integrator; plain torque; current). The plant YAML's `drive:` (default kinova) or a robot
+  // bundle's, which must agree when both say it (RobotBundle::apply_to).
   DriveKind drive = DriveKind::kKinova;
+  bool drive_stated = false;  ///< the plant YAML has a `drive:` key
+  GenericHoldGains generic_hold;  ///< drive generic: the hold's gains (empty: GenericDrive::hold_gains' rule)
 
   // ---- the vendor's actuator loops, emulated inside the plant (see KinovaDriveEmulator)
   struct Vendor {

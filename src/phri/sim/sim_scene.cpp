@@ -57,7 +57,10 @@ FlangeMount find_flange_mount(const SimRobotConfig& config) {
   const MjModelPtr arm = load_arm(config);
   const std::string& site_name = config.ft_sensor.flange_site;
   const int site = mj_name2id(arm.get(), mjOBJ_SITE, site_name.c_str());
-  if (site < 0) throw ConfigError(config.source, "plant.ft_sensor.flange_site", "no site '" + site_name + "' in " + file);
+  if (site < 0) {
+    throw ConfigError(config.source, config.has_ft_sensor ? "plant.ft_sensor.flange_site" : "plant.tool.flange_site",
+                      "no site '" + site_name + "' in " + file);
+  }
   FlangeMount mount;
   mount.body = mj_id2name(arm.get(), mjOBJ_BODY, arm->site_bodyid[site]);
   for (const char* name : {SimScene::kAdapterBody, SimScene::kToolBody, SimScene::kDropBody}) {
@@ -77,6 +80,27 @@ void remove_keyframes(std::string& xml, const std::string& file) {
   const auto key_end = xml.find("</keyframe>", key_begin);
   if (key_end == std::string::npos) throw ConfigError(file, "keyframe", "unterminated <keyframe>");
   xml.erase(key_begin, key_end + std::string("</keyframe>").size() - key_begin);
+}
+
+// The tool alone on the flange (no F/T sensor): its origin is the flange site's frame.
+std::string bare_tool_mjcf(const SimRobotConfig& config, const FlangeMount& mount) {
+  const mjtNum* sp = mount.pos;
+  const mjtNum* sq = mount.quat;
+  const auto& tool = config.tool;
+  std::string chain;
+  chain += "\n<!-- phri simulator scene: the tool on the flange (no F/T sensor) -->\n";
+  chain += "<body name=\"" + std::string(SimScene::kToolBody) + "\" pos=\"" + num(sp[0]) + " " + num(sp[1]) + " " +
+           num(sp[2]) + "\" quat=\"" + num(sq[0]) + " " + num(sq[1]) + " " + num(sq[2]) + " " + num(sq[3]) + "\">\n";
+  chain += "  <inertial pos=\"" + vec(tool.com_m) + "\" mass=\"" + num(tool.mass_kg) + "\" diaginertia=\"" +
+           vec(tool.inertia_kgm2) + "\"/>\n";
+  chain += "  <geom name=\"tool_geom\" type=\"box\" size=\"0.03 0.05 0.03\" pos=\"" + vec(tool.com_m) +
+           "\" contype=\"0\" conaffinity=\"0\" group=\"1\" rgba=\"0.2 0.2 0.8 0.6\"/>\n";
+  if (config.drop_test.enabled) {
+    chain += "  <site name=\"" + std::string(SimScene::kAnchorSite) + "\" pos=\"" + vec(config.drop_test.anchor_m) +
+             "\" size=\"0.005\"/>\n";
+  }
+  chain += "</body>\n";
+  return chain;
 }
 
 // The F/T adapter and the tool below it, as a body tree for the flange body.
@@ -182,10 +206,10 @@ std::string SimScene::build_mjcf(const SimRobotConfig& config) {
   remove_keyframes(xml, file);
   if (config.has_end_of_arm) {
     const FlangeMount mount = find_flange_mount(config);
-    insert_into_body(xml, mount.body, tool_chain_mjcf(config, mount), file);
+    insert_into_body(xml, mount.body, config.has_ft_sensor ? tool_chain_mjcf(config, mount) : bare_tool_mjcf(config, mount), file);
   }
   insert_before_end_tag(xml, "worldbody", world_additions_mjcf(config), file);
-  if (config.has_end_of_arm) insert_before_end_tag(xml, "mujoco", ft_sensors_mjcf(), file);
+  if (config.ft_sensor_present()) insert_before_end_tag(xml, "mujoco", ft_sensors_mjcf(), file);
   return xml;
 }
 

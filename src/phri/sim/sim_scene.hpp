@@ -8,7 +8,9 @@
 //       tool           welded at sensor_offset_m along the flange z: the tool (DS4 gamepad + mount);
 //                      its origin is the sensor's measuring frame, site "ft_sensor" with a MuJoCo
 //                      force and torque sensor; site "cable_anchor" when the drop test is enabled
-//   (neither when the plant has no end of arm, SimRobotConfig::has_end_of_arm: a bare flange)
+//   (a tool without an F/T sensor, SimRobotConfig::has_ft_sensor false: `tool` welded at the flange
+//   site itself, its origin the flange frame, no adapter, no sensor site, no MuJoCo sensors;
+//   neither when the plant has no end of arm, SimRobotConfig::has_end_of_arm: a bare flange)
 //   world
 //     drop_mass        (drop test only) free body, a sphere; held at the anchor until release
 //     floor            (optional) a plane; only the drop mass collides with it
