@@ -191,18 +191,22 @@ TEST(KortexSession, DemoThroughTheEmulatorGivesTheSimulatorsPerPhaseTable) {
   }
 }
 
-// The motor torque's largest cycle-to-cycle step after the fault stays within the largest step
-// of the second before it plus a margin (the actuators' position hold takes over without a kick).
+// The motor torque the plant applies, its largest cycle-to-cycle step (any joint) from the fault
+// on, against the same window of the same session without the fault: the actuators' own position
+// hold takes over with no kick beyond what the session itself does (the elbow pushes at 4 s).
 void expect_no_torque_jump(const Outcome& o) {
-  std::printf("largest motor torque step: %.3f N.m in the second before the fault, %.3f N.m after\n", o.step_before, o.step_after);
-  EXPECT_LT(o.step_after, 1.5 * o.step_before + 1.0);
+  static const double fault_free = run_demo(Path::kKortex, kFaultAt_s + 1.5).step_after;
+  std::printf("largest motor torque step: %.3f N.m in the second before %.1f s; after it %.3f N.m with the fault, %.3f N.m "
+              "without\n", o.step_before, kFaultAt_s, o.step_after, fault_free);
+  EXPECT_LT(o.step_after, 1.2 * fault_free + 0.5);
 }
 
 TEST(KortexSession, PacketLossOfOnePercentIsRiddenThroughWithoutATorqueJump) {
   const Outcome o = run_demo(Path::kKortex, kFaultAt_s + 1.5, Fault::kPacketLoss);
-  std::printf("1 %% packet loss: %llu lost, longest run %d, safe hold: %s %s\n",
-              static_cast<unsigned long long>(o.emulator.lost_packets), o.health.longest_failure_run,
-              o.summary.safe_hold ? "yes" : "no", o.summary.safe_hold_reason.c_str());
+  std::printf("1 %% packet loss: %llu lost, longest run %d; %ld held cycles, %llu degraded spells; safe hold: %s %s\n",
+              static_cast<unsigned long long>(o.emulator.lost_packets), o.health.longest_failure_run, o.summary.held_cycles,
+              static_cast<unsigned long long>(o.summary.degraded_spells), o.summary.safe_hold ? "yes" : "no",
+              o.summary.safe_hold_reason.c_str());
   EXPECT_GT(o.emulator.lost_packets, 5u);
   expect_no_torque_jump(o);
   if (o.summary.safe_hold) {  // if the supervisor's budget ran out, it is a logged safe stop
