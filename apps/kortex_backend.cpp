@@ -86,10 +86,9 @@ public:
     if (sensor_) {
       settings.wrench_source = [this](phri::RobotState& s) {
         sensor_->read_into(s);
-        s.wrench.stamp_s -= clock_start_s_;  // host steady clock -> robot time
+        s.wrench.stamp_s -= robot_->clock_start_s();  // host steady clock (the SDK client's) -> robot time
       };
     }
-    clock_start_s_ = client_->clock_s();
     robot_ = std::make_unique<phri::KortexRobot>(*client_, settings);
   }
   phri::KortexRobot& robot() override { return *robot_; }
@@ -98,7 +97,6 @@ public:
 private:
   std::unique_ptr<phri::KortexSdkClient> client_;
   std::unique_ptr<phri::BotaSensOne> sensor_;
-  double clock_start_s_ = 0.0;
   std::unique_ptr<phri::KortexRobot> robot_;  // last: stopped first
 };
 #endif

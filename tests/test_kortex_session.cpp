@@ -218,6 +218,7 @@ TEST(KortexSession, PacketLossOfOnePercentIsRiddenThroughWithoutATorqueJump) {
 
 TEST(KortexSession, StallOfFiveMillisecondsEndsInALoggedSafeStop) {
   const Outcome o = run_demo(Path::kKortex, kFaultAt_s + 1.5, Fault::kStall);
+  std::printf("%sphri: SAFE HOLD: %s\n", o.logged.c_str(), o.summary.safe_hold_reason.c_str());
   EXPECT_TRUE(o.health.link_lost);
   EXPECT_TRUE(o.summary.safe_hold);
   EXPECT_NE(o.printed.find("robot_fault"), std::string::npos) << o.printed;
@@ -228,6 +229,7 @@ TEST(KortexSession, StallOfFiveMillisecondsEndsInALoggedSafeStop) {
 
 TEST(KortexSession, DroppedSessionEndsInALoggedSafeStopAndTheWatchdogsBrake) {
   const Outcome o = run_demo(Path::kKortex, kFaultAt_s + 1.5, Fault::kDroppedSession);
+  std::printf("%sphri: SAFE HOLD: %s\n", o.logged.c_str(), o.summary.safe_hold_reason.c_str());
   EXPECT_TRUE(o.health.link_lost);
   EXPECT_TRUE(o.summary.safe_hold);
   EXPECT_NE(o.logged.find("communication lost"), std::string::npos) << o.logged;

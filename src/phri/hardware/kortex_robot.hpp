@@ -113,6 +113,8 @@ public:
   /// The ControlMode the actuators were last switched to.
   kortex::ControlMode control_mode() const { return active_mode_; }
   const KortexRobotSettings& settings() const { return settings_; }
+  /// The client clock at robot time 0 [s] (RobotState::time_s = client clock - this).
+  double clock_start_s() const { return clock_start_s_; }
   /// The exit sequence now (POSITION, SINGLE_LEVEL_SERVOING, sessions closed); idempotent, no throw.
   void shutdown() noexcept;
 
