@@ -3,18 +3,22 @@
 
 namespace kortex_sdk_double {
 
-Arm& arm() {
-  static Arm the_arm;
-  return the_arm;
-}
-
-void reset(int actuator_count) {
-  Arm& a = arm();
-  a = Arm{};
+namespace {
+Arm fresh_arm(int actuator_count) {
+  Arm a;
   a.actuator_count = actuator_count;
   a.modes.assign(static_cast<std::size_t>(actuator_count), Kinova::Api::ActuatorConfig::POSITION);
   a.position_deg.assign(static_cast<std::size_t>(actuator_count), 10.0f);
+  return a;
 }
+}  // namespace
+
+Arm& arm() {
+  static Arm the_arm = fresh_arm(7);
+  return the_arm;
+}
+
+void reset(int actuator_count) { arm() = fresh_arm(actuator_count); }
 
 namespace {
 void note(const std::string& call) { arm().calls.push_back(call); }
