@@ -9,12 +9,16 @@
 #include <phri/hardware/kortex_sdk/kortex_sdk_client.hpp>
 #endif
 
+#include <chrono>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <ostream>
 #include <vector>
 
 namespace {
+
+volatile std::sig_atomic_t g_interrupted = 0;
 
 phri::KortexRobotSettings robot_settings(const phri::Config& config, const phri::Model& model, bool dry_run) {
   phri::KortexRobotSettings s;
@@ -131,7 +135,9 @@ int kortex_dry_run(KortexBackend& backend, double duration_s, bool real_time, st
   phri::LoopClock clock(robot.period_s(), real_time ? phri::LoopClock::Pacing::kRealTime : phri::LoopClock::Pacing::kLockstep);
   const long cycles = std::lround(duration_s / robot.period_s());
   double next_print = 0.0;
-  for (long k = 0; k < cycles; ++k) {
+  g_interrupted = 0;
+  std::signal(SIGINT, [](int) { g_interrupted = 1; });  // Ctrl-C ends the dry run through the exit sequence
+  for (long k = 0; k < cycles && !g_interrupted; ++k) {
     const phri::RobotState& s = robot.read();
     if (s.time_s >= next_print) {
       next_print += 1.0;
@@ -145,6 +151,34 @@ int kortex_dry_run(KortexBackend& backend, double duration_s, bool real_time, st
     }
     clock.wait_next();
   }
+  std::signal(SIGINT, SIG_DFL);
   out << backend.report() << "\n";
   return robot.health().arm_fault || robot.health().link_lost ? 3 : 0;
+}
+
+InterruptToStop::InterruptToStop(phri::LiveChannel& live) : live_(live) {
+  g_interrupted = 0;
+  std::signal(SIGINT, [](int) {
+    g_interrupted = 1;
+    std::signal(SIGINT, SIG_DFL);  // a second Ctrl-C kills
+  });
+  watcher_ = std::thread([this] {
+    while (!done_.load()) {
+      if (g_interrupted) {
+        phri::LiveCommand stop;
+        stop.kind = phri::LiveCommand::Kind::kEvent;
+        stop.event = phri::Event::kStop;
+        live_.send(stop);
+        std::fprintf(stderr, "\nphri: interrupted: stopping (brake to rest, position hold, then the exit sequence); Ctrl-C again kills\n");
+        return;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+  });
+}
+
+InterruptToStop::~InterruptToStop() {
+  done_.store(true);
+  watcher_.join();
+  std::signal(SIGINT, SIG_DFL);
 }

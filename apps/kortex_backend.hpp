@@ -4,13 +4,16 @@
 // -DPHRI_KORTEX_API_DIR) or on the in-process emulator over the simulated plant; with
 // --ft-serial, the Bota SensONE's wrench; with --dry-run, only reading (no torque ever sent).
 #include <phri/app/config.hpp>
+#include <phri/app/live_channel.hpp>
 #include <phri/hardware/kortex_robot.hpp>
 #include <phri/model/model.hpp>
 #include <phri/robot/robot_interface.hpp>
 
+#include <atomic>
 #include <iosfwd>
 #include <memory>
 #include <string>
+#include <thread>
 
 struct KortexArguments {
   std::string backend = "sim";  ///< sim | kortex | kortex-emulator
@@ -37,3 +40,19 @@ std::unique_ptr<KortexBackend> make_kortex_backend(const KortexArguments& args, 
 /// --dry-run: reads the arm for `duration_s` (paced at its period on the real arm), printing the
 /// state once a second; sends nothing but the measured pose in POSITION. Returns the exit status.
 int kortex_dry_run(KortexBackend& backend, double duration_s, bool real_time, std::ostream& out);
+
+/// On the arm, Ctrl-C must not just kill the program: while this lives, the first SIGINT posts
+/// the FSM's stop through `live` (brake to rest, hold; the run then ends and the exit sequence
+/// puts the actuators in POSITION and the arm in single-level servoing); a second one kills as usual.
+class InterruptToStop {
+public:
+  explicit InterruptToStop(phri::LiveChannel& live);
+  ~InterruptToStop();
+  InterruptToStop(const InterruptToStop&) = delete;
+  InterruptToStop& operator=(const InterruptToStop&) = delete;
+
+private:
+  phri::LiveChannel& live_;
+  std::atomic<bool> done_{false};
+  std::thread watcher_;
+};

@@ -227,7 +227,9 @@ int run_command(const RunArguments& args) {
   if (args.dashboard.enabled) dashboard = start_dashboard(args.dashboard, config, cycle, live);
 
   phri::RunOptions options;
-  if (dashboard) options.live = &live;
+  if (dashboard || kortex) options.live = &live;
+  std::optional<InterruptToStop> interrupt;
+  if (kortex) interrupt.emplace(live);
   options.duration_s = config.run.duration_s;
   options.real_time = config.run.pacing == phri::LoopClock::Pacing::kRealTime;
   options.phases.push_back({0.0, "startup"});
