@@ -406,7 +406,11 @@ TEST(KortexRobot, FaultAndWarningBitsReachTheState) {
   EXPECT_TRUE(robot.state().fault);
   EXPECT_EQ(robot.health().fault_bank_a[4], kortex::safety_bit::kMaximumTorque);
   EXPECT_EQ(robot.health().arm_state, kortex::ArmState::kInFault);
-  EXPECT_EQ(robot.write(rig.torque()), phri::WriteStatus::kFault);
+  EXPECT_EQ(robot.write(rig.torque(3.0)), phri::WriteStatus::kFault);
+  for (std::size_t i = 0; i < 7; ++i) {  // the measured pose, no torque, from the fault on
+    EXPECT_EQ(robot.command().actuators[i].torque_joint_Nm, 0.0f);
+    EXPECT_EQ(robot.command().actuators[i].position_deg, robot.feedback().actuators[i].position_deg);
+  }
   std::rewind(log);
   char text[512] = {};
   const std::size_t n = std::fread(text, 1, sizeof text - 1, log);

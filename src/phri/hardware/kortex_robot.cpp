@@ -240,6 +240,9 @@ void KortexRobot::update_health() noexcept {
     fault = fault || (a.fault_bank_a | a.fault_bank_b) != 0;
     warning = warning || (a.warning_bank_a | a.warning_bank_b) != 0;
   }
+  // A fault latches on the arm until ClearFaults; from its first report on the command is the
+  // measured pose with no torque, so nothing stale is applied if the arm is cleared meanwhile.
+  if (fault && !health_.arm_fault) hold_measured_pose();
   health_.arm_fault = fault;
   health_.warning = warning;
   if (fault && !fault_logged_) {
