@@ -1,8 +1,10 @@
 // phri: the command-line entry point.
 //   phri run --config FILE [--robot DIR] [--lockstep|--realtime] [--duration S] [--out DIR]
 //            [--dashboard [--port P] [--bind ADDR] [--push-max N]]
-//                                              a session: simulated arm, FSM, gamepad, log, figure,
-//                                              and the live dashboard in a browser
+//            [--backend sim|kortex|kortex-emulator [--ip ADDR] [--ft-serial DEV] [--dry-run]]
+//                                              a session: simulated arm (or the Gen3 through the
+//                                              Kortex backend, kortex_backend.cpp), FSM, gamepad,
+//                                              log, figure, and the live dashboard in a browser
 //   phri info --urdf FILE                      model summary of a robot description
 //   phri fit-collision --robot DIR [--out FILE] self-collision capsules fitted from the robot's URDF
 //   phri identify-friction [options]           the paper's friction identification (simulated arm)
@@ -17,6 +19,7 @@
 // Every bad argument or file, and every failure of a run or an experiment (phri::Error: ConfigError,
 // IoError, ExperimentError), gives one line on stderr naming what is wrong and a non-zero exit status.
 #include "ft_monitor.hpp"
+#include "kortex_backend.hpp"
 
 #include <phri/app/config.hpp>
 #include <phri/app/config_checks.hpp>
@@ -167,6 +170,7 @@ struct RunArguments {
   double duration_s = -1.0;
   std::string out_dir = "out";
   bool figure = true;
+  KortexArguments kortex;
 };
 
 // The generated plant's warnings (none for a hand-written MJCF).
@@ -190,7 +194,12 @@ int run_command(const RunArguments& args) {
   config.logging.path = (out / std::filesystem::path(config.logging.path).filename()).string();
 
   // Everything that can refuse the configuration is built before the first line of output.
-  phri::SimRobot robot(config.plant);
+  check_kortex_arguments(args.kortex);
+  const bool real_arm = args.kortex.backend == "kortex";
+  if (real_arm && args.lockstep) throw phri::ConfigError("--lockstep", "", "the real arm runs in real time (--backend kortex)");
+  if (real_arm) config.run.pacing = phri::LoopClock::Pacing::kRealTime;
+  std::unique_ptr<phri::SimRobot> sim;
+  if (args.kortex.backend == "sim") sim = std::make_unique<phri::SimRobot>(config.plant);
   phri::Controller cycle(config.controller);
   // What the URDF loader and the plant generator accepted but the user should know (one line each,
   // naming the link): odd inertias, a base inertial ignored, inertias MuJoCo balanced.
@@ -198,8 +207,16 @@ int run_command(const RunArguments& args) {
   for (const std::string& warning : generated_plant_warnings(config.plant)) std::fprintf(stderr, "phri: warning: %s\n", warning.c_str());
   for (const std::string& warning : phri::config_warnings(config)) std::fprintf(stderr, "phri: warning: %s\n", warning.c_str());
   phri::Fsm fsm(config.fsm, cycle);
-  std::printf("phri run: %s, %.1f s, %s\n", args.config_path.c_str(), config.run.duration_s,
-              config.run.pacing == phri::LoopClock::Pacing::kLockstep ? "lockstep" : "real time");
+  // The Kortex backend connects and starts the arm last (a refusal is one line, the arm put back).
+  std::unique_ptr<KortexBackend> kortex;
+  if (!sim) kortex = make_kortex_backend(args.kortex, config, cycle.model());
+  phri::RobotInterface& robot = sim ? static_cast<phri::RobotInterface&>(*sim) : kortex->robot();
+  std::printf("phri run: %s, %.1f s, %s%s%s\n", args.config_path.c_str(), config.run.duration_s,
+              config.run.pacing == phri::LoopClock::Pacing::kLockstep ? "lockstep" : "real time",
+              sim ? "" : (", backend " + args.kortex.backend).c_str(), args.kortex.dry_run ? ", dry run" : "");
+  if (args.kortex.dry_run) {
+    return kortex_dry_run(*kortex, config.run.duration_s, config.run.pacing == phri::LoopClock::Pacing::kRealTime, std::cout);
+  }
   std::unique_ptr<phri::Gamepad> gamepad;
   if (config.gamepad.enabled) {
     gamepad = std::make_unique<phri::Gamepad>(config.gamepad);
@@ -212,7 +229,9 @@ int run_command(const RunArguments& args) {
   if (args.dashboard.enabled) dashboard = start_dashboard(args.dashboard, config, cycle, live);
 
   phri::RunOptions options;
-  if (dashboard) options.live = &live;
+  if (dashboard || kortex) options.live = &live;
+  std::optional<InterruptToStop> interrupt;
+  if (kortex) interrupt.emplace(live);
   options.duration_s = config.run.duration_s;
   options.real_time = config.run.pacing == phri::LoopClock::Pacing::kRealTime;
   options.phases.push_back({0.0, "startup"});
@@ -221,6 +240,7 @@ int run_command(const RunArguments& args) {
   if (gamepad) gamepad->stop();
   if (dashboard) dashboard->stop();
   std::printf("\n");
+  if (kortex) std::printf("%s\n", kortex->report().c_str());
   phri::print_run_summary(summary, std::cout);
   std::ostringstream md;
   md << "# phri run: " << args.config_path << "\n\n";
@@ -273,6 +293,14 @@ CLI::App* add_run_command(CLI::App& app, RunArguments& args) {
       ->check(duration_seconds());
   run->add_option("--out", args.out_dir, "output folder (log, summary, figure)")->capture_default_str();
   run->add_flag("!--no-figure", args.figure, "skip the figure");
+  run->add_option("--backend", args.kortex.backend,
+                  "the arm: sim (the simulated Gen3), kortex (the real Gen3 through Kinova's Kortex API; needs a build with "
+                  "-DPHRI_KORTEX_API_DIR) or kortex-emulator (the Kortex backend on an emulated arm over the simulation)")
+      ->check(CLI::IsMember({"sim", "kortex", "kortex-emulator"}))->capture_default_str();
+  run->add_option("--ip", args.kortex.ip, "the arm's address (--backend kortex; TCP 10000, UDP 10001)")->capture_default_str();
+  run->add_option("--ft-serial", args.kortex.ft_serial, "the Bota SensONE's serial device (--backend kortex)");
+  run->add_flag("--dry-run", args.kortex.dry_run, "connect and read the arm, print its state; no torque is ever sent "
+                "(the actuators hold the measured pose in position mode)");
   auto* dashboard = run->add_flag("--dashboard", args.dashboard.enabled,
                                   "serve the live dashboard (3-D view, plots, buttons, sliders, drag-to-push) on "
                                   "127.0.0.1; its address, with a random token, is printed at start");
