@@ -157,7 +157,10 @@ RobotBundle parse(const YamlReader& r, const std::string& folder) {
   b.locked_joints = names(r, "locked_joints");
   const int dof = ActuatorTable::from_yaml_file(b.actuators_path).size();
   b.home_q_rad = r.per_joint<std::vector<double>>("home_q_rad", dof, -kMaxJointAngle_rad, kMaxJointAngle_rad);
-  b.compliance_deadband_Nm = r.per_joint<Eigen::VectorXd>("compliance_deadband_Nm", dof, 0.0, kMaxDeadband_Nm);
+  // Absent: the controller's default per drive (by `size`, or 1 % of the torque limit without one).
+  if (r.has("compliance_deadband_Nm")) {
+    b.compliance_deadband_Nm = r.per_joint<Eigen::VectorXd>("compliance_deadband_Nm", dof, 0.0, kMaxDeadband_Nm);
+  }
   b.drive = parse_drive(r.at("drive"), dof, b.generic_hold);
   if (r.has("custom_loop_filter")) parse_custom_loop_filter(r.at("custom_loop_filter"), b);
   if (r.has("end_of_arm")) b.end_of_arm = parse_end_of_arm(r.at("end_of_arm"));
