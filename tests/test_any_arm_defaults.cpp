@@ -4,10 +4,13 @@
 //    dead band is 1 % of the drive's torque limit and the emulated Kinova gains follow the drive's
 //    maximum torque (the Gen3's classes reproduced by that rule); an arm whose drives state no size
 //    loads, holds its pose and runs;
+//  * WholeBodyQpSettings and StateEncoderSettings name no end-effector frame (the Gen3's
+//    end_effector_link was their default): empty is refused, the Controller sets it;
 // The arm is robots/example_6dof, copied and edited.
 #include <phri/app/config.hpp>
 #include <phri/app/robot_bundle.hpp>
 #include <phri/control/controller.hpp>
+#include <phri/dashboard/state_encoder.hpp>
 #include <phri/model/algorithms.hpp>
 #include <phri/robot/actuator_table.hpp>
 #include <phri/sim/sim_robot.hpp>
@@ -191,6 +194,24 @@ TEST(AnyArmDefaults, AnArmWhoseDrivesStateNoSizeLoadsAndHoldsItsPose) {
   Eigen::VectorXd robot_yaml(6);
   robot_yaml << 1.0, 1.0, 1.0, 1.0, 0.4, 0.4;
   EXPECT_EQ(stated.controller.qp.compliance_deadband, robot_yaml);
+}
+
+// ------------------------------------------------------------------ end-effector frame
+TEST(AnyArmDefaults, NoLibrarySettingNamesAnArmsEndEffectorFrame) {
+  EXPECT_EQ(phri::WholeBodyQpSettings{}.end_effector_frame, "");
+  EXPECT_EQ(phri::StateEncoderSettings{}.end_effector_frame, "");
+  EXPECT_EQ(phri::ControllerSettings{}.end_effector_frame, "");
+  // Left empty: refused, naming the key (no silent fallback on the Gen3's frame).
+  const phri::Model model = phri::Model::from_urdf_file(kGen3 + "/gen3.urdf");
+  const auto error = expect_config_error([&] { phri::WholeBodyQp qp(model, nullptr, phri::WholeBodyQpSettings{}); },
+                                         {.element = "end_effector_frame", .mentions = {"empty"}, .file = "WholeBodyQpSettings"});
+  if (error) {
+    EXPECT_EQ(std::string(error->what()).find('\n'), std::string::npos) << error->what();
+  }
+  // The Controller sets the robot's: the example arm's flange.
+  const phri::Config config = run_config(example_bundle("frame", false));
+  const phri::Controller cycle(config.controller);
+  EXPECT_EQ(cycle.qp().settings().end_effector_frame, "flange");
 }
 
 }  // namespace
