@@ -6,6 +6,8 @@
 //    loads, holds its pose and runs;
 //  * WholeBodyQpSettings and StateEncoderSettings name no end-effector frame (the Gen3's
 //    end_effector_link was their default): empty is refused, the Controller sets it;
+//  * robot.yaml's `payloads`: bodies on any link, carried alike by the controller's model and the
+//    generated plant (gravity torques against MuJoCo's bias force at rest), the arm holding its pose.
 // The arm is robots/example_6dof, copied and edited.
 #include <phri/app/config.hpp>
 #include <phri/app/robot_bundle.hpp>
@@ -212,6 +214,122 @@ TEST(AnyArmDefaults, NoLibrarySettingNamesAnArmsEndEffectorFrame) {
   const phri::Config config = run_config(example_bundle("frame", false));
   const phri::Controller cycle(config.controller);
   EXPECT_EQ(cycle.qp().settings().end_effector_frame, "flange");
+}
+
+// ------------------------------------------------------------------------------ payloads
+// Bodies on three links beyond the URDF and the end of arm: a valve block on the forearm (link_3),
+// a camera on the flange, a sensor on a locked finger; all off their link's origin.
+const std::string kPayloads =
+    "payloads:\n"
+    "  - {name: valve_block, link: link_3, mass_kg: 1.5, com_m: [0.04, -0.03, 0.10], inertia_kgm2: [4.0e-3, 3.0e-3, 2.0e-3]}\n"
+    "  - {name: camera, link: flange, mass_kg: 0.4, com_m: [0.06, 0.0, 0.02], inertia_kgm2: [6.0e-4, 5.0e-4, 4.0e-4]}\n"
+    "  - {link: left_finger, mass_kg: 0.1, com_m: [0.0, 0.01, 0.02], inertia_kgm2: [2.0e-5, 2.0e-5, 1.0e-5]}\n";
+
+struct Agreement {
+  double gravity_Nm = 0.0;      ///< max |g_model(q) - MuJoCo's qfrc_bias| at rest
+  double gravity_max_Nm = 0.0;  ///< max |g_model(q)|
+};
+
+// The controller's model (its options: chain, payloads, placement) against the plant at the
+// plant's posture, at rest: MuJoCo's bias force is then the gravity torque alone.
+Agreement model_against_plant(const phri::ControllerSettings& settings, const phri::SimRobot& robot) {
+  const phri::Model model = phri::Model::from_urdf_file(settings.urdf_path, phri::Controller::model_options(settings));
+  phri::Data data(model);
+  const Eigen::VectorXd q = robot.truth().q_rad;
+  const Eigen::VectorXd g = phri::compute_gravity(model, data, q);
+  const mjModel* m = robot.mujoco_model();
+  const mjData* d = robot.mujoco_data();
+  Agreement a;
+  for (int i = 0; i < model.nv(); ++i) {
+    const int joint = mj_name2id(m, mjOBJ_JOINT, model.joint(i).name.c_str());
+    EXPECT_GE(joint, 0);
+    a.gravity_Nm = std::max(a.gravity_Nm, std::abs(d->qfrc_bias[m->jnt_dofadr[joint]] - g[i]));
+  }
+  a.gravity_max_Nm = g.cwiseAbs().maxCoeff();
+  return a;
+}
+
+TEST(AnyArmDefaults, PayloadsOnLinksAreCarriedAlikeByTheControllersModelAndThePlant) {
+  const std::string folder = example_bundle("payloads", false, "", kPayloads);
+  const phri::RobotBundle bundle = phri::RobotBundle::from_folder(folder);
+  ASSERT_EQ(bundle.payloads.size(), 3u);
+  EXPECT_EQ(bundle.payloads[2].name, "payload_2");  // a name by default
+  const phri::Config config = run_config(folder);
+  // The end of arm's two payloads (F/T adapter, tool), then the bundle's three on their links.
+  ASSERT_EQ(config.controller.payloads.size(), 5u);
+  EXPECT_EQ(config.controller.payloads[2].frame, "link_3");
+  EXPECT_EQ(config.controller.payloads[2].inertia.com, Eigen::Vector3d(0.04, -0.03, 0.10));
+  ASSERT_EQ(config.plant.payloads.size(), 3u);
+
+  const phri::SimRobot robot(config.plant);
+  const phri::Controller cycle(config.controller);
+  const phri::Config without = run_config(example_bundle("no_payloads", false));
+  const phri::Controller bare(without.controller);
+  const mjModel* m = robot.mujoco_model();
+  const double plant_moving = m->body_subtreemass[mj_name2id(m, mjOBJ_BODY, "link_1")];
+  std::printf("payloads 2.0 kg on link_3, flange, left_finger: moving mass %.4f kg in the controller's model, %.4f kg in the plant "
+              "(%.4f kg without them)\n", cycle.model().total_mass(), plant_moving, bare.model().total_mass());
+  EXPECT_NEAR(cycle.model().total_mass(), bare.model().total_mass() + 2.0, 1e-12);
+  EXPECT_NEAR(plant_moving, bare.model().total_mass() + 2.0, 1e-12);
+  for (const char* link : {"link_3", "flange", "left_finger"}) {
+    SCOPED_TRACE(link);
+    bool found = false;
+    for (int b = 0; b < m->nbody; ++b) {
+      const std::string name = mj_id2name(m, mjOBJ_BODY, b) ? mj_id2name(m, mjOBJ_BODY, b) : "";
+      if (name.rfind(phri::SimScene::kPayloadBodyPrefix, 0) == 0 &&
+          std::string(mj_id2name(m, mjOBJ_BODY, m->body_parentid[b])) == link) {
+        found = true;
+      }
+    }
+    EXPECT_TRUE(found);  // welded into the link's own body
+  }
+
+  // Gravity torques at rest: the controller's model against MuJoCo's bias force, and they matter.
+  const Agreement with = model_against_plant(config.controller, robot);
+  phri::ControllerSettings unaware = config.controller;
+  unaware.payloads.resize(2);  // the end of arm only
+  const Agreement without_payloads = model_against_plant(unaware, robot);
+  std::printf("payloads: |g_model - qfrc_bias| max %.2e N.m (|g| max %.2f N.m; %.2f N.m with the payloads left out of the model)\n",
+              with.gravity_Nm, with.gravity_max_Nm, without_payloads.gravity_Nm);
+  EXPECT_LT(with.gravity_Nm, 1e-9);
+  EXPECT_GT(without_payloads.gravity_Nm, 1.0);
+
+  const Held held = hold_pose(config, 3.0);
+  std::printf("payloads: flange drift max %.3f mm over 3 s\n", 1e3 * held.drift_m);
+  EXPECT_LT(held.drift_m, 1e-3);
+  EXPECT_EQ(held.status, phri::CycleStatus::kOk);
+}
+
+TEST(AnyArmDefaults, PayloadMistakesAreOneLineErrorsNamingTheKey) {
+  const std::string ok = "mass_kg: 1.0, com_m: [0, 0, 0.1], inertia_kgm2: [1.0e-3, 1.0e-3, 1.0e-3]";
+  const struct {
+    std::string payloads, key;
+  } cases[] = {
+      {"[{link: nowhere, " + ok + "}]", "payloads[0].link"},
+      {"[{link: link_3, mass_kg: 0, com_m: [0, 0, 0.1], inertia_kgm2: [1.0e-3, 1.0e-3, 1.0e-3]}]", "payloads[0].mass_kg"},
+      {"[{link: link_3, mass_kg: 1000, com_m: [0, 0, 0.1], inertia_kgm2: [1.0e-3, 1.0e-3, 1.0e-3]}]", "payloads[0].mass_kg"},
+      {"[{link: link_3, mass_kg: 1, com_m: [0, 0, 100], inertia_kgm2: [1.0e-3, 1.0e-3, 1.0e-3]}]", "payloads[0].com_m[2]"},
+      {"[{link: link_3, mass_kg: 1, com_m: [0, 0, 0.1], inertia_kgm2: [1.0e-3, 1.0e-3, 5.0e-3]}]", "payloads[0].inertia_kgm2"},
+      {"[{link: link_3, mass_kg: 1, com_m: [0, 0, 0.1], inertia_kgm2: [1.0e-3, 1.0e-3, -1.0e-3]}]", "payloads[0].inertia_kgm2[2]"},
+      {"[{link: link_3, " + ok + ", colour: red}]", "payloads[0].colour"},
+      {"[{" + ok + "}]", "payloads[0].link"},
+      {"[{name: a, link: link_3, " + ok + "}, {name: a, link: link_2, " + ok + "}]", "payloads[1].name"},
+      {"{link: link_3, " + ok + "}", "payloads"},
+  };
+  int n = 0;
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.payloads);
+    const std::string folder = example_bundle("payload_mistake_" + std::to_string(n++), false, "", "payloads: " + c.payloads + "\n");
+    const auto error = expect_config_error([&] { (void)phri::RobotBundle::from_folder(folder); },
+                                           {.element = c.key, .file = folder + "/robot.yaml"});
+    if (error) {
+      EXPECT_EQ(std::string(error->what()).find('\n'), std::string::npos) << error->what();
+    }
+  }
+  // A plant made in code with a link its MJCF lacks: refused where the plant is made.
+  phri::Config config = run_config(example_bundle("payload_plant", false, "", kPayloads));
+  config.plant.payloads[1].link = "nowhere";
+  expect_config_error([&] { phri::SimRobot r(config.plant); }, {.element = "payloads[1].link", .mentions = {"nowhere"}});
 }
 
 }  // namespace
