@@ -52,6 +52,7 @@ public:
   }
 
   static phri::WholeBodyQpSettings with_paper_limits(phri::WholeBodyQpSettings s) {
+    if (s.end_effector_frame.empty()) s.end_effector_frame = "end_effector_link";  // no library default
     if (s.torque_limit.size() == 0) {
       s.torque_limit.resize(7);
       s.torque_limit << 95, 95, 95, 95, 26, 45, 26;  // actuators.yaml (paper QP limits)

@@ -20,6 +20,13 @@ namespace {
 
 const std::string kGen3 = std::string(PHRI_SOURCE_DIR) + "/robots/kinova_gen3/";
 
+// The library names no end-effector frame (the Controller sets the robot's): the Gen3's here.
+phri::WholeBodyQpSettings gen3_settings() {
+  phri::WholeBodyQpSettings s;
+  s.end_effector_frame = "end_effector_link";
+  return s;
+}
+
 class WholeBodyQpTest : public ::testing::Test {
 protected:
   void SetUp() override {
@@ -29,7 +36,7 @@ protected:
   }
   // Far from every limit: large torque limits, gains that keep the bounds slack.
   phri::WholeBodyQpSettings loose_settings() const {
-    phri::WholeBodyQpSettings s;
+    phri::WholeBodyQpSettings s = gen3_settings();
     s.torque_limit = Eigen::VectorXd::Constant(7, 1e4);
     s.velocity_limit = Eigen::VectorXd::Constant(7, 100.0);
     return s;
@@ -108,7 +115,7 @@ TEST_F(WholeBodyQpTest, NullSpaceComplianceKeepsTheTaskAccelerationWhileThePostu
 }
 
 TEST_F(WholeBodyQpTest, JointDamperAndTorqueLimitsBound) {
-  phri::WholeBodyQpSettings settings;
+  phri::WholeBodyQpSettings settings = gen3_settings();
   phri::WholeBodyQp qp(model_, nullptr, settings);
   set_tasks(qp, 0.0, 0.0);
   // Joint 2 close to its upper limit and moving toward it: the bound brakes it.
@@ -139,7 +146,7 @@ TEST_F(WholeBodyQpTest, JointDamperAndTorqueLimitsBound) {
 }
 
 TEST_F(WholeBodyQpTest, InvalidInputHoldsTheLastCommandAndInfeasibleBrakes) {
-  phri::WholeBodyQp qp(model_, nullptr, phri::WholeBodyQpSettings{});
+  phri::WholeBodyQp qp(model_, nullptr, gen3_settings());
   set_tasks(qp, 0.0, 1.0);
   ASSERT_EQ(qp.update(model_, data_, q_, qd_, Eigen::VectorXd::Zero(7), 1e-3), phri::WholeBodyQpStatus::kOk);
   const Eigen::VectorXd good = qp.desired_torque();
@@ -175,7 +182,7 @@ TEST_F(WholeBodyQpTest, TheFallbackBrakeIsScaledToTheTorqueLimitsAndRealisesItsA
   phri::compute_all_terms(model_, data_, q, qd);
   Eigen::VectorXd tau_ext = Eigen::VectorXd::Zero(7);
   tau_ext[1] = data_.nonlinear_effects[1] + 27.0;  // joint 2 needs -27 of its 30 N.m just to hold
-  phri::WholeBodyQpSettings settings;  // the others: 15 N.m beyond what holds them
+  phri::WholeBodyQpSettings settings = gen3_settings();  // the others: 15 N.m beyond what holds them
   settings.torque_limit = data_.nonlinear_effects.cwiseAbs() + Eigen::VectorXd::Constant(7, 15.0);
   settings.torque_limit[1] = 30.0;
   phri::WholeBodyQp qp(model_, nullptr, settings);
@@ -198,7 +205,7 @@ TEST_F(WholeBodyQpTest, TheFallbackBrakeIsScaledToTheTorqueLimitsAndRealisesItsA
 
 TEST_F(WholeBodyQpTest, OneFullCycleDoesNotAllocate) {
   const phri::CollisionModel collision = phri::CollisionModel::from_yaml_file(kGen3 + "collision.yaml", model_);
-  phri::WholeBodyQp qp(model_, &collision, phri::WholeBodyQpSettings{});
+  phri::WholeBodyQp qp(model_, &collision, gen3_settings());
   phri::ComplianceController compliance{phri::ComplianceSettings{}};
   compliance.initialise(phri::ComplianceMode::kDual, qp, data_);
   qp.posture().set_target(q_);
@@ -228,7 +235,7 @@ TEST_F(WholeBodyQpTest, OneFullCycleDoesNotAllocate) {
 // Dual compliance's Schmitt trigger (8 N up, 4 N down): update() reports the release, once, so the
 // controller can re-anchor the posture where the hand left the arm.
 TEST_F(WholeBodyQpTest, DualComplianceReportsTheReleaseOnceAfterTheSchmittTrigger) {
-  phri::WholeBodyQp qp(model_, nullptr, phri::WholeBodyQpSettings{});
+  phri::WholeBodyQp qp(model_, nullptr, gen3_settings());
   phri::ComplianceController compliance{phri::ComplianceSettings{}};
   compliance.initialise(phri::ComplianceMode::kDual, qp, data_);
   EXPECT_FALSE(compliance.update(5.0, qp, data_));  // below the touch threshold: nothing
@@ -437,7 +444,7 @@ TEST_F(WholeBodyQpTest, NearTheOutstretchedElbowTheTaskNoLongerAsksForHugeJointA
 
 TEST_F(WholeBodyQpTest, ACycleNearTheSingularityDoesNotAllocate) {
   q_ << 0.0, 0.4, 0.0, 1e-3, 0.0, 0.9, 0.0;
-  phri::WholeBodyQp qp(model_, nullptr, phri::WholeBodyQpSettings{});
+  phri::WholeBodyQp qp(model_, nullptr, gen3_settings());
   qp.posture().set_target(q_);
   const Eigen::VectorXd tau_ext = Eigen::VectorXd::Zero(7);
   phri::compute_all_terms(model_, data_, q_, qd_);

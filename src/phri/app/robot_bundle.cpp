@@ -43,18 +43,46 @@ std::vector<std::string> names(const YamlReader& r, std::string_view key) {
   return out;
 }
 
-RigidBodyData rigid_body(const YamlReader& r) {
-  r.allow_keys({"mass_kg", "com_m", "inertia_kgm2"});
+// mass_kg, com_m (within max_com_m of the frame on each axis), inertia_kgm2 (principal moments).
+RigidBodyData rigid_body_values(const YamlReader& r, double max_com_m) {
   RigidBodyData body;
   body.mass_kg = r.number("mass_kg", 0.0, kMaxPayload_kg);
   if (!(body.mass_kg > 0.0)) throw r.error("mass_kg", "must be > 0");
-  body.com_m = r.vector3("com_m", -0.5, 0.5);
+  body.com_m = r.vector3("com_m", -max_com_m, max_com_m);
   body.principal_inertia_kgm2 = r.vector3("inertia_kgm2", 1e-9, kMaxPayloadInertia_kgm2);
   const Eigen::Vector3d& i = body.principal_inertia_kgm2;
   if (i[0] + i[1] < i[2] || i[0] + i[2] < i[1] || i[1] + i[2] < i[0]) {
     throw r.error("inertia_kgm2", "principal moments must satisfy the triangle inequality (a rigid body)");
   }
   return body;
+}
+
+RigidBodyData rigid_body(const YamlReader& r) {
+  r.allow_keys({"mass_kg", "com_m", "inertia_kgm2"});
+  return rigid_body_values(r, 0.5);
+}
+
+// `payloads`: [{name (optional), link, mass_kg, com_m, inertia_kgm2}, ...], in the link's frame. A
+// body on a link (a camera on the forearm, a valve block on the shoulder) sits within 1 m of the
+// link's frame; its mass and moments within what an arm carries (physical_ranges.hpp). Whether
+// the link exists is checked against the URDF's model (check_against_model).
+std::vector<LinkPayload> parse_payloads(const YamlReader& list) {
+  list.expect_sequence();
+  std::vector<LinkPayload> out;
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    const YamlReader p = list.at(i);
+    p.allow_keys({"name", "link", "mass_kg", "com_m", "inertia_kgm2"});
+    LinkPayload payload;
+    payload.name = p.text_or("name", "payload_" + std::to_string(i));
+    if (payload.name.empty()) throw p.error("name", "empty name");
+    for (const LinkPayload& other : out) {
+      if (other.name == payload.name) throw p.error("name", "duplicate payload name '" + payload.name + "'");
+    }
+    payload.link = p.text("link");
+    payload.body = rigid_body_values(p, 1.0);
+    out.push_back(payload);
+  }
+  return out;
 }
 
 void parse_frames(const YamlReader& f, RobotBundle& b) {
@@ -141,8 +169,8 @@ void parse_custom_loop_filter(const YamlReader& f, RobotBundle& b) {
 
 RobotBundle parse(const YamlReader& r, const std::string& folder) {
   r.allow_keys({"name", "urdf", "actuators", "collision", "frames", "locked_joints", "home_q_rad",
-                "compliance_deadband_Nm", "drive", "custom_loop_filter", "end_of_arm", "plant", "gravity_m_s2",
-                "base_placement"});
+                "compliance_deadband_Nm", "drive", "custom_loop_filter", "end_of_arm", "payloads", "plant",
+                "gravity_m_s2", "base_placement"});
   RobotBundle b;
   b.source = r.file();
   b.name = r.text("name");
@@ -157,10 +185,14 @@ RobotBundle parse(const YamlReader& r, const std::string& folder) {
   b.locked_joints = names(r, "locked_joints");
   const int dof = ActuatorTable::from_yaml_file(b.actuators_path).size();
   b.home_q_rad = r.per_joint<std::vector<double>>("home_q_rad", dof, -kMaxJointAngle_rad, kMaxJointAngle_rad);
-  b.compliance_deadband_Nm = r.per_joint<Eigen::VectorXd>("compliance_deadband_Nm", dof, 0.0, kMaxDeadband_Nm);
+  // Absent: the controller's default per drive (by `size`, or 1 % of the torque limit without one).
+  if (r.has("compliance_deadband_Nm")) {
+    b.compliance_deadband_Nm = r.per_joint<Eigen::VectorXd>("compliance_deadband_Nm", dof, 0.0, kMaxDeadband_Nm);
+  }
   b.drive = parse_drive(r.at("drive"), dof, b.generic_hold);
   if (r.has("custom_loop_filter")) parse_custom_loop_filter(r.at("custom_loop_filter"), b);
   if (r.has("end_of_arm")) b.end_of_arm = parse_end_of_arm(r.at("end_of_arm"));
+  if (r.has("payloads")) b.payloads = parse_payloads(r.at("payloads"));
   parse_plant(r.has("plant") ? r.at("plant") : YamlReader(YAML::Node(YAML::NodeType::Map), r.file(), "plant"), folder, b);
   return b;
 }
@@ -192,6 +224,13 @@ void check_against_model(const RobotBundle& b) {
   const Model& model = *loaded;
   if (!model.has_frame(b.end_effector_frame)) {
     throw ConfigError(b.source, "frames.end_effector", "no frame '" + b.end_effector_frame + "' in " + b.urdf_path);
+  }
+  for (std::size_t i = 0; i < b.payloads.size(); ++i) {
+    const std::string& link = b.payloads[i].link;
+    if (!model.has_frame(link)) {
+      throw ConfigError(b.source, "payloads[" + std::to_string(i) + "].link",
+                        "no link '" + link + "' in the arm's model (" + b.urdf_path + ")");
+    }
   }
   const ActuatorTable drives = ActuatorTable::from_yaml_file(b.actuators_path);
   for (int i = 0; i < model.nq(); ++i) {
@@ -249,6 +288,10 @@ void RobotBundle::apply_to(ControllerSettings& s) const {
   s.locked_joints = locked_joints;
   s.qp.compliance_deadband = compliance_deadband_Nm;
   s.set_end_of_arm(end_of_arm);
+  for (const LinkPayload& p : payloads) {  // after the end of arm's, which set_end_of_arm replaces
+    s.payloads.push_back(ControllerSettings::end_of_arm_payload(p.name.c_str(), p.body, 0.0));
+    s.payloads.back().frame = p.link;
+  }
   s.gravity_m_s2 = gravity_m_s2;
   s.base_placement = base_placement;
   s.custom_torque.filter_numerator = custom_loop_numerator;
@@ -266,6 +309,7 @@ void RobotBundle::apply_to(SimRobotConfig& c) const {
   if (c.initial_q_rad.size() != home_q_rad.size()) c.initial_q_rad = home_q_rad;
   c.ft_sensor.flange_site = plant.flange_site;
   c.set_end_of_arm(end_of_arm);
+  c.payloads = payloads;
   c.base_link = base_link;
   c.gravity_m_s2 = gravity_m_s2;
   c.base_placement = base_placement;

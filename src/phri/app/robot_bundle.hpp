@@ -64,6 +64,9 @@ struct RobotBundle {
   /// `end_of_arm`: the F/T sensor and the tool (becoming the controller's payloads and the
   /// plant's bodies); nullopt when the key is absent or says `none` (a bare flange).
   std::optional<EndOfArm> end_of_arm;
+  /// `payloads`: bodies fixed to links of the arm beyond its URDF and its end of arm (none by
+  /// default); the controller's model and the plant both carry them.
+  std::vector<LinkPayload> payloads;
 
   struct Plant {
     std::string mjcf_path;  ///< hand-written arm MJCF; '' : generated from the URDF

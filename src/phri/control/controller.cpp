@@ -70,8 +70,8 @@ WholeBodyQpSettings Controller::qp_settings(const ControllerSettings& settings, 
   if (qp.compliance_deadband.size() == 0) {
     qp.compliance_deadband.resize(actuators.size());
     for (int i = 0; i < actuators.size(); ++i) {
-      qp.compliance_deadband[i] = actuators[i].size == ActuatorSize::kLarge ? settings.deadband_large_Nm
-                                                                            : settings.deadband_small_Nm;
+      qp.compliance_deadband[i] =
+          actuators[i].default_compliance_deadband_Nm(settings.deadband_large_Nm, settings.deadband_small_Nm);
     }
   }
   if (qp.velocity_limit.size() == 0) {

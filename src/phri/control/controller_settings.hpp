@@ -152,7 +152,8 @@ struct ControllerSettings {
   bool position_mode_open_loop = false;
   WholeBodyQpSettings qp;  ///< torque/velocity limits default to actuators.yaml's
   /// Dead band of tau_ext in the compliant tasks when qp.compliance_deadband is empty, by actuator
-  /// size [N.m]: above the estimate's bias (5 % mismatch, sensor offsets), far below a push.
+  /// size [N.m]: above the estimate's bias (5 % mismatch, sensor offsets), far below a push. An
+  /// actuator without `size` gets 1 % of its torque limit instead (robot/actuator_parameters.hpp).
   double deadband_large_Nm = 1.0;
   double deadband_small_Nm = 0.4;
   ComplianceSettings compliance;

@@ -10,6 +10,8 @@
 namespace phri {
 WholeBodyQp::Limits WholeBodyQp::checked_limits(const Model& model, const WholeBodyQpSettings& settings) {
   auto fail = [](const std::string& key, const std::string& reason) { throw ConfigError("WholeBodyQpSettings", key, reason); };
+  // No default names an arm's frame: the Controller sets the robot's (ControllerSettings::end_effector_frame).
+  if (settings.end_effector_frame.empty()) fail("end_effector_frame", "empty: name the end-effector task's frame");
   Limits limits{settings.torque_limit.size() ? settings.torque_limit : model.effort_limits(),
                 settings.velocity_limit.size() ? settings.velocity_limit : model.velocity_limits()};
   if (limits.torque.size() != model.nv()) fail("torque_limit", "needs one value per joint");

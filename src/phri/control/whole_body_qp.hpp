@@ -39,7 +39,9 @@
 namespace phri {
 
 struct WholeBodyQpSettings {
-  std::string end_effector_frame = "end_effector_link";
+  /// The end-effector task's frame: no default, every arm names its own (the Controller sets it
+  /// from ControllerSettings::end_effector_frame, i.e. the robot bundle's frames.end_effector).
+  std::string end_effector_frame;
   Eigen::VectorXd torque_limit;    ///< |tau_d| bound per joint (N.m); empty: the URDF effort limits
   Eigen::VectorXd velocity_limit;  ///< per joint (rad/s), before the fraction; empty: URDF limits
   double velocity_limit_fraction = 0.9;  ///< paper: 0.9 of the robot's limits

@@ -132,6 +132,7 @@ struct DashboardServer::Impl {
     e.push_max_N = s.push_max_N;
     e.touch_threshold = controller.settings().compliance.touch_threshold;
     e.release_threshold = controller.settings().compliance.release_threshold;
+    e.end_effector_frame = controller.settings().end_effector_frame;
     return e;
   }
 

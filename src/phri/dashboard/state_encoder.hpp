@@ -25,7 +25,8 @@ struct StateEncoderSettings {
   double push_max_N = 100.0;
   double touch_threshold = 8.0;    ///< dual compliance, drawn on the wrench plot
   double release_threshold = 4.0;
-  std::string end_effector_frame = "end_effector_link";
+  /// The arm's end-effector frame: no default (the dashboard server sets the controller's).
+  std::string end_effector_frame;
 };
 
 class StateEncoder {

@@ -3,15 +3,27 @@
 // read from robots/<robot>/actuators.yaml by phri::ActuatorTable. Joint side unless stated.
 #include <phri/robot/friction_parameters.hpp>
 
+#include <optional>
 #include <string>
 
 namespace phri {
 
+/// Kinova's two actuator classes (the Gen3's joints 1-4 and 5-7); actuators.yaml's optional `size`.
 enum class ActuatorSize { kLarge, kSmall };
+
+/// What `size` selects when an actuators.yaml leaves it out, derived from the drive's own data:
+/// - the compliance dead band: kDeadbandPerTorqueLimit x torque_limit_Nm (the Gen3's drives would
+///   get 0.95 N.m on joints 1-4, 0.26 / 0.45 N.m on 5-7, against the 1.0 / 0.4 their sizes give);
+/// - the class of a Kinova drive's emulated loops (the plant's vendor gains): large when the drive
+///   can produce at least kLargeActuatorMinTorque_Nm (current_limit_A x K_T x G_r; the Gen3's
+///   large 105 N.m, small 52 N.m), small below.
+inline constexpr double kDeadbandPerTorqueLimit = 0.01;
+inline constexpr double kLargeActuatorMinTorque_Nm = 75.0;
 
 struct ActuatorParameters {
   std::string joint_name;
-  ActuatorSize size = ActuatorSize::kLarge;
+  /// actuators.yaml's `size` when stated (a Kinova actuator); nullopt: derived where needed (above).
+  std::optional<ActuatorSize> size;
   double gear_ratio = 1.0;                ///< G_r, motor turns per joint turn
   double torque_constant_Nm_per_A = 0.0;  ///< K_T, motor side
   double rotor_inertia_kgm2 = 0.0;        ///< I_r, motor side
@@ -27,6 +39,17 @@ struct ActuatorParameters {
   double torque_per_amp() const { return torque_constant_Nm_per_A * gear_ratio; }
   /// Largest joint torque the motor can produce, K_T G_r i_max [N.m].
   double max_motor_torque_Nm() const { return current_limit_A * torque_per_amp(); }
+  /// The Kinova class: `size` when stated, else by the drive's maximum torque (kLargeActuatorMinTorque_Nm).
+  ActuatorSize size_class() const {
+    if (size) return *size;
+    return max_motor_torque_Nm() >= kLargeActuatorMinTorque_Nm ? ActuatorSize::kLarge : ActuatorSize::kSmall;
+  }
+  /// The compliance dead band by default [N.m]: by `size` when stated (large_Nm, small_Nm), else
+  /// kDeadbandPerTorqueLimit x torque_limit_Nm.
+  double default_compliance_deadband_Nm(double large_Nm, double small_Nm) const {
+    if (size) return *size == ActuatorSize::kLarge ? large_Nm : small_Nm;
+    return kDeadbandPerTorqueLimit * torque_limit_Nm;
+  }
 };
 
 }  // namespace phri

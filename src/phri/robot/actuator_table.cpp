@@ -65,7 +65,9 @@ ActuatorParameters parse_joint(const YamlReader& j) {
                 "current_limit_A", "torque_limit_Nm", "velocity_limit_rad_s", "transmission_stiffness_Nm_per_rad", "friction"});
   ActuatorParameters a;
   a.joint_name = j.text("name");
-  a.size = j.choice("size", {"large", "small"}) == "large" ? ActuatorSize::kLarge : ActuatorSize::kSmall;
+  // Optional: Kinova's actuator class. Absent, what it selects is derived from the drive's own data
+  // (ActuatorParameters::size_class, default_compliance_deadband_Nm).
+  if (j.has("size")) a.size = j.choice("size", {"large", "small"}) == "large" ? ActuatorSize::kLarge : ActuatorSize::kSmall;
   a.gear_ratio = j.number("gear_ratio", kMinGearRatio, kMaxGearRatio);
   a.torque_constant_Nm_per_A = j.number("torque_constant_Nm_per_A", kMinTorqueConstant, kMaxTorqueConstant);
   a.rotor_inertia_kgm2 = j.number("rotor_inertia_kgm2", 0.0, kMaxRotorInertia);

@@ -7,6 +7,8 @@
 // (ControllerSettings::set_end_of_arm), the plant as bodies (SimRobotConfig::set_end_of_arm).
 #include <Eigen/Core>
 
+#include <string>
+
 namespace phri {
 
 /// A rigid body given by its mass, centre of mass and principal moments of inertia about it.
@@ -23,6 +25,15 @@ struct EndOfArm {
   double sensor_offset_m = 0.0;  ///< flange -> F/T measuring frame, along the flange's z axis [m]
   RigidBodyData flange_side;     ///< adapter + sensor body, COM in the flange frame (not measured by the sensor)
   RigidBodyData tool;            ///< below the sensor, COM in the sensor frame
+};
+
+/// A rigid body fixed to a link of the arm that its URDF does not carry (a robot bundle's
+/// `payloads`: a camera, a cable reel, a valve block): the controller's model merges it into that
+/// link's body (ModelOptions::payloads), the plant welds it into the link's body.
+struct LinkPayload {
+  std::string name;
+  std::string link;    ///< the URDF link it is fixed to (a frame of the model, a body of the plant)
+  RigidBodyData body;  ///< mass, COM and principal moments about the COM, in the link's frame
 };
 
 }  // namespace phri

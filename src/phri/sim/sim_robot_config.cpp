@@ -388,14 +388,15 @@ SimRobotConfig SimRobotConfig::from_yaml_string(const std::string& yaml, const s
   return parse(YamlReader::load_string(yaml, source_name), base_dir);
 }
 
-// Defaults of the vendor loops by actuator size; see KinovaDriveEmulator and
+// Defaults of the vendor loops by actuator size (an actuator without `size`: by its maximum torque,
+// ActuatorParameters::size_class); see KinovaDriveEmulator and
 // robots/kinova_gen3/README.md ("Simulated plant") for why these values.
 void SimRobotConfig::fill_defaults() {
   auto& v = vendor;
   const int n = actuators.size();
   auto fill = [&](std::vector<double>& out, double large, double small) {
     if (!out.empty()) return;
-    for (int i = 0; i < n; ++i) out.push_back(actuators[i].size == ActuatorSize::kLarge ? large : small);
+    for (int i = 0; i < n; ++i) out.push_back(actuators[i].size_class() == ActuatorSize::kLarge ? large : small);
   };
   fill(v.position_kp_Nm_per_rad, 12000.0, 3000.0);
   fill(v.position_kd_Nms_per_rad, 150.0, 15.0);

@@ -160,6 +160,11 @@ struct SimRobotConfig {
   std::optional<EndOfArm> end_of_arm() const;
   void set_end_of_arm(const std::optional<EndOfArm>& end_of_arm);
 
+  /// Bodies welded into links of the arm (a robot bundle's `payloads`), each a child body of the
+  /// link's body with its inertial; none by default. A link that is no body of the arm's MJCF is
+  /// a ConfigError at "payloads[i].link".
+  std::vector<LinkPayload> payloads;
+
   // ---- link inertial and drive-gain mismatch relative to the URDF and actuators.yaml
   struct Mismatch {
     bool enabled = false;

@@ -9,6 +9,9 @@
 #include <algorithm>
 #include <fstream>
 #include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
 
 namespace phri {
 namespace {
@@ -198,6 +201,33 @@ void insert_before_end_tag(std::string& xml, const std::string& element, const s
   xml.insert(end, text);
 }
 
+// The bodies a robot bundle's `payloads` fix to links: each a child body of its link's body, at the
+// link's frame, with the payload's inertial (no geometry, no contact). Links that are no body of
+// the arm, and names the arm already uses, are refused naming the payload.
+std::vector<std::pair<std::string, std::string>> payload_bodies(const SimRobotConfig& config) {
+  std::vector<std::pair<std::string, std::string>> out;  // (link, MJCF text)
+  if (config.payloads.empty()) return out;
+  const MjModelPtr arm = load_arm(config);
+  for (std::size_t i = 0; i < config.payloads.size(); ++i) {
+    const LinkPayload& p = config.payloads[i];
+    const std::string key = "payloads[" + std::to_string(i) + "]";
+    if (mj_name2id(arm.get(), mjOBJ_BODY, p.link.c_str()) < 0) {
+      throw ConfigError(config.source, key + ".link", "no body '" + p.link + "' in the arm's plant (" + config.arm_file() + ")");
+    }
+    const std::string name = std::string(SimScene::kPayloadBodyPrefix) + p.name;
+    if (mj_name2id(arm.get(), mjOBJ_BODY, name.c_str()) >= 0) {
+      throw ConfigError(config.source, key + ".name", "body name '" + name + "' already used by the arm's plant");
+    }
+    if (!(p.body.mass_kg > 0.0) || !(p.body.principal_inertia_kgm2.array() > 0.0).all() || !p.body.com_m.allFinite()) {
+      throw ConfigError(config.source, key, "needs a mass > 0, principal moments > 0 and a finite COM");
+    }
+    out.emplace_back(p.link, "\n<!-- phri simulator scene: payload '" + p.name + "' on " + p.link + " -->\n<body name=\"" + name +
+                                 "\">\n  <inertial pos=\"" + vec(p.body.com_m) + "\" mass=\"" + num(p.body.mass_kg) +
+                                 "\" diaginertia=\"" + vec(p.body.principal_inertia_kgm2) + "\"/>\n</body>\n");
+  }
+  return out;
+}
+
 }  // namespace
 
 std::string SimScene::build_mjcf(const SimRobotConfig& config) {
@@ -208,6 +238,7 @@ std::string SimScene::build_mjcf(const SimRobotConfig& config) {
     const FlangeMount mount = find_flange_mount(config);
     insert_into_body(xml, mount.body, config.has_ft_sensor ? tool_chain_mjcf(config, mount) : bare_tool_mjcf(config, mount), file);
   }
+  for (const auto& [link, body] : payload_bodies(config)) insert_into_body(xml, link, body, file);
   insert_before_end_tag(xml, "worldbody", world_additions_mjcf(config), file);
   if (config.ft_sensor_present()) insert_before_end_tag(xml, "mujoco", ft_sensors_mjcf(), file);
   return xml;

@@ -27,6 +27,8 @@ namespace phri {
 struct SimScene {
   static constexpr const char* kAdapterBody = "ft_adapter";
   static constexpr const char* kToolBody = "tool";
+  /// A robot bundle's payload is the body kPayloadBodyPrefix + its name, a child of its link's body.
+  static constexpr const char* kPayloadBodyPrefix = "payload_";
   static constexpr const char* kSensorSite = "ft_sensor";
   static constexpr const char* kForceSensor = "ft_force";
   static constexpr const char* kTorqueSensor = "ft_torque";
