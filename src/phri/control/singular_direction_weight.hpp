@@ -23,9 +23,9 @@
 // nothing steps when eigenvectors swap. When every sigma_i >= sigma_0 the weight is the identity
 // and the task is exactly the paper's (W is then not even formed: update() says false).
 //
-// The test is cheap: lambda_min(J J^T) >= 1 / trace((J J^T)^-1) (the trace sums 1/lambda_i), read
-// off a 6 x 6 Cholesky factor; only when that bound falls below sigma_0^2 (or J J^T is singular)
-// is the eigen-decomposition computed. Fixed-size, no allocation.
+// The test is cheap: every sigma_i >= sigma_0 exactly when J J^T - sigma_0^2 I has a Cholesky
+// factor (6 x 6); only when it has none is the eigen-decomposition computed. Fixed-size, no
+// allocation.
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
 #include <Eigen/Eigenvalues>
@@ -49,13 +49,12 @@ public:
     if (sigma0_ <= 0.0) return false;
     jjt_.noalias() = jacobian * jacobian.transpose();
     const double threshold = sigma0_ * sigma0_;
-    llt_.compute(jjt_);
-    if (llt_.info() == Eigen::Success) {
-      inverse_factor_.setIdentity();
-      llt_.matrixL().solveInPlace(inverse_factor_);  // L^-1: trace((L L^T)^-1) = ||L^-1||_F^2
-      const double trace_inverse = inverse_factor_.squaredNorm();
-      if (trace_inverse > 0.0 && 1.0 / trace_inverse >= threshold) return false;
-    }
+    // Every sigma_i >= sigma_0 exactly when J J^T - sigma_0^2 I is positive definite (Sylvester):
+    // a 6 x 6 Cholesky decides it; the eigen-decomposition only runs when some sigma_i is below.
+    shifted_ = jjt_;
+    shifted_.diagonal().array() -= threshold;
+    llt_.compute(shifted_);
+    if (llt_.info() == Eigen::Success) return false;
     eigen_.compute(jjt_);
     const Eigen::Matrix<double, 6, 1>& lambda = eigen_.eigenvalues();
     if (lambda.minCoeff() >= threshold) return false;
@@ -77,7 +76,7 @@ private:
   bool active_ = false;
   double smallest_singular_value_ = 0.0;
   Matrix6d jjt_ = Matrix6d::Zero();
-  Matrix6d inverse_factor_ = Matrix6d::Identity();
+  Matrix6d shifted_ = Matrix6d::Zero();
   Matrix6d weight_ = Matrix6d::Identity();
   Eigen::Matrix<double, 6, 1> factor_ = Eigen::Matrix<double, 6, 1>::Ones();
   Eigen::LLT<Matrix6d> llt_{6};
