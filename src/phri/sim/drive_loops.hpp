@@ -11,6 +11,7 @@
 #include <Eigen/Core>
 
 #include <algorithm>
+#include <vector>
 
 namespace phri {
 
@@ -23,6 +24,14 @@ inline void follow_set_point(const Eigen::VectorXd& q_new, double period_s, cons
     qd_ff[i] = std::clamp(v, -velocity_limit[i], velocity_limit[i]);
   }
   q_des = q_new;
+}
+
+/// A per-joint gain list from the configuration as an n-vector, zero where the list is short
+/// (construction only: it allocates).
+inline Eigen::VectorXd per_joint_or_zero(const std::vector<double>& values, int n) {
+  Eigen::VectorXd out = Eigen::VectorXd::Zero(n);
+  for (int i = 0; i < n && i < static_cast<int>(values.size()); ++i) out[i] = values[static_cast<std::size_t>(i)];
+  return out;
 }
 
 class DriveLoops {

@@ -10,11 +10,6 @@ GenericDrive::GenericDrive(const ActuatorTable& drives, const std::vector<double
                            double control_period_s)
     : control_period_s_(control_period_s) {
   const int n = drives.size();
-  auto vec = [n](const std::vector<double>& v) {
-    Eigen::VectorXd out = Eigen::VectorXd::Zero(n);
-    for (int i = 0; i < n && i < static_cast<int>(v.size()); ++i) out[i] = v[static_cast<std::size_t>(i)];
-    return out;
-  };
   torque_per_amp_.resize(n);
   current_limit_.resize(n);
   torque_limit_.resize(n);
@@ -25,8 +20,8 @@ GenericDrive::GenericDrive(const ActuatorTable& drives, const std::vector<double
     torque_limit_[i] = drives[i].torque_limit_Nm;
     velocity_limit_[i] = drives[i].velocity_limit_rad_s;
   }
-  kp_ = vec(kp);
-  kd_ = vec(kd);
+  kp_ = per_joint_or_zero(kp, n);
+  kd_ = per_joint_or_zero(kd, n);
   q_des_ = Eigen::VectorXd::Zero(n);
   qd_des_ = Eigen::VectorXd::Zero(n);
   hold_torque_ = Eigen::VectorXd::Zero(n);

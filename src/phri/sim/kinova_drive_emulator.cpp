@@ -8,11 +8,6 @@ KinovaDriveEmulator::KinovaDriveEmulator(const ActuatorTable& drives, const SimR
                                          double tick_s, double control_period_s)
     : tick_s_(tick_s), control_period_s_(control_period_s) {
   const int n = drives.size();
-  auto vec = [n](const std::vector<double>& v) {
-    Eigen::VectorXd out = Eigen::VectorXd::Zero(n);
-    for (int i = 0; i < n && i < static_cast<int>(v.size()); ++i) out[i] = v[static_cast<std::size_t>(i)];
-    return out;
-  };
   torque_per_amp_.resize(n);
   current_limit_.resize(n);
   velocity_limit_.resize(n);
@@ -21,12 +16,12 @@ KinovaDriveEmulator::KinovaDriveEmulator(const ActuatorTable& drives, const SimR
     current_limit_[i] = drives[i].current_limit_A;
     velocity_limit_[i] = drives[i].velocity_limit_rad_s;
   }
-  kp_ = vec(vendor.position_kp_Nm_per_rad);
-  kd_ = vec(vendor.position_kd_Nms_per_rad);
-  ki_ = vec(vendor.position_ki_Nm_per_rad_s);
-  integral_limit_ = vec(vendor.position_integral_limit_Nm);
-  kt_ = vec(vendor.torque_feedback_gain);
-  damping_ = vec(vendor.torque_velocity_damping_Nms_per_rad);
+  kp_ = per_joint_or_zero(vendor.position_kp_Nm_per_rad, n);
+  kd_ = per_joint_or_zero(vendor.position_kd_Nms_per_rad, n);
+  ki_ = per_joint_or_zero(vendor.position_ki_Nm_per_rad_s, n);
+  integral_limit_ = per_joint_or_zero(vendor.position_integral_limit_Nm, n);
+  kt_ = per_joint_or_zero(vendor.torque_feedback_gain, n);
+  damping_ = per_joint_or_zero(vendor.torque_velocity_damping_Nms_per_rad, n);
   const DiscreteTransferFunction filter(vendor.high_velocity_numerator, vendor.high_velocity_denominator);
   filters_.assign(static_cast<std::size_t>(n), filter);
   q_des_ = Eigen::VectorXd::Zero(n);
