@@ -155,6 +155,50 @@ TEST_F(CustomLoop, BumplessEntryAndNoAllocation) {
   EXPECT_LT(max_change, 0.05);  // A: the integrator leaks the entry offset away, no jump
 }
 
+// A joint at rest that the previous loop held against static friction: the entry keeps the
+// present current (the integrator carries the gap), but once the joint slides, the friction share
+// of that gap leaves the integrator: the friction compensation supplies it from then on. (Carried
+// on with the integrator's 1 s leak, it added to the compensation and ran a joint of the safety
+// fuzz's warm-up away at 1.25 rad/s, seed 20261127.)
+TEST_F(CustomLoop, FrictionHoldAtEntryIsNotCarriedIntoSliding) {
+  const phri::CustomTorqueSettings settings;
+  const double leak = std::exp(-settings.integral_leak * settings.period_s);
+  const double input = settings.integral_gain * (1.0 - leak) / settings.integral_leak;
+  Eigen::VectorXd load(7), hold(7), current_now(7), tau_s(7);
+  load << 3.0, -20.0, 1.5, 8.0, -0.4, 1.2, 0.05;
+  tau_s = load + Eigen::VectorXd::Constant(7, 0.1);  // a sensor offset: not friction
+  for (int i = 0; i < 7; ++i) {
+    // Joints 1-6 held within the friction band; joint 7 beyond it (a drive constant off).
+    const double share = i == 6 ? 3.0 : (i % 2 == 0 ? 0.9 : -0.9);
+    hold[i] = share * table_[i].friction.static_Nm;
+    current_now[i] = (tau_s[i] + hold[i]) / table_[i].torque_per_amp();
+  }
+  phri::CustomTorqueController loop(table_, settings);
+  loop.reset(current_now, load, zero_, tau_s, zero_);
+  EXPECT_LT((loop.current() - current_now).cwiseAbs().maxCoeff(), 1e-12);  // no current step
+  // The entry hold: the gap less what the sensor sees, at most the static friction level (it
+  // differs from `hold` by H(z)'s and the integrator's first outputs on the 0.1 N.m error).
+  const Eigen::VectorXd hold0 = loop.entry_hold(), integral0 = loop.integral_term();
+  for (int i = 0; i < 6; ++i) EXPECT_NEAR(hold0[i], hold[i], 0.02) << "joint " << i + 1;
+  EXPECT_DOUBLE_EQ(hold0[6], table_[6].friction.static_Nm);
+  // At rest nothing changes: the hold is a share of the integrator and leaks with it.
+  phri::CustomTorqueController at_rest(table_, settings);
+  at_rest.reset(current_now, load, zero_, tau_s, zero_);
+  for (int k = 0; k < 250; ++k) at_rest.update(load, zero_, tau_s, zero_);
+  for (int i = 0; i < 7; ++i) EXPECT_NEAR(at_rest.entry_hold()[i], hold0[i] * std::pow(leak, 250), 1e-12);
+  // Sliding from the next sample on: the integrator drops the hold, so the command is
+  // tau_d + friction model + H(z) + the integrator without the friction share.
+  const Eigen::VectorXd qd = Eigen::VectorXd::Constant(7, -0.3);
+  loop.update(load, zero_, tau_s, qd);
+  for (int i = 0; i < 7; ++i) {
+    const auto& f = table_[i].friction;
+    const double integral = leak * (integral0[i] - hold0[i]) + input * (load[i] - tau_s[i]);
+    const double expected = load[i] + (-f.coulomb_Nm - 0.3 * f.viscous_Nms_per_rad) + loop.filter_term()[i] + integral;
+    EXPECT_NEAR(loop.torque_command()[i], expected, 1e-12) << "joint " << i + 1;
+    EXPECT_EQ(loop.entry_hold()[i], 0.0);
+  }
+}
+
 TEST_F(CustomLoop, RejectsBadSettingsNamingTheKey) {
   using phri::test::expect_config_error;
   phri::CustomTorqueSettings s;

@@ -29,6 +29,8 @@
 namespace phri {
 namespace {
 
+constexpr double kFirstPushSettleMax_s = 2.0;  // the longest wait for a still arm before the first push
+
 // MuJoCo's XML compiler keeps global state in some versions: plants are built one at a time.
 // Everything after construction (mj_step on a plant's own mjData) runs in parallel.
 std::mutex& plant_construction_mutex() {
@@ -223,6 +225,18 @@ public:
     return classify(m, s_.o.thresholds).violations == 0 && !m.safe_stop;
   }
 
+  // Before the first push: on until the arm is still (as between pushes), for at most max_s, so
+  // that the held pose the pushes are judged against is not a pose the arm was passing through.
+  // No cycle at all when it already is (the usual case). The checks go into m, as in warm_up(),
+  // and the same verdict comes back.
+  bool settle(WindowMetrics& m, double max_s) {
+    const long n = std::lround(max_s / s_.dt);
+    for (long k = 0; k < n && speed_ >= s_.o.thresholds.settle_speed_rad_s; ++k) step(m);
+    m.safe_stop = cycle_.supervisor().safe_stop();
+    m.safe_stop_rest_time_s = m.safe_stop ? -1.0 : 0.0;
+    return classify(m, s_.o.thresholds).violations == 0 && !m.safe_stop;
+  }
+
   // Every later cycle as one CSV row (a replay's --trace); appends when `append`.
   void trace_to(const std::string& path, bool append) {
     trace_.open(path, append ? std::ios::app : std::ios::trunc);
@@ -383,7 +397,7 @@ void push_run(const Shared& s, const std::string& id, ComplianceMode mode, LowLe
       Rig rig(s, mode, loop, seed, FaultSpec{});
       ++out.rigs;
       if (!s.o.trace_path.empty()) rig.trace_to(s.o.trace_path, rebuild > 0);
-      if (!rig.warm_up(r.metrics)) {
+      if (!rig.warm_up(r.metrics) || !rig.settle(r.metrics, kFirstPushSettleMax_s)) {
         r.verdict = classify(r.metrics, s.o.thresholds);
         r.safe_stop_reason = rig.safe_stop_reason();
         out.records.push_back(r);

@@ -4,7 +4,8 @@
 //
 // The arm holds the paper demo's posture [0, 0.58, 3.14, -1.84, 0, 0.85, 1.57] (the plant starts
 // there) with the controller's targets fixed; each run starts in the position loop, switches to the
-// loop under test after position_phase_s and settles for settle_s. Then:
+// loop under test after position_phase_s and settles for settle_s (the pushes: and, when the arm
+// still moves, until it is still, for at most 2 s more). Then:
 //
 // 1. Pushes, on every compliance mode (stiff, null_space, full_body, dual) x low-level loop
 //    (position, kinova_torque, kinova_torque_high_velocity, custom) pair: `pushes` random pushes

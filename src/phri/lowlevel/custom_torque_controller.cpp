@@ -6,7 +6,6 @@
 #include <cmath>
 
 namespace phri {
-
 CustomTorqueController::CustomTorqueController(const ActuatorTable& actuators, const CustomTorqueSettings& settings)
     : actuators_(actuators.joints()), settings_(settings) {
   auto fail = [](const std::string& key, const std::string& reason) {
@@ -31,7 +30,7 @@ CustomTorqueController::CustomTorqueController(const ActuatorTable& actuators, c
   input_factor_ = settings.integral_gain * (1.0 - leak_factor_) / settings.integral_leak;
   integral_limit_.resize(n);
   for (int i = 0; i < n; ++i) integral_limit_[i] = settings.integral_limit_fraction * actuators_[static_cast<std::size_t>(i)].torque_limit_Nm;
-  friction_ = rotor_ = filtered_ = integral_ = tau_command_ = current_ = Eigen::VectorXd::Zero(n);
+  friction_ = rotor_ = filtered_ = integral_ = tau_command_ = current_ = entry_hold_ = Eigen::VectorXd::Zero(n);
   cases_.assign(static_cast<std::size_t>(n), FrictionCase::kNone);
 }
 
@@ -40,18 +39,24 @@ void CustomTorqueController::reset(const Eigen::VectorXd& current_now, const Eig
                                    const Eigen::VectorXd& qd) {
   for (auto& f : filters_) f.reset();
   integral_.setZero();
+  entry_hold_.setZero();
   update(tau_desired, qdd_desired, tau_sensor, qd);
-  // Put the difference to the present current into the integrator (clamped), and restart H(z)
-  // so that this first period's filter output is accounted for.
+  // The integrator takes the difference to the present current, so that this first current is
+  // the present one; the share of it that friction explains is remembered as the entry hold.
   for (int i = 0; i < dof(); ++i) {
     const ActuatorParameters& a = actuators_[static_cast<std::size_t>(i)];
+    const double limit = a.max_motor_torque_Nm();
     // The whole gap, even beyond the integrator's clamp: it leaks away with time constant 1/theta.
     const double gap = current_now[i] * a.torque_per_amp() - tau_command_[i];
-    integral_[i] = std::clamp(gap, -a.max_motor_torque_Nm(), a.max_motor_torque_Nm());
+    integral_[i] = std::clamp(gap, -limit, limit);
+    // Spent between motor and sensor (what the sensor does not see), up to the static friction
+    // level: beyond it, a drive constant off its nominal value or a load the model misses.
+    const double friction = a.friction.static_Nm;
+    entry_hold_[i] = std::clamp(integral_[i] - (tau_sensor[i] - tau_desired[i]), -friction, friction);
     tau_command_[i] += integral_[i];
     current_[i] = std::clamp(tau_command_[i] / a.torque_per_amp(), -a.current_limit_A, a.current_limit_A);
   }
-  // The integrator's state carries the offset from here on; the filters keep their first sample.
+  // The filters keep their first sample; the integrator carries the offset.
 }
 
 const Eigen::VectorXd& CustomTorqueController::update(const Eigen::VectorXd& tau_desired,
@@ -67,6 +72,12 @@ const Eigen::VectorXd& CustomTorqueController::update(const Eigen::VectorXd& tau
     cases_[j] = which;
     rotor_[i] = settings_.rotor_inertia_compensation ? a.reflected_inertia_kgm2 * qdd_desired[i] : 0.0;
     filtered_[i] = settings_.transfer_gain * filters_[j].step(error);
+    // The joint slides: the friction compensation now supplies what the entry's friction hold did.
+    if (which == FrictionCase::kSliding && entry_hold_[i] != 0.0) {
+      integral_[i] -= entry_hold_[i];
+      entry_hold_[i] = 0.0;
+    }
+    entry_hold_[i] *= leak_factor_;  // a share of the integrator: it leaks with it
     const double without_integral = tau_desired[i] + rotor_[i] + friction_[i] + filtered_[i];
     // Leaky integrator, with anti-windup: no integration pushing further into saturation.
     // Above the clamp only after a bumpless entry (reset): then the integral may only leak down.

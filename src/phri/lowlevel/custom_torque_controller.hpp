@@ -20,7 +20,12 @@
 //
 // Entering the loop from another mode is bumpless: reset() starts H(z) at rest and sets the
 // integrator so that the first current equals the current the drive was carrying (even beyond the
-// integrator's clamp: that entry offset then only leaks away, with time constant 1 / theta).
+// integrator's clamp: that entry offset then only leaks away, with time constant 1 / theta). Part
+// of that offset is torque spent between motor and sensor, up to the static friction level: at
+// rest, the friction the previous loop was pushing against (the entry hold). When the joint starts
+// to slide, the friction compensation supplies that torque, so the entry hold leaves the
+// integrator then; carried on, it added to the compensation and drove the joint on (1.25 rad/s on
+// a joint nobody touched, seed 20261127 of the safety fuzz).
 #include <phri/core/discrete_transfer_function.hpp>
 #include <phri/lowlevel/friction_compensation.hpp>
 #include <phri/robot/actuator_table.hpp>
@@ -66,6 +71,8 @@ public:
   const Eigen::VectorXd& rotor_term() const { return rotor_; }
   const Eigen::VectorXd& filter_term() const { return filtered_; }
   const Eigen::VectorXd& integral_term() const { return integral_; }
+  /// What is left of the entry's motor-to-sensor share (see the header comment) [N.m].
+  const Eigen::VectorXd& entry_hold() const { return entry_hold_; }
   const Eigen::VectorXd& torque_command() const { return tau_command_; }
   const std::vector<FrictionCase>& friction_cases() const { return cases_; }
   /// Joints whose current saturated in the last update.
@@ -80,6 +87,7 @@ private:
   double input_factor_ = 0.0;  // K_I (1 - a) / theta
   Eigen::VectorXd integral_limit_;
   Eigen::VectorXd friction_, rotor_, filtered_, integral_, tau_command_, current_;
+  Eigen::VectorXd entry_hold_;  // the integrator's share that friction explains (see the header) [N.m]
   std::vector<FrictionCase> cases_;
   int saturated_ = 0;
 };
