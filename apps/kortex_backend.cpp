@@ -51,9 +51,10 @@ std::string health_line(const phri::KortexRobot& robot) {
 // The emulated arm over the simulated plant; the F/T fields come from the plant's sensor.
 class EmulatedArm final : public KortexBackend {
 public:
-  EmulatedArm(const phri::Config& config, const phri::Model& model, bool dry_run)
+  EmulatedArm(const phri::Config& config, const phri::Model& model, const KortexArguments& args)
       : plant_(config.plant), arm_(plant_, plant_.state()) {
-    phri::KortexRobotSettings settings = robot_settings(config, model, dry_run);
+    if (!args.emulate_fault.empty()) arm_.schedule(phri::ScheduledKortexFault::parse(args.emulate_fault, "--emulate-fault"));
+    phri::KortexRobotSettings settings = robot_settings(config, model, args.dry_run);
     settings.wrench_source = [this](phri::RobotState& s) {
       s.wrench_sensor = arm_.plant_state().wrench_sensor;
       s.wrench = arm_.plant_state().wrench;
@@ -64,6 +65,7 @@ public:
   std::string report() const override {
     const phri::KortexEmulator::Counters& c = arm_.counters();
     return health_line(*robot_) + "; emulator: " + std::to_string(c.commands_applied) + " commands applied, " +
+           std::to_string(c.lost_packets) + " packets lost, " + std::to_string(c.stalls) + " stalls, " +
            std::to_string(c.watchdog_trips) + " watchdog trips, " + std::to_string(c.following_errors) + " following errors";
   }
 
@@ -111,6 +113,10 @@ void check_kortex_arguments(const KortexArguments& args) {
   const bool kortex = args.backend == "kortex" || args.backend == "kortex-emulator";
   if (!kortex && args.dry_run) throw phri::ConfigError("--dry-run", "", "needs --backend kortex or kortex-emulator");
   if (args.backend != "kortex" && !args.ft_serial.empty()) throw phri::ConfigError("--ft-serial", "", "needs --backend kortex");
+  if (!args.emulate_fault.empty()) {
+    if (args.backend != "kortex-emulator") throw phri::ConfigError("--emulate-fault", "", "needs --backend kortex-emulator");
+    phri::ScheduledKortexFault::parse(args.emulate_fault, "--emulate-fault");  // a bad spec fails before anything starts
+  }
 #ifndef PHRI_HAVE_KORTEX_SDK
   if (args.backend == "kortex") {
     throw phri::ConfigError("--backend kortex", "",
@@ -123,7 +129,7 @@ void check_kortex_arguments(const KortexArguments& args) {
 std::unique_ptr<KortexBackend> make_kortex_backend(const KortexArguments& args, const phri::Config& config,
                                                    const phri::Model& model) {
   check_kortex_arguments(args);
-  if (args.backend == "kortex-emulator") return std::make_unique<EmulatedArm>(config, model, args.dry_run);
+  if (args.backend == "kortex-emulator") return std::make_unique<EmulatedArm>(config, model, args);
 #ifdef PHRI_HAVE_KORTEX_SDK
   if (args.backend == "kortex") return std::make_unique<RealArm>(args, config, model);
 #endif

@@ -20,6 +20,7 @@ struct KortexArguments {
   std::string ip = "192.168.1.10";
   std::string ft_serial;        ///< Bota SensONE device; empty: no F/T sensor on the real arm
   bool dry_run = false;
+  std::string emulate_fault;    ///< kortex-emulator: a scheduled link fault (ScheduledKortexFault::parse)
 };
 
 /// The arm of a run with its link and sensors, kept alive together; robot() is what the loop drives.

@@ -299,6 +299,9 @@ CLI::App* add_run_command(CLI::App& app, RunArguments& args) {
       ->check(CLI::IsMember({"sim", "kortex", "kortex-emulator"}))->capture_default_str();
   run->add_option("--ip", args.kortex.ip, "the arm's address (--backend kortex; TCP 10000, UDP 10001)")->capture_default_str();
   run->add_option("--ft-serial", args.kortex.ft_serial, "the Bota SensONE's serial device (--backend kortex)");
+  run->add_option("--emulate-fault", args.kortex.emulate_fault,
+                  "--backend kortex-emulator: a link fault the emulated arm injects at robot time T: packet-loss:P@T, "
+                  "stall:MS@T or drop-session@T (e.g. packet-loss:0.01@3.5)");
   run->add_flag("--dry-run", args.kortex.dry_run, "connect and read the arm, print its state; no torque is ever sent "
                 "(the actuators hold the measured pose in position mode)");
   auto* dashboard = run->add_flag("--dashboard", args.dashboard.enabled,

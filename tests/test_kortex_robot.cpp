@@ -6,6 +6,7 @@
 // switch sequence and its way back, current = tau / (K_T G_r), fault and warning bits, the
 // watchdog and the session timeout, the start-up refusals (one line each), communication loss
 // and the allocation-free cycle.
+#include <phri/core/error.hpp>
 #include <phri/hardware/kortex_emulator.hpp>
 #include <phri/hardware/kortex_robot.hpp>
 #include <phri/hardware/kortex_units.hpp>
@@ -448,6 +449,56 @@ TEST(KortexRobot, CommunicationLossHoldsThePoseInPositionAndStopsTorque) {
       EXPECT_EQ(robot.command().actuators[0].position_deg, robot.feedback().actuators[0].position_deg);
     }
   }
+}
+
+// A degraded link: isolated losses are ridden through (each one stale sample for the supervisor),
+// but more than 0.5 % of a second's Refresh calls failing stops torque like a lost link, with the
+// count in the logged line. Losses one at a time (never two in a row, never 5 ms of silence).
+TEST(KortexRobot, SustainedPacketLossStopsTorqueButIsolatedLossesDoNot) {
+  auto lose_every = [](Rig& rig, KortexRobot& robot, int period, int cycles) {
+    for (int k = 1; k <= cycles && !robot.health().link_lost; ++k) {
+      rig.arm.set_packet_loss(k % period == 0 ? 1.0 : 0.0, 7);
+      robot.write(rig.torque(0.3));
+      robot.read();
+    }
+  };
+  std::FILE* log = std::tmpfile();
+  phri::KortexRobotSettings settings = gen3_like();
+  settings.log = log;
+  Rig rig;
+  KortexRobot& robot = rig.start(settings);
+  robot.read();
+  // One loss every 250 cycles for 5 s: 4 a second, within the budget of 5.
+  lose_every(rig, robot, 250, 5000);
+  EXPECT_FALSE(robot.health().link_lost);
+  EXPECT_EQ(robot.health().failed_refreshes, 20u);
+  EXPECT_EQ(robot.health().most_losses_in_window, 4);
+  EXPECT_EQ(rig.arm.control_mode(0), kortex::ControlMode::kTorque);
+  // One every 100 cycles (1 %): the sixth within a second stops, 500 cycles on at the latest.
+  lose_every(rig, robot, 100, 1000);
+  EXPECT_TRUE(robot.health().link_lost);
+  EXPECT_EQ(robot.health().losses_in_window, 6);
+  EXPECT_EQ(robot.health().longest_failure_run, 1);
+  EXPECT_TRUE(robot.state().fault);
+  EXPECT_EQ(rig.arm.control_mode(0), kortex::ControlMode::kPosition);
+  for (const kortex::ActuatorCommand& a : robot.command().actuators) EXPECT_EQ(a.torque_joint_Nm, 0.0f);
+  std::rewind(log);
+  char text[512] = {};
+  const std::string logged(text, std::fread(text, 1, sizeof text - 1, log));
+  std::fclose(log);
+  EXPECT_NE(logged.find("communication lost at t = "), std::string::npos) << logged;
+  EXPECT_NE(logged.find("packet loss: 6 of the last 1000 Refresh failed, more than 0.5 %"), std::string::npos) << logged;
+  EXPECT_EQ(std::count(logged.begin(), logged.end(), '\n'), 1);
+}
+
+TEST(KortexRobot, LossBudgetSettingsAreChecked) {
+  Rig rig;
+  phri::KortexRobotSettings s = gen3_like();
+  s.max_loss_fraction = 1.0;
+  EXPECT_THROW(rig.start(s), phri::ConfigError);
+  s = gen3_like();
+  s.loss_window_s = 0.0;
+  EXPECT_THROW(rig.start(s), phri::ConfigError);
 }
 
 TEST(KortexRobot, DryRunNeverLeavesPosition) {

@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <exception>
+#include <string>
 
 namespace phri {
 namespace {
@@ -176,6 +178,15 @@ CallStatus KortexEmulator::refresh_feedback(kortex::CyclicFeedback& feedback) no
 
 CallStatus KortexEmulator::refresh(const kortex::CyclicCommand& command, kortex::CyclicFeedback& feedback) noexcept {
   ++counters_.refreshes;
+  if (scheduled_.kind != ScheduledKortexFault::Kind::kNone && plant_state_->time_s >= scheduled_.at_s - 1e-9) {
+    switch (scheduled_.kind) {
+      case ScheduledKortexFault::Kind::kPacketLoss: settings_.packet_loss_probability = scheduled_.value; break;
+      case ScheduledKortexFault::Kind::kStall: stall_next_refresh(scheduled_.value); break;
+      case ScheduledKortexFault::Kind::kDroppedSession: drop_session(); break;
+      case ScheduledKortexFault::Kind::kNone: break;
+    }
+    scheduled_.kind = ScheduledKortexFault::Kind::kNone;
+  }
   if (stall_periods_ > 0) {
     ++counters_.stalls;
     for (long k = stall_periods_; k > 0; --k) step(false);
@@ -305,6 +316,49 @@ void KortexEmulator::fill(kortex::CyclicFeedback& feedback) const {
     a.warning_bank_a = warning_a_[index(i)];
     a.warning_bank_b = 0;
   }
+}
+
+}  // namespace phri
+
+namespace phri {
+
+ScheduledKortexFault ScheduledKortexFault::parse(const std::string& text, const std::string& option) {
+  const std::string usage = "packet-loss:P@T (0 < P <= 1), stall:MS@T (1 to 1000 ms) or drop-session@T (T >= 0 s)";
+  auto number = [&](const std::string& s) {
+    std::size_t used = 0;
+    double v = 0.0;
+    try {
+      v = std::stod(s, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used == 0 || used != s.size() || !std::isfinite(v)) throw ConfigError(option, text, "expected " + usage);
+    return v;
+  };
+  const std::size_t at = text.rfind('@');
+  if (at == std::string::npos) throw ConfigError(option, text, "expected " + usage);
+  ScheduledKortexFault f;
+  f.at_s = number(text.substr(at + 1));
+  const std::string head = text.substr(0, at);
+  const std::size_t colon = head.find(':');
+  const std::string kind = head.substr(0, colon);
+  const bool has_value = colon != std::string::npos;
+  if (kind == "packet-loss" && has_value) {
+    f.kind = Kind::kPacketLoss;
+    f.value = number(head.substr(colon + 1));
+    if (!(f.value > 0.0 && f.value <= 1.0)) throw ConfigError(option, text, "the loss probability must be in (0, 1]");
+  } else if (kind == "stall" && has_value) {
+    f.kind = Kind::kStall;
+    const double ms = number(head.substr(colon + 1));
+    if (!(ms >= 1.0 && ms <= 1000.0)) throw ConfigError(option, text, "the stall must be 1 to 1000 ms");
+    f.value = 1e-3 * ms;
+  } else if (kind == "drop-session" && !has_value) {
+    f.kind = Kind::kDroppedSession;
+  } else {
+    throw ConfigError(option, text, "expected " + usage);
+  }
+  if (!(f.at_s >= 0.0 && f.at_s <= 3600.0)) throw ConfigError(option, text, "the time must be 0 to 3600 s");
+  return f;
 }
 
 }  // namespace phri

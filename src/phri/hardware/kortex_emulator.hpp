@@ -33,6 +33,7 @@
 
 #include <cstdint>
 #include <random>
+#include <string>
 #include <vector>
 
 namespace phri {
@@ -44,6 +45,19 @@ struct KortexEmulatorSettings {
   double packet_loss_probability = 0.0;  ///< each Refresh lost with this probability
   std::uint64_t seed = 1;                ///< of the packet loss draws
   std::size_t call_capacity = 1 << 16;   ///< calls recorded at most
+};
+
+/// A communication fault the emulator injects by itself once its plant's clock reaches at_s
+/// (`phri run --backend kortex-emulator --emulate-fault`).
+struct ScheduledKortexFault {
+  enum class Kind { kNone, kPacketLoss, kStall, kDroppedSession };
+  Kind kind = Kind::kNone;
+  double value = 0.0;  ///< kPacketLoss: the probability; kStall: the stall [s]
+  double at_s = 0.0;   ///< plant time [s]
+
+  /// "packet-loss:P@T" (0 < P <= 1), "stall:MS@T" (1..1000 ms) or "drop-session@T" (T >= 0 s);
+  /// a ConfigError naming `option` otherwise.
+  static ScheduledKortexFault parse(const std::string& text, const std::string& option);
 };
 
 class KortexEmulator final : public KortexClient {
@@ -86,6 +100,8 @@ public:
 
   // ---- fault injection
   void set_packet_loss(double probability, std::uint64_t seed);
+  /// One fault injected by the emulator itself at its time (replaces any earlier schedule).
+  void schedule(const ScheduledKortexFault& fault) { scheduled_ = fault; }
   /// The next Refresh takes `seconds` of plant time (the arm on its last command), then times out.
   void stall_next_refresh(double seconds) { stall_periods_ = periods(seconds); }
   /// The arm closes the sessions (as on a network drop); calls fail with INVALID_SESSION.
@@ -138,6 +154,7 @@ private:
   std::vector<std::uint32_t> fault_a_, warning_a_;
   kortex::ServoingMode servoing_ = kortex::ServoingMode::kSingleLevel;
   bool sessions_open_ = false, estop_ = false, holding_ = false;
+  ScheduledKortexFault scheduled_;
   kortex::SessionSettings session_;
   double last_command_s_ = 0.0, last_activity_s_ = 0.0;
   long stall_periods_ = 0;

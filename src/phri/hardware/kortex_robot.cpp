@@ -46,6 +46,9 @@ KortexRobot::KortexRobot(KortexClient& client, KortexRobotSettings settings)
     bank->assign(static_cast<std::size_t>(n_), 0u);
   }
   state_ = RobotState(n_);
+  const long window = std::max(1L, std::lround(settings_.loss_window_s / settings_.period_s));
+  loss_ring_.assign(static_cast<std::size_t>(window), 0u);
+  max_losses_ = static_cast<int>(std::floor(settings_.max_loss_fraction * static_cast<double>(window) + 1e-9));
   start_up();
 }
 
@@ -63,6 +66,12 @@ void KortexRobot::check_settings() const {
   }
   if (settings_.max_failed_refreshes < 1) throw ConfigError(subject, "max_failed_refreshes", "must be at least 1");
   if (!(settings_.max_silence_s > 0.0)) throw ConfigError(subject, "max_silence_s", "must be positive");
+  if (!(settings_.max_loss_fraction >= 0.0 && settings_.max_loss_fraction < 1.0)) {
+    throw ConfigError(subject, "max_loss_fraction", "must be in [0, 1)");
+  }
+  if (!(settings_.loss_window_s >= settings_.period_s && settings_.loss_window_s <= 60.0)) {
+    throw ConfigError(subject, "loss_window_s", "must be between one period and 60 s");
+  }
 }
 
 // kortex_lowlevel.md section 5 (Kinova's example 108, ros2_kortex): sessions, single level,
@@ -162,7 +171,7 @@ void KortexRobot::shutdown() noexcept {
 
 const RobotState& KortexRobot::read() {
   if (!health_.link_lost && requested_mode_ != active_mode_) {
-    if (!switch_control_mode(requested_mode_)) enter_link_loss();
+    if (!switch_control_mode(requested_mode_)) enter_link_loss("a control mode switch was refused");
   }
   frame_id_ = kortex::next_frame_id(frame_id_);
   command_.frame_id = frame_id_;
@@ -176,6 +185,7 @@ const RobotState& KortexRobot::read() {
   } else {
     note_failure(status);
   }
+  note_outcome(!status.ok());
   ++state_.cycle;
   state_.time_s = client_.clock_s() - clock_start_s_;
   state_.mode = active_low_level_;
@@ -262,15 +272,34 @@ void KortexRobot::note_failure(kortex::CallStatus status) noexcept {
   health_.last_failure = status;
   if (health_.link_lost) return;
   const double silence = client_.clock_s() - last_good_s_;
-  if (health_.consecutive_failures >= settings_.max_failed_refreshes || silence >= settings_.max_silence_s - 1e-9) {
-    enter_link_loss();
+  if (health_.consecutive_failures >= settings_.max_failed_refreshes) {
+    std::snprintf(reason_, sizeof reason_, "%d failed Refresh in a row, last: sub-code %u", health_.consecutive_failures,
+                  health_.last_failure.sub_code);
+    enter_link_loss(reason_);
+  } else if (silence >= settings_.max_silence_s - 1e-9) {
+    std::snprintf(reason_, sizeof reason_, "no good feedback for %.1f ms, last: sub-code %u", 1e3 * silence,
+                  health_.last_failure.sub_code);
+    enter_link_loss(reason_);
   }
+}
+
+// The loss rate over the last loss_window_s (a ring of outcomes, allocated at construction).
+void KortexRobot::note_outcome(bool lost) noexcept {
+  const std::uint8_t now = lost ? 1u : 0u;
+  health_.losses_in_window += static_cast<int>(now) - static_cast<int>(loss_ring_[loss_next_]);
+  loss_ring_[loss_next_] = now;
+  loss_next_ = (loss_next_ + 1) % loss_ring_.size();
+  health_.most_losses_in_window = std::max(health_.most_losses_in_window, health_.losses_in_window);
+  if (health_.link_lost || health_.losses_in_window <= max_losses_) return;
+  std::snprintf(reason_, sizeof reason_, "packet loss: %d of the last %zu Refresh failed, more than %.1f %%",
+                health_.losses_in_window, loss_ring_.size(), 100.0 * settings_.max_loss_fraction);
+  enter_link_loss(reason_);
 }
 
 // kortex_lowlevel.md section 6: with the link gone, a torque set-point must not stay in force;
 // the actuators' position loop holds the last measured pose (and the arm's watchdog brakes it if
 // nothing arrives at all).
-void KortexRobot::enter_link_loss() noexcept {
+void KortexRobot::enter_link_loss(const char* why) noexcept {
   health_.link_lost = true;
   health_.link_lost_at_s = client_.clock_s() - clock_start_s_;
   hold_measured_pose();
@@ -278,9 +307,9 @@ void KortexRobot::enter_link_loss() noexcept {
   active_mode_ = requested_mode_ = kortex::ControlMode::kPosition;
   active_low_level_ = requested_low_level_ = LowLevelMode::kPosition;
   std::snprintf(line_, sizeof line_,
-                "phri: kortex: communication lost at t = %.3f s (%d failed Refresh in a row, last: sub-code %u); "
+                "phri: kortex: communication lost at t = %.3f s (%s); "
                 "actuators back to POSITION holding the measured pose, torque commands stopped\n",
-                health_.link_lost_at_s, health_.consecutive_failures, health_.last_failure.sub_code);
+                health_.link_lost_at_s, why);
   log_line(line_);
 }
 

@@ -35,8 +35,10 @@
 // (the supervisor's robot_fault: a safe stop); the banks and warnings are in health(). A write
 // while the arm is in fault, or after the link was lost, is refused (kFault).
 //
-// Communication loss: `max_failed_refreshes` failed Refresh calls in a row, or none good for
-// `max_silence_s`, and the robot stops commanding torque for good: every actuator back to
+// Communication loss: `max_failed_refreshes` failed Refresh calls in a row, none good for
+// `max_silence_s`, or more than `max_loss_fraction` of the Refresh calls of the last
+// `loss_window_s` failed (a degraded link: at 1 kHz each loss leaves the arm on a 2 ms old
+// set-point; 1 % is ten a second), and the robot stops commanding torque for good: every actuator back to
 // POSITION holding the last measured pose (the arm's own position hold; it keeps being sent if
 // the link comes back), RobotState::fault set, one line written to `log`. Without a link at all
 // the arm's watchdog brakes it.
@@ -70,8 +72,12 @@ struct KortexRobotSettings {
   kortex::SessionSettings session;
   /// Communication loss: this many failed Refresh calls in a row...
   int max_failed_refreshes = 3;
-  /// ...or no good feedback for this long [s].
+  /// ...or no good feedback for this long [s]...
   double max_silence_s = 0.005;
+  /// ...or more than this fraction of the Refresh calls of the last loss_window_s failed (0: any
+  /// loss). 0.5 % of a second's 1000 is 5: the sixth loss within a second stops.
+  double max_loss_fraction = 0.005;
+  double loss_window_s = 1.0;  ///< [s], at least one period
   bool dry_run = false;
   /// Where the one line on a communication loss or an arm fault goes (null: nowhere).
   std::FILE* log = stderr;
@@ -90,6 +96,7 @@ struct KortexHealth {
   double link_lost_at_s = 0.0;
   std::uint64_t refreshes = 0, failed_refreshes = 0, mode_switches = 0, failed_mode_switches = 0;
   int consecutive_failures = 0, longest_failure_run = 0;
+  int losses_in_window = 0, most_losses_in_window = 0;  ///< failed Refresh calls in the last loss_window_s
   kortex::CallStatus last_failure;
 };
 
@@ -129,7 +136,8 @@ private:
   bool switch_control_mode(kortex::ControlMode mode) noexcept;
   void publish_feedback() noexcept;
   void note_failure(kortex::CallStatus status) noexcept;
-  void enter_link_loss() noexcept;
+  void note_outcome(bool lost) noexcept;
+  void enter_link_loss(const char* why) noexcept;
   void hold_measured_pose() noexcept;
   void update_health() noexcept;
   void log_line(const char* text) noexcept;
@@ -153,7 +161,11 @@ private:
   bool fault_logged_ = false;
   RobotState state_;
   KortexHealth health_;
-  char line_[256] = {};
+  std::vector<std::uint8_t> loss_ring_;  // 1: that Refresh failed; the last loss_window_s of them
+  std::size_t loss_next_ = 0;
+  int max_losses_ = 0;                    // in the window; one more is a degraded link
+  char line_[320] = {};
+  char reason_[128] = {};
 };
 
 }  // namespace phri
