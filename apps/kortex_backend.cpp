@@ -40,11 +40,12 @@ std::string health_line(const phri::KortexRobot& robot) {
   const phri::KortexHealth& h = robot.health();
   char line[320];
   std::snprintf(line, sizeof line,
-                "kortex: %llu Refresh, %llu failed (longest run %d), %llu mode switches (%llu failed); arm %s%s%s",
+                "kortex: %llu Refresh, %llu failed (longest run %d), %llu mode switches (%llu failed); arm %s%s%s%s",
                 static_cast<unsigned long long>(h.refreshes), static_cast<unsigned long long>(h.failed_refreshes),
                 h.longest_failure_run, static_cast<unsigned long long>(h.mode_switches),
                 static_cast<unsigned long long>(h.failed_mode_switches), std::string(phri::kortex::to_string(h.arm_state)).c_str(),
-                h.arm_fault ? ", FAULT" : "", h.link_lost ? ", LINK LOST (position hold)" : "");
+                h.arm_fault ? ", FAULT" : "", h.link_lost ? ", LINK LOST (position hold)" : "",
+                h.link_degraded ? ", LINK DEGRADED (safe stop)" : "");
   return line;
 }
 

@@ -452,8 +452,9 @@ TEST(KortexRobot, CommunicationLossHoldsThePoseInPositionAndStopsTorque) {
 }
 
 // A degraded link: isolated losses are ridden through (each one stale sample for the supervisor),
-// but more than 0.5 % of a second's Refresh calls failing stops torque like a lost link, with the
-// count in the logged line. Losses one at a time (never two in a row, never 5 ms of silence).
+// but more than 0.5 % of the last 5 s of Refresh calls failing asks for a safe stop, with the count
+// in the logged line: the link still carries the brake, then the position hold, and from that hold
+// on torque is refused. Losses one at a time (never two in a row, never 5 ms of silence).
 TEST(KortexRobot, SustainedPacketLossStopsTorqueButIsolatedLossesDoNot) {
   auto lose_every = [](Rig& rig, KortexRobot& robot, int period, int cycles) {
     for (int k = 1; k <= cycles && !robot.health().link_lost; ++k) {
@@ -468,26 +469,45 @@ TEST(KortexRobot, SustainedPacketLossStopsTorqueButIsolatedLossesDoNot) {
   Rig rig;
   KortexRobot& robot = rig.start(settings);
   robot.read();
-  // One loss every 250 cycles for 5 s: 4 a second, within the budget of 5.
-  lose_every(rig, robot, 250, 5000);
+  // One loss every 200 cycles for 10 s: 25 in any 5 s, the budget.
+  lose_every(rig, robot, 200, 10000);
   EXPECT_FALSE(robot.health().link_lost);
-  EXPECT_EQ(robot.health().failed_refreshes, 20u);
-  EXPECT_EQ(robot.health().most_losses_in_window, 4);
+  EXPECT_EQ(robot.health().failed_refreshes, 50u);
+  EXPECT_EQ(robot.health().most_losses_in_window, 25);
   EXPECT_EQ(rig.arm.control_mode(0), kortex::ControlMode::kTorque);
-  // One every 100 cycles (1 %): the sixth within a second stops, 500 cycles on at the latest.
-  lose_every(rig, robot, 100, 1000);
-  EXPECT_TRUE(robot.health().link_lost);
-  EXPECT_EQ(robot.health().losses_in_window, 6);
+  // One every 100 cycles (1 %): the 26th within 5 s asks to stop, 2.5 s on at the latest.
+  for (int k = 1; k <= 5000 && !robot.health().link_degraded; ++k) {
+    rig.arm.set_packet_loss(k % 100 == 0 ? 1.0 : 0.0, 7);
+    robot.write(rig.torque(0.3));
+    robot.read();
+  }
+  rig.arm.set_packet_loss(0.0, 7);
+  EXPECT_TRUE(robot.health().link_degraded);
+  EXPECT_FALSE(robot.health().link_lost);
+  EXPECT_EQ(robot.health().losses_in_window, 26);
   EXPECT_EQ(robot.health().longest_failure_run, 1);
-  EXPECT_TRUE(robot.state().fault);
+  EXPECT_TRUE(robot.state().stop_requested);
+  EXPECT_FALSE(robot.state().fault);  // the samples stay good: the brake runs on them
+  // The brake (torque) still reaches the arm...
+  EXPECT_EQ(robot.write(rig.torque(0.2)), phri::WriteStatus::kOk);
+  robot.read();
+  EXPECT_EQ(rig.arm.control_mode(0), kortex::ControlMode::kTorque);
+  EXPECT_FLOAT_EQ(rig.arm.last_command().actuators[0].torque_joint_Nm, 0.2f);
+  // ...then the position hold; after it, torque is refused.
+  phri::RobotCommand hold(7);
+  hold.mode = phri::LowLevelMode::kPosition;
+  hold.q_rad = robot.state().q_rad;
+  EXPECT_EQ(robot.write(hold), phri::WriteStatus::kOk);
+  robot.read();
   EXPECT_EQ(rig.arm.control_mode(0), kortex::ControlMode::kPosition);
-  for (const kortex::ActuatorCommand& a : robot.command().actuators) EXPECT_EQ(a.torque_joint_Nm, 0.0f);
+  EXPECT_EQ(robot.write(rig.torque(0.3)), phri::WriteStatus::kFault);
+  EXPECT_TRUE(robot.state().stop_requested);
   std::rewind(log);
   char text[512] = {};
   const std::string logged(text, std::fread(text, 1, sizeof text - 1, log));
   std::fclose(log);
-  EXPECT_NE(logged.find("communication lost at t = "), std::string::npos) << logged;
-  EXPECT_NE(logged.find("packet loss: 6 of the last 1000 Refresh failed, more than 0.5 %"), std::string::npos) << logged;
+  EXPECT_NE(logged.find("link degraded at t = "), std::string::npos) << logged;
+  EXPECT_NE(logged.find("packet loss: 26 of the last 5000 Refresh failed, more than 0.5 %"), std::string::npos) << logged;
   EXPECT_EQ(std::count(logged.begin(), logged.end(), '\n'), 1);
 }
 

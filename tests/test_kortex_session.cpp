@@ -6,7 +6,8 @@
 // rounds every value to float degrees, N.m and A). Then communication faults in the custom loop:
 // 1 % packet loss, one 5 ms stall, a dropped session; each is met without a jump in the motor
 // torque the plant applies and ends in a logged safe stop (the controller's safe hold, the
-// actuators in their position hold).
+// actuators in their position hold; after packet loss the controller's brake first, the link
+// still carrying it).
 #include <phri/app/config.hpp>
 #include <phri/app/fsm.hpp>
 #include <phri/app/run_session.hpp>
@@ -23,6 +24,7 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
+#include <map>
 #include <memory>
 #include <sstream>
 #include <string>
@@ -194,27 +196,32 @@ TEST(KortexSession, DemoThroughTheEmulatorGivesTheSimulatorsPerPhaseTable) {
 // The motor torque the plant applies, its largest cycle-to-cycle step (any joint) from the fault
 // on, against the same window of the same session without the fault: the actuators' own position
 // hold takes over with no kick beyond what the session itself does (the elbow pushes at 4 s).
-void expect_no_torque_jump(const Outcome& o) {
-  static const double fault_free = run_demo(Path::kKortex, kFaultAt_s + 1.5).step_after;
+void expect_no_torque_jump(const Outcome& o, double duration_s = kFaultAt_s + 1.5) {
+  static std::map<double, double> fault_free_by_duration;
+  if (!fault_free_by_duration.contains(duration_s)) {
+    fault_free_by_duration[duration_s] = run_demo(Path::kKortex, duration_s).step_after;
+  }
+  const double fault_free = fault_free_by_duration[duration_s];
   std::printf("largest motor torque step: %.3f N.m in the second before %.1f s; after it %.3f N.m with the fault, %.3f N.m "
               "without\n", o.step_before, kFaultAt_s, o.step_after, fault_free);
   EXPECT_LT(o.step_after, 1.2 * fault_free + 0.5);
 }
 
 TEST(KortexSession, PacketLossOfOnePercentEndsInALoggedSafeStopWithoutATorqueJump) {
-  const Outcome o = run_demo(Path::kKortex, kFaultAt_s + 1.5, Fault::kPacketLoss);
+  const Outcome o = run_demo(Path::kKortex, kFaultAt_s + 4.0, Fault::kPacketLoss);
   std::printf("%s1 %% packet loss: %llu lost, longest run %d; %ld held cycles, %llu degraded spells; safe hold: %s %s\n",
               o.logged.c_str(), static_cast<unsigned long long>(o.emulator.lost_packets), o.health.longest_failure_run,
               o.summary.held_cycles, static_cast<unsigned long long>(o.summary.degraded_spells),
               o.summary.safe_hold ? "yes" : "no", o.summary.safe_hold_reason.c_str());
   EXPECT_GT(o.emulator.lost_packets, 5u);
-  EXPECT_TRUE(o.health.link_lost);
-  EXPECT_EQ(o.health.losses_in_window, 6);  // the sixth loss within a second
+  EXPECT_TRUE(o.health.link_degraded);
+  EXPECT_FALSE(o.health.link_lost);
+  EXPECT_GE(o.health.most_losses_in_window, 26);  // the 26th loss within 5 s
   EXPECT_TRUE(o.summary.safe_hold);
-  EXPECT_NE(o.printed.find("robot_fault"), std::string::npos) << o.printed;
-  EXPECT_NE(o.logged.find("packet loss: 6 of the last 1000 Refresh failed"), std::string::npos) << o.logged;
+  EXPECT_NE(o.printed.find("robot_stop_request"), std::string::npos) << o.printed;
+  EXPECT_NE(o.logged.find("packet loss: 26 of the last 5000 Refresh failed"), std::string::npos) << o.logged;
   EXPECT_EQ(o.emulator.watchdog_trips, 0u);  // the arm's own position hold, not its watchdog
-  expect_no_torque_jump(o);
+  expect_no_torque_jump(o, kFaultAt_s + 4.0);
 }
 
 TEST(KortexSession, StallOfFiveMillisecondsEndsInALoggedSafeStop) {

@@ -346,6 +346,40 @@ TEST(Safety, ASafeStopAfterTheQpFailedUnderAPushKeepsResistingIt) {
   }
 }
 
+// A robot that still obeys but asks for a safe stop (RobotState::stop_requested: the Kortex
+// backend's degraded link) while a push moves the arm: the stop is logged as robot_stop_request,
+// the samples stay good, and the brake blends in from the last command over
+// requested_stop_blend_s instead of stepping to it (13.6 N.m on the demo through the emulator).
+TEST(Safety, ARequestedStopBrakesWithoutATorqueStep) {
+  struct Outcome {
+    double largest_step = 0.0, speed_at_request = 0.0;
+  };
+  auto run = [](double blend_s) {
+    Rig rig(phri::ComplianceMode::kNullSpace, phri::LowLevelMode::kCurrent,
+            {hand_push("forearm_link", Eigen::Vector3d::Zero(), Eigen::Vector3d(0, 30, 0), 0.6, 1.0)},
+            [blend_s](phri::ControllerSettings& s) { s.safety.requested_stop_blend_s = blend_s; });
+    Outcome o;
+    Eigen::VectorXd previous = rig.robot_.truth().tau_motor_Nm;
+    rig.run(2.5, [](long k, phri::RobotState& s) { s.stop_requested = k >= 1000; }, [&]() {
+      const Eigen::VectorXd& tau = rig.robot_.truth().tau_motor_Nm;
+      if (rig.cycle_count_ == 1000) o.speed_at_request = rig.qd().cwiseAbs().maxCoeff();
+      if (rig.cycle_count_ >= 1000) o.largest_step = std::max(o.largest_step, (tau - previous).cwiseAbs().maxCoeff());
+      previous = tau;
+    });
+    EXPECT_EQ(rig.cycle_.status(), phri::CycleStatus::kSafeStop);
+    EXPECT_EQ(rig.cycle_.supervisor().safe_stop_transition().reason, phri::SafetyFault::kRobotStopRequest);
+    EXPECT_TRUE(rig.cycle_.holding());
+    EXPECT_LT(rig.qd().cwiseAbs().maxCoeff(), 0.01);
+    EXPECT_LT(rig.speed_ratio_, 1.0);
+    return o;
+  };
+  const Outcome blended = run(0.05), stepped = run(0.0);
+  std::printf("stop requested at %.2f rad/s: largest motor torque step %.2f N.m blended, %.2f N.m without the blend\n",
+              blended.speed_at_request, blended.largest_step, stepped.largest_step);
+  EXPECT_GT(blended.speed_at_request, 0.1);  // the arm was moving
+  EXPECT_LT(blended.largest_step, 0.5 * stepped.largest_step);
+}
+
 // Defect 6: with NaN on q2 for 2.5 s, the torque loops repeated the last torque or current command
 // for the whole time and the arm moved 5-6 rad. Now: a brake, then the robot's position hold,
 // which also resists a push meanwhile.

@@ -49,6 +49,8 @@ void bind_state(py::module_& m) {
       .def_readwrite("current", &RobotState::current)
       .def_readwrite("wrench", &RobotState::wrench)
       .def_readwrite("fault", &RobotState::fault, "The robot stopped obeying commands.")
+      .def_readwrite("stop_requested", &RobotState::stop_requested,
+                     "The robot still obeys but asks for a safe stop (a degraded link).")
       .def_readwrite("last_write_status", &RobotState::last_write_status)
       .def_readwrite("rejected_writes", &RobotState::rejected_writes);
 }

@@ -119,6 +119,7 @@ const ControllerSettings& checked(const ControllerSettings& settings) {
   }
   const SafetySettings& safety = settings.safety;
   if (!(safety.max_qp_fallback_s >= 0 && safety.brake_rate > 0 && safety.handover_speed_rad_s > 0 &&
+        safety.requested_stop_blend_s >= 0 && safety.requested_stop_blend_s <= 1.0 &&
         safety.max_brake_s > 0 && safety.velocity_guard_fraction > 0 && safety.velocity_guard_fraction <= 1.5 &&
         safety.velocity_guard_rate >= 0 && safety.limit_guard_stiffness_Nm_per_rad >= 0 &&
         safety.collision_guard_stiffness_N_per_m >= 0 && safety.collision_guard_damping_Ns_per_m >= 0 &&
@@ -215,6 +216,7 @@ Controller::Controller(LoadedRobot robot, const ControllerSettings& settings)
       brake_q_(Eigen::VectorXd::Zero(model_.nv())),
       brake_qd_(Eigen::VectorXd::Zero(model_.nv())),
       brake_tau_(Eigen::VectorXd::Zero(model_.nv())),
+      stop_entry_tau_(Eigen::VectorXd::Zero(model_.nv())),
       guarded_tau_(Eigen::VectorXd::Zero(model_.nv())),
       limit_lower_(supervisor_.ranges().q_lower),
       limit_upper_(supervisor_.ranges().q_upper),
@@ -359,6 +361,7 @@ void Controller::safe_stop(bool sample_good, RobotCommand& command) {
     brake_against_push_ = !holding_ && supervisor_.safe_stop_transition().reason == SafetyFault::kQpFailure;
     hold_q_ = supervisor_.has_good() ? good.q_rad : q_;
     hold_qd_.setZero();
+    stop_entry_tau_ = guarded_tau_;
     // In the position loop the reference brakes from where it is (kept within the following
     // error of the measured pose, LowLevelController): a jump to the measured pose, or a reference
     // stopped dead, is a step of kd x qd in the servo's torque (33 N.m with the arm at 0.8 rad/s).
@@ -395,6 +398,11 @@ void Controller::safe_stop(bool sample_good, RobotCommand& command) {
     const double push = brake_against_push_ ? tau_ext_[i] : 0.0;
     const double reach = std::max(torque_limit_[i], kDriveReach * drive_torque_[i]);
     brake_tau_[i] = std::clamp(data_.nonlinear_effects[i] - push + damping, -reach, reach);
+  }
+  // A stop the robot asked for: blended in from the last command (the emergencies brake at once).
+  if (supervisor_.safe_stop_transition().reason == SafetyFault::kRobotStopRequest && s.requested_stop_blend_s > 0.0) {
+    const double share = std::min(1.0, static_cast<double>(safe_stop_cycles_) * settings_.period_s / s.requested_stop_blend_s);
+    brake_tau_ = share * brake_tau_ + (1.0 - share) * stop_entry_tau_;
   }
   low_level_.command_torque(brake_tau_, command);
 }

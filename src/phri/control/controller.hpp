@@ -170,7 +170,9 @@ private:
   bool holding_ = false;
   bool brake_against_push_ = false;  // the safe stop's brake resists tau_ext (after a QP failure)
   Eigen::VectorXd hold_q_, hold_qd_;  // the safe stop's held reference, braking to rest (position loop)
-  Eigen::VectorXd brake_q_, brake_qd_, brake_tau_, guarded_tau_;
+  Eigen::VectorXd brake_q_, brake_qd_, brake_tau_;
+  Eigen::VectorXd stop_entry_tau_;  // the last torque command before the safe stop
+  Eigen::VectorXd guarded_tau_;
   Eigen::VectorXd limit_lower_, limit_upper_;       // URDF limits (±inf: continuous)
   Eigen::VectorXd torque_limit_, drive_velocity_limit_, reflected_inertia_, static_friction_;
   Eigen::VectorXd drive_torque_;  // the drives' peak motor torque

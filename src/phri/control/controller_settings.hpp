@@ -55,6 +55,10 @@ struct SafetySettings {
   double handover_speed_rad_s = 0.02;
   /// [s] longest brake before the hand-over, whatever the speed.
   double max_brake_s = 1.0;
+  /// [s] a stop the robot asks for while it still obeys (RobotState::stop_requested: a degraded
+  /// link) is no emergency: the brake blends in from the last torque command over this time, with
+  /// no step in the motor torque (a 0.6 rad/s joint met the full brake with a 13.6 N.m step).
+  double requested_stop_blend_s = 0.05;
   /// Velocity guard of the torque loops, the last line behind the QP's velocity constraint: above
   /// guard_fraction x the drive's velocity limit, damping rate x (M_ii + I_r) x the excess, scaled
   /// down where coupled joints would ring (torque_guards.hpp).

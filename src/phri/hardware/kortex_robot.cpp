@@ -290,10 +290,22 @@ void KortexRobot::note_outcome(bool lost) noexcept {
   loss_ring_[loss_next_] = now;
   loss_next_ = (loss_next_ + 1) % loss_ring_.size();
   health_.most_losses_in_window = std::max(health_.most_losses_in_window, health_.losses_in_window);
-  if (health_.link_lost || health_.losses_in_window <= max_losses_) return;
+  if (health_.link_lost || health_.link_degraded || health_.losses_in_window <= max_losses_) return;
   std::snprintf(reason_, sizeof reason_, "packet loss: %d of the last %zu Refresh failed, more than %.1f %%",
                 health_.losses_in_window, loss_ring_.size(), 100.0 * settings_.max_loss_fraction);
-  enter_link_loss(reason_);
+  request_stop(reason_);
+}
+
+// The link still carries commands: the controller's safe stop brakes, then holds (see the header).
+void KortexRobot::request_stop(const char* why) noexcept {
+  health_.link_degraded = true;
+  health_.link_degraded_at_s = client_.clock_s() - clock_start_s_;
+  state_.stop_requested = true;
+  std::snprintf(line_, sizeof line_,
+                "phri: kortex: link degraded at t = %.3f s (%s); safe stop requested: the controller brakes, then the "
+                "arm's position hold, torque commands refused from then on\n",
+                health_.link_degraded_at_s, why);
+  log_line(line_);
 }
 
 // kortex_lowlevel.md section 6: with the link gone, a torque set-point must not stay in force;
@@ -336,6 +348,7 @@ WriteStatus KortexRobot::validate(const RobotCommand& c) const noexcept {
     return WriteStatus::kOutOfRange;
   }
   if (health_.link_lost || health_.arm_fault) return WriteStatus::kFault;
+  if (position_only_ && c.mode != LowLevelMode::kPosition) return WriteStatus::kFault;
   return WriteStatus::kOk;
 }
 
@@ -352,6 +365,7 @@ WriteStatus KortexRobot::write(const RobotCommand& c) {
   }
   requested_mode_ = control_mode_for(c.mode);
   requested_low_level_ = c.mode;
+  if (health_.link_degraded && c.mode == LowLevelMode::kPosition) position_only_ = true;
   for (int i = 0; i < n_; ++i) {
     kortex::ActuatorCommand& a = command_.actuators[static_cast<std::size_t>(i)];
     const float measured_deg = feedback_.actuators[static_cast<std::size_t>(i)].position_deg;

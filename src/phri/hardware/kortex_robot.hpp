@@ -35,13 +35,17 @@
 // (the supervisor's robot_fault: a safe stop); the banks and warnings are in health(). A write
 // while the arm is in fault, or after the link was lost, is refused (kFault).
 //
-// Communication loss: `max_failed_refreshes` failed Refresh calls in a row, none good for
-// `max_silence_s`, or more than `max_loss_fraction` of the Refresh calls of the last
-// `loss_window_s` failed (a degraded link: at 1 kHz each loss leaves the arm on a 2 ms old
-// set-point; 1 % is ten a second), and the robot stops commanding torque for good: every actuator back to
+// Communication loss: `max_failed_refreshes` failed Refresh calls in a row, or none good for
+// `max_silence_s`, and the robot stops commanding torque for good: every actuator back to
 // POSITION holding the last measured pose (the arm's own position hold; it keeps being sent if
 // the link comes back), RobotState::fault set, one line written to `log`. Without a link at all
 // the arm's watchdog brakes it.
+//
+// A degraded link: more than `max_loss_fraction` of the Refresh calls of the last `loss_window_s`
+// failed (at 1 kHz each loss leaves the arm on a 2 ms old set-point; 1 % is ten a second). The
+// link still carries commands, so the robot asks for a safe stop (RobotState::stop_requested,
+// latched; one line logged): the controller brakes on good samples, then commands the position
+// hold, bumplessly; from that hold on, torque and current commands are refused (kFault).
 //
 // Dry run: the arm is only read; every Refresh holds the measured pose in POSITION, whatever is
 // written (writes are accepted and ignored).
@@ -75,9 +79,10 @@ struct KortexRobotSettings {
   /// ...or no good feedback for this long [s]...
   double max_silence_s = 0.005;
   /// ...or more than this fraction of the Refresh calls of the last loss_window_s failed (0: any
-  /// loss). 0.5 % of a second's 1000 is 5: the sixth loss within a second stops.
+  /// loss). 0.5 % of 5 s is 25: the 26th loss within 5 s stops. A 1 % loss stops within about
+  /// 2.5 s; a 0.3 % one, 15 expected in 5 s, goes on (over 25 once in ~250 windows).
   double max_loss_fraction = 0.005;
-  double loss_window_s = 1.0;  ///< [s], at least one period
+  double loss_window_s = 5.0;  ///< [s], at least one period
   bool dry_run = false;
   /// Where the one line on a communication loss or an arm fault goes (null: nowhere).
   std::FILE* log = stderr;
@@ -94,6 +99,8 @@ struct KortexHealth {
   bool warning = false;    ///< a warning bit in the latest feedback
   bool link_lost = false;  ///< latched: communication loss handled (position hold)
   double link_lost_at_s = 0.0;
+  bool link_degraded = false;  ///< latched: the loss rate asked for a safe stop
+  double link_degraded_at_s = 0.0;
   std::uint64_t refreshes = 0, failed_refreshes = 0, mode_switches = 0, failed_mode_switches = 0;
   int consecutive_failures = 0, longest_failure_run = 0;
   int losses_in_window = 0, most_losses_in_window = 0;  ///< failed Refresh calls in the last loss_window_s
@@ -138,6 +145,7 @@ private:
   void note_failure(kortex::CallStatus status) noexcept;
   void note_outcome(bool lost) noexcept;
   void enter_link_loss(const char* why) noexcept;
+  void request_stop(const char* why) noexcept;
   void hold_measured_pose() noexcept;
   void update_health() noexcept;
   void log_line(const char* text) noexcept;
@@ -159,6 +167,7 @@ private:
   double last_good_s_ = 0.0;  // client clock of the last good feedback
   bool sessions_open_ = false, low_level_ = false, have_feedback_ = false;
   bool fault_logged_ = false;
+  bool position_only_ = false;  // a degraded link's safe stop reached the position hold
   RobotState state_;
   KortexHealth health_;
   std::vector<std::uint8_t> loss_ring_;  // 1: that Refresh failed; the last loss_window_s of them

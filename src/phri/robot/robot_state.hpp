@@ -47,6 +47,9 @@ struct RobotState {
   SignalStatus wrench;   ///< F/T sensor (may run slower than the control cycle)
 
   bool fault = false;  ///< the robot stopped obeying commands (simulator: the physics diverged)
+  /// The robot still obeys and its samples are good, but asks for a safe stop (a degraded link):
+  /// the controller brakes on good data, then hands over to the robot's position hold.
+  bool stop_requested = false;
   WriteStatus last_write_status = WriteStatus::kOk;  ///< answer to the latest write()
   std::uint64_t rejected_writes = 0;                 ///< refused commands so far
 };

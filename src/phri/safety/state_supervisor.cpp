@@ -272,6 +272,8 @@ bool StateSupervisor::check(const RobotState& s) {
   }
   if (fault == SafetyFault::kNone) {
     accept(s);
+    // A good sample from a robot that asks to stop: the safe stop brakes on it (the link still works).
+    if (s.stop_requested) report(SafetyFault::kRobotStopRequest, s.time_s);
     return true;
   }
   reject(s, fault, joint);

@@ -52,7 +52,8 @@ enum class SafetyFault : std::uint8_t {
   kFollowingError,  ///< the position loop could not follow its reference (re-synced too often)
   kVelocityMismatch,///< q̇ disagrees with the rate of q between consecutive samples
   kTorqueCurrentMismatch,  ///< τ_s disagrees with the motor torque K_T G_r i beyond friction and rotor inertia
-  kLast = kTorqueCurrentMismatch,
+  kRobotStopRequest,///< the robot asks for a safe stop while its samples are good (a degraded link)
+  kLast = kRobotStopRequest,
 };
 
 constexpr std::string_view to_string(SupervisorState s) {
@@ -78,6 +79,7 @@ constexpr std::string_view to_string(SafetyFault f) {
     case SafetyFault::kVelocityRange: return "velocity_out_of_range";
     case SafetyFault::kVelocityMismatch: return "velocity_mismatch";
     case SafetyFault::kTorqueCurrentMismatch: return "torque_current_mismatch";
+    case SafetyFault::kRobotStopRequest: return "robot_stop_request";
     case SafetyFault::kTorqueRange: return "torque_out_of_range";
     case SafetyFault::kCurrentRange: return "current_out_of_range";
     case SafetyFault::kFrozenValues: return "frozen_values";
