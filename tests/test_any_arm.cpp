@@ -242,7 +242,7 @@ TEST(AnyArm, AToolWithoutAnFtSensorIsCarriedByTheControllerAndThePlant) {
   ASSERT_EQ(config.controller.payloads.size(), 1u);
   EXPECT_EQ(config.controller.payloads[0].name, "tool");
   EXPECT_EQ(config.controller.payloads[0].inertia.com, Eigen::Vector3d(0.01, -0.02, 0.06));  // on the flange: no offset
-  EXPECT_EQ(config.controller.ft_sensor_offset_m, 0.0);
+  EXPECT_EQ(config.controller.ft_sensor_mount.matrix(), Eigen::Matrix4d::Identity());
   EXPECT_EQ(config.controller.wrench.tool_mass_kg, 0.0);  // no F/T reading to remove it from
 
   const phri::SimRobot robot(config.plant);
