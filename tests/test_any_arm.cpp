@@ -433,7 +433,7 @@ TEST(AnyArm, ABaseAJointCouldMoveIsRefusedUnlessTheJointIsLocked) {
 }
 
 // ------------------------------------------------------------ an F/T sensor turned and moved
-// The sensor mounted a quarter turn about the flange z and 25 mm sideways (xyz_m, rpy_rad) against
+// The sensor mounted a quarter turn about the flange z and 22 mm sideways (xyz_m, rpy_rad) against
 // the straight mount (offset_m), both carrying the same physical tool: the turned mount's tool
 // COM and principal moments are the straight one's restated in its turned, shifted sensor frame
 // (flange frame: COM [0, 0, 0.115] and moments [3.4e-4, 7.3e-4, 8.9e-4] about x, y, z either way).
@@ -450,7 +450,8 @@ const Eigen::Vector3d kTurnedPushPoint(0.01, 0.02, 0.05);
 using Wrench = Eigen::Matrix<double, 6, 1>;
 
 // The run with the plant's sensor noise and offsets and its encoders' quantum off: the arm at rest
-// is still to 1e-4 N on the tool, and the controller's model sees the plant's posture exactly.
+// holds still (the tool's reading is its weight to round-off), and the controller's model sees the
+// plant's posture exactly.
 phri::Config quiet_sensor_config(const std::string& folder) {
   phri::Config config = run_config(folder);
   config.plant.ft_sensor.force_std_N = 0.0;
