@@ -7,6 +7,9 @@
 //  * a tool without an F/T sensor (`end_of_arm: {tool: ...}`): carried by both, no wrench signal;
 //  * a base link below the URDF's root (frames.base): placed alike in the model and the plant, and
 //    refused when a joint could move it;
+//  * an F/T sensor turned about the flange z and set off sideways (end_of_arm.ft_sensor xyz_m,
+//    rpy_rad): the same world wrench as a straight mount under the same push, the raw reading
+//    turned as MuJoCo's own sensor reads it, the tool's weight removed at rest;
 //  * each new key's mistakes are one-line errors naming robot.yaml and the key.
 // The arm is robots/example_6dof, copied and its robot.yaml edited.
 #include <phri/app/config.hpp>
@@ -17,16 +20,20 @@
 #include <phri/sim/sim_scene.hpp>
 
 #include "config_error.hpp"
+#include "hand_push.hpp"
 #include "temp_dir.hpp"
 
 #include <mujoco/mujoco.h>
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <optional>
 #include <sstream>
+#include <vector>
 
 namespace {
 
@@ -242,7 +249,7 @@ TEST(AnyArm, AToolWithoutAnFtSensorIsCarriedByTheControllerAndThePlant) {
   ASSERT_EQ(config.controller.payloads.size(), 1u);
   EXPECT_EQ(config.controller.payloads[0].name, "tool");
   EXPECT_EQ(config.controller.payloads[0].inertia.com, Eigen::Vector3d(0.01, -0.02, 0.06));  // on the flange: no offset
-  EXPECT_EQ(config.controller.ft_sensor_offset_m, 0.0);
+  EXPECT_EQ(config.controller.ft_sensor_mount.matrix(), Eigen::Matrix4d::Identity());
   EXPECT_EQ(config.controller.wrench.tool_mass_kg, 0.0);  // no F/T reading to remove it from
 
   const phri::SimRobot robot(config.plant);
@@ -423,6 +430,259 @@ TEST(AnyArm, ABaseAJointCouldMoveIsRefusedUnlessTheJointIsLocked) {
   if (plant_error) {
     EXPECT_EQ(std::string(plant_error->what()).find('\n'), std::string::npos) << plant_error->what();
   }
+}
+
+// ------------------------------------------------------------ an F/T sensor turned and moved
+// The sensor mounted a quarter turn about the flange z and 22 mm sideways (xyz_m, rpy_rad) against
+// the straight mount (offset_m), both carrying the same physical tool: the turned mount's tool
+// COM and principal moments are the straight one's restated in its turned, shifted sensor frame
+// (flange frame: COM [0, 0, 0.115] and moments [3.4e-4, 7.3e-4, 8.9e-4] about x, y, z either way).
+const double kQuarterTurn = 1.5707963267948966;
+const Eigen::Vector3d kTurnedXyz(0.02, -0.01, 0.065);
+const std::string kFlangeSide = "flange_side: {mass_kg: 0.26931, com_m: [0.0, 0.0, 0.03], inertia_kgm2: [2.0e-4, 2.0e-4, 2.2e-4]}";
+const std::string kStraightMount = "\n  ft_sensor: {offset_m: 0.065, " + kFlangeSide +
+                                   "}\n  tool: {mass_kg: 0.3, com_m: [0.0, 0.0, 0.05], inertia_kgm2: [3.4e-4, 7.3e-4, 8.9e-4]}";
+const std::string kTurnedMount = "\n  ft_sensor: {xyz_m: [0.02, -0.01, 0.065], rpy_rad: [0, 0, 1.5707963267948966], " + kFlangeSide +
+                                 "}\n  tool: {mass_kg: 0.3, com_m: [0.01, 0.02, 0.05], inertia_kgm2: [7.3e-4, 3.4e-4, 8.9e-4]}";
+const Eigen::Vector3d kStraightPushPoint(0.0, 0.0, 0.05);  // the tool's COM, in each mount's tool (sensor) frame
+const Eigen::Vector3d kTurnedPushPoint(0.01, 0.02, 0.05);
+
+using Wrench = Eigen::Matrix<double, 6, 1>;
+
+// The run with the plant's sensor noise and offsets and its encoders' quantum off: the arm at rest
+// holds still (the tool's reading is its weight to round-off), and the controller's model sees the
+// plant's posture exactly.
+phri::Config quiet_sensor_config(const std::string& folder) {
+  phri::Config config = run_config(folder);
+  config.plant.ft_sensor.force_std_N = 0.0;
+  config.plant.ft_sensor.torque_std_Nm = 0.0;
+  phri::SimRobotConfig::Noise& noise = config.plant.noise;
+  noise.torque_sensor_std_Nm = noise.velocity_std_rad_s = noise.current_std_A = noise.encoder_counts_per_rev = 0.0;
+  std::fill(noise.torque_sensor_offset_Nm.begin(), noise.torque_sensor_offset_Nm.end(), 0.0);
+  return config;
+}
+
+struct PushRun {
+  std::vector<Wrench> estimate_world;  ///< the controller's, each cycle
+  std::vector<Wrench> sensor_truth;    ///< MuJoCo's force/torque sensor at the sensor site, each cycle
+  std::vector<Wrench> sensor_read;     ///< what the controller was given (RobotState::wrench_sensor)
+  std::vector<Wrench> applied_world;   ///< the push (force; moment about the flange site), world axes
+  std::vector<Eigen::Matrix3d> sensor_axes_plant, sensor_axes_model;
+  std::vector<Eigen::Vector3d> sensor_origin_plant, sensor_origin_model;
+  Eigen::Vector3d bias_force = Eigen::Vector3d::Zero();
+};
+
+// `force_N` [world] at `point` of the tool (its frame) from 0.6 s on, ramped over 50 ms, for 1 s.
+PushRun push_on_the_tool(const std::string& folder, const Eigen::Vector3d& point, const Eigen::Vector3d& force_N, double seconds = 2.0) {
+  phri::Config config = quiet_sensor_config(folder);
+  config.plant.disturbances.push_back(phri::test::hand_push("tool", point, force_N, 0.6, 1.0));
+  phri::SimRobot robot(config.plant);
+  phri::Controller cycle(config.controller);
+  phri::RobotCommand command(robot.dof());
+  const mjModel* m = robot.mujoco_model();
+  const mjData* d = robot.mujoco_data();
+  const int tool = mj_name2id(m, mjOBJ_BODY, phri::SimScene::kToolBody);
+  PushRun run;
+  for (long k = 0; k < std::lround(seconds / robot.period_s()); ++k) {
+    // The sample read, the plant's truth and the push at that instant, then the controller's step.
+    const phri::RobotState& state = robot.read();
+    run.sensor_read.push_back(state.wrench_sensor);
+    run.sensor_truth.push_back(robot.truth().wrench_sensor);
+    run.sensor_axes_plant.push_back(robot.truth().sensor_rotation);
+    run.sensor_origin_plant.push_back(robot.truth().sensor_position_m);
+    const double scale = config.plant.disturbances[0].scale_at(state.time_s);
+    const Eigen::Matrix3d tool_axes = Eigen::Map<const Eigen::Matrix<mjtNum, 3, 3, Eigen::RowMajor>>(d->xmat + 9 * tool);
+    const Eigen::Vector3d at = Eigen::Map<const Eigen::Vector3d>(d->xpos + 3 * tool) + tool_axes * point;
+    Wrench applied;
+    applied << scale * force_N, (at - site_position(robot, "flange")).cross(scale * force_N);
+    run.applied_world.push_back(applied);
+    cycle.step(state, command);
+    run.estimate_world.push_back(cycle.wrench().wrench_world());
+    const Eigen::Isometry3d& sensor = cycle.data().frame_placements[static_cast<std::size_t>(cycle.sensor_frame())];
+    run.sensor_axes_model.push_back(sensor.linear());
+    run.sensor_origin_model.push_back(sensor.translation());
+    EXPECT_EQ(robot.write(command), phri::WriteStatus::kOk) << "cycle " << k;
+  }
+  EXPECT_EQ(cycle.status(), phri::CycleStatus::kOk);
+  run.bias_force = cycle.wrench().bias().head<3>();
+  return run;
+}
+
+TEST(AnyArm, AnFtSensorTurnedAndMovedOnTheFlangeGivesTheSameWorldWrench) {
+  const phri::Config turned_config = run_config(example_bundle("ft_turned", kTurnedMount));
+  // The mount reaches both: the controller's settings and the plant's.
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(kQuarterTurn, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  EXPECT_LT((turned_config.controller.ft_sensor_mount.linear() - R).norm(), 1e-15);
+  EXPECT_LT((turned_config.controller.ft_sensor_mount.translation() - kTurnedXyz).norm(), 1e-15);
+  EXPECT_LT((turned_config.plant.ft_sensor.sensor_mount.matrix() - turned_config.controller.ft_sensor_mount.matrix()).norm(), 1e-15);
+
+  const Eigen::Vector3d push(6.0, -4.0, 8.0);  // [N], world
+  const PushRun straight = push_on_the_tool(example_bundle("ft_straight", kStraightMount), kStraightPushPoint, push);
+  const PushRun turned = push_on_the_tool(example_bundle("ft_turned_run", kTurnedMount), kTurnedPushPoint, push);
+  ASSERT_EQ(straight.estimate_world.size(), turned.estimate_world.size());
+  // The sensor's displacement on the flange, in the straight sensor's (= the flange's) axes.
+  const Eigen::Vector3d shift = kTurnedXyz - Eigen::Vector3d(0.0, 0.0, 0.065);
+  // Windows: the arm at rest before the push, and held still under it (0.7 s after it has risen).
+  auto still = [](std::size_t k) { return k < 600 || (k >= 1300 && k < 1580); };
+  struct Max {
+    double value = 0.0;
+    void operator()(double x) { value = std::max(value, x); }
+  } force_diff, moment_diff, moment_diff_still, scale, raw_diff, raw_scale, read_diff, axes_plant, axes_model,
+      axes_model_rest, origin_model, origin_model_rest, estimate_vs_push;
+  for (std::size_t k = 0; k < straight.estimate_world.size(); ++k) {
+    const Wrench dw = turned.estimate_world[k] - straight.estimate_world[k];
+    force_diff(dw.head<3>().cwiseAbs().maxCoeff());
+    moment_diff(dw.tail<3>().cwiseAbs().maxCoeff());
+    if (still(k)) moment_diff_still(dw.tail<3>().cwiseAbs().maxCoeff());
+    scale(straight.estimate_world[k].cwiseAbs().maxCoeff());
+    // MuJoCo's own sensor on the turned site reads the straight one's wrench turned into its axes,
+    // the moment taken about its shifted origin: f' = R^T f, m' = R^T (m - shift x f).
+    const Wrench& w = straight.sensor_truth[k];
+    Wrench expected;
+    expected << R.transpose() * w.head<3>(), R.transpose() * (w.tail<3>() - shift.cross(w.head<3>()));
+    raw_diff((turned.sensor_truth[k] - expected).cwiseAbs().maxCoeff());
+    raw_scale(w.cwiseAbs().maxCoeff());
+    read_diff((turned.sensor_read[k] - turned.sensor_truth[k]).cwiseAbs().maxCoeff());
+    // The plant's sensor site is the straight one's turned by R; the controller's model puts its
+    // sensor frame where the plant's site is.
+    axes_plant((turned.sensor_axes_plant[k] - straight.sensor_axes_plant[k] * R).norm());
+    const double axes = (turned.sensor_axes_model[k] - turned.sensor_axes_plant[k]).norm();
+    const double origin = (turned.sensor_origin_model[k] - turned.sensor_origin_plant[k]).norm();
+    axes_model(axes);
+    origin_model(origin);
+    if (k < 600) {
+      axes_model_rest(axes);
+      origin_model_rest(origin);
+    }
+    if (k >= 1300 && k < 1580) estimate_vs_push((turned.estimate_world[k] - turned.applied_world[k]).cwiseAbs().maxCoeff());
+  }
+  std::printf("turned F/T mount vs straight, world wrench estimate: force %.1e N, moment %.1e N.m held still (%.1e N.m "
+              "while the arm moves; of %.2f); MuJoCo's sensor vs R^T-turned %.1e (of %.2f), read vs truth %.1e; plant "
+              "site axes vs straight x R %.1e; model sensor frame vs plant site: axes %.1e origin %.1e m at rest (%.1e, "
+              "%.1e while moving); estimate vs the push held %.1e\n",
+              force_diff.value, moment_diff_still.value, moment_diff.value, scale.value, raw_diff.value, raw_scale.value,
+              read_diff.value, axes_plant.value, axes_model_rest.value, origin_model_rest.value, axes_model.value,
+              origin_model.value, estimate_vs_push.value);
+  EXPECT_GT(scale.value, 5.0);  // the push came through
+  EXPECT_LT(force_diff.value, 1e-9);
+  EXPECT_LT(moment_diff_still.value, 1e-8);
+  // While the wrench changes, the estimator's per-axis median of three (in sensor axes) can pick
+  // another sample on a turned, shifted axis (m' mixes m and f): single cycles, bounded.
+  EXPECT_LT(moment_diff.value, 5e-3);
+  EXPECT_LT(raw_diff.value, 1e-9);
+  EXPECT_EQ(read_diff.value, 0.0);  // noise and bias off: the reading is MuJoCo's
+  EXPECT_LT(axes_plant.value, 1e-12);
+  EXPECT_LT(axes_model_rest.value, 1e-12);
+  EXPECT_LT(origin_model_rest.value, 1e-12);
+  // Moving, MuJoCo's site pose is the one before its last physics step's integration.
+  EXPECT_LT(axes_model.value, 5e-5);
+  EXPECT_LT(origin_model.value, 5e-5);
+  EXPECT_LT(estimate_vs_push.value, 2e-3);
+  EXPECT_LT(turned.bias_force.norm(), 1e-9);
+}
+
+// At rest with no push, the estimator removes the turned tool's weight: the bias it learns is the
+// sensor's (none here) and the estimate stays at zero, at postures where gravity has a large
+// component across the sensor's z (where a mount turned about z changes the load the sensor reads).
+TEST(AnyArm, AnFtSensorTurnedOnTheFlangeHasItsToolsWeightRemoved) {
+  const std::string folder = example_bundle("ft_turned_rest", kTurnedMount);
+  const phri::Config base = quiet_sensor_config(folder);
+  const std::vector<std::vector<double>> postures = {base.plant.initial_q_rad, {0.01, 0.48, 1.34, 1.2, 1.6, 0.44},
+                                                     {0.3, 0.2, 1.0, 0.5, -1.2, 1.5}};
+  int across = 0;  // postures where a straight reading of the mount would be wrong
+  for (const std::vector<double>& q : postures) {
+    phri::Config config = base;
+    config.plant.initial_q_rad = q;
+    phri::SimRobot robot(config.plant);
+    phri::Controller cycle(config.controller);
+    phri::RobotCommand command(robot.dof());
+    double estimate = 0.0;
+    for (long k = 0; k < 1000; ++k) {
+      cycle.step(robot.read(), command);
+      EXPECT_EQ(robot.write(command), phri::WriteStatus::kOk);
+      if (k >= 300) estimate = std::max(estimate, cycle.wrench().wrench_world().cwiseAbs().maxCoeff());
+    }
+    // What the sensor reads at rest is the tool's weight in its axes, about its origin (MuJoCo).
+    const Eigen::Matrix3d axes = robot.truth().sensor_rotation;
+    const Eigen::Vector3d g_sensor = axes.transpose() * config.plant.gravity_m_s2;
+    const Eigen::Vector3d com(0.01, 0.02, 0.05);
+    Wrench weight;
+    weight << 0.3 * g_sensor, com.cross(0.3 * g_sensor);
+    // A mount read as straight (the sensor's axes taken as the flange's) would expect another load.
+    const Eigen::Matrix3d R = Eigen::AngleAxisd(kQuarterTurn, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    const Eigen::Vector3d g_flange = R * g_sensor;
+    Wrench as_if_straight;
+    as_if_straight << 0.3 * g_flange, com.cross(0.3 * g_flange);
+    const double reading = (robot.truth().wrench_sensor - weight).cwiseAbs().maxCoeff();
+    const double bias = cycle.wrench().bias().cwiseAbs().maxCoeff();
+    std::printf("turned F/T mount at rest, q5 %.2f: |g across the sensor z| %.2f m/s^2, MuJoCo reading vs the weight %.2e, "
+                "bias %.2e, estimate %.2e (a straight reading of the mount: %.2f off)\n",
+                q[4], g_sensor.head<2>().norm(), reading, bias, estimate, (as_if_straight - weight).cwiseAbs().maxCoeff());
+    EXPECT_EQ(cycle.status(), phri::CycleStatus::kOk);
+    // Noise off, the arm holds still: the reading is the weight, the bias nothing, to round-off.
+    EXPECT_LT(reading, 1e-9);
+    EXPECT_LT(bias, 1e-9);
+    EXPECT_LT(estimate, 1e-9);
+    if (g_sensor.head<2>().norm() > 3.0) {
+      ++across;
+      EXPECT_GT((as_if_straight - weight).cwiseAbs().maxCoeff(), 100 * std::max(bias, 1e-4));
+    }
+  }
+  EXPECT_GE(across, 2);
+}
+
+// Both offset_m and xyz_m, a non-finite or degree-sized rpy, |xyz| beyond 0.5 m: one-line errors
+// naming robot.yaml (or the plant YAML) and the key.
+TEST(AnyArm, FtSensorMountMistakesAreOneLineErrorsNamingTheKey) {
+  const std::string tool = "}\n  tool: {mass_kg: 0.3, com_m: [0.0, 0.0, 0.05], inertia_kgm2: [3.4e-4, 7.3e-4, 8.9e-4]}";
+  const struct {
+    std::string mount, key, mention;
+  } cases[] = {
+      {"offset_m: 0.065, xyz_m: [0, 0, 0.065]", "end_of_arm.ft_sensor.xyz_m", "not both"},
+      {"xyz_m: [0.4, 0.0, 0.4]", "end_of_arm.ft_sensor.xyz_m", "|xyz| = 0.565685 m: at most 0.5"},
+      {"xyz_m: [0.0, 0.0, 0.7]", "end_of_arm.ft_sensor.xyz_m[2]", "0.5"},
+      {"xyz_m: [0.0, 0.0]", "end_of_arm.ft_sensor.xyz_m", "expected 3 numbers"},
+      {"offset_m: 0.065, rpy_rad: [0, .nan, 0]", "end_of_arm.ft_sensor.rpy_rad[1]", "finite"},
+      {"offset_m: 0.065, rpy_rad: [.inf, 0, 0]", "end_of_arm.ft_sensor.rpy_rad[0]", "finite"},
+      {"offset_m: 0.065, rpy_rad: [0, 0, 90]", "end_of_arm.ft_sensor.rpy_rad[2]", "must be in"},  // degrees
+      {"rpy_rad: [0, 0, 1]", "end_of_arm.ft_sensor.offset_m", "missing"},               // no offset at all
+  };
+  int n = 0;
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.mount);
+    const std::string folder = example_bundle("ft_mistake_" + std::to_string(n++), "\n  ft_sensor: {" + c.mount + ", " + kFlangeSide + tool);
+    const auto error = expect_config_error([&] { (void)phri::RobotBundle::from_folder(folder); },
+                                           {.element = c.key, .mentions = {c.mention}, .file = folder + "/robot.yaml"});
+    if (error) {
+      EXPECT_EQ(std::string(error->what()).find('\n'), std::string::npos) << error->what();
+    }
+  }
+  // The plant YAML's ft_sensor section: the same keys with the sensor_ prefix of its offset.
+  const std::string sensor = "  ft_sensor: {flange_site: flange, flange_side_mass_kg: 0.27, flange_side_com_m: [0, 0, 0.03], "
+                             "flange_side_inertia_kgm2: [2.0e-4, 2.0e-4, 2.2e-4], ";
+  const std::string plant_tool = "}\n  tool: {mass_kg: 0.8, com_m: [0, 0, 0.06], inertia_kgm2: [2.0e-3, 2.5e-3, 1.5e-3]}\n";
+  const struct {
+    std::string mount, key, mention;
+  } plant_cases[] = {
+      {"sensor_offset_m: 0.065, sensor_xyz_m: [0, 0, 0.065]", "plant.ft_sensor.sensor_xyz_m", "not both"},
+      {"sensor_xyz_m: [0.3, 0.3, 0.3]", "plant.ft_sensor.sensor_xyz_m", "at most 0.5"},
+      {"sensor_offset_m: 0.065, sensor_rpy_rad: [.nan, 0, 0]", "plant.ft_sensor.sensor_rpy_rad[0]", "finite"},
+  };
+  for (const auto& c : plant_cases) {
+    SCOPED_TRACE(c.mount);
+    const auto error = expect_config_error(
+        [&] { (void)phri::SimRobotConfig::from_yaml_string(example_plant_yaml(sensor + c.mount + plant_tool), "plant.yaml", kExample); },
+        {.element = c.key, .mentions = {c.mention}, .file = "plant.yaml"});
+    if (error) {
+      EXPECT_EQ(std::string(error->what()).find('\n'), std::string::npos) << error->what();
+    }
+  }
+  // A plant YAML's turned mount is the bundle's: the same scene pose of the sensor site.
+  const phri::SimRobotConfig plant = phri::SimRobotConfig::from_yaml_string(
+      example_plant_yaml(sensor + "sensor_xyz_m: [0.02, -0.01, 0.065], sensor_rpy_rad: [0, 0, 1.5707963267948966]" + plant_tool),
+      "plant.yaml", kExample);
+  const phri::Config bundled = run_config(example_bundle("ft_turned_plant", kTurnedMount));
+  EXPECT_EQ(plant.ft_sensor.sensor_mount.matrix(), bundled.plant.ft_sensor.sensor_mount.matrix());
 }
 
 }  // namespace

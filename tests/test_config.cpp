@@ -132,7 +132,7 @@ TEST(Config, MinimalFileTakesTheDefaults) {
   EXPECT_TRUE(c.fsm.timeline.empty());
   EXPECT_DOUBLE_EQ(c.controller.observer_gain, phri::ControllerSettings{}.observer_gain);
   EXPECT_TRUE(c.controller.payloads.empty());  // the library knows no arm's end of arm
-  EXPECT_EQ(c.controller.ft_sensor_offset_m, 0.0);
+  EXPECT_EQ(c.controller.ft_sensor_mount.matrix(), Eigen::Matrix4d::Identity());
   EXPECT_EQ(c.controller.wrench.tool_mass_kg, 0.0);
   EXPECT_EQ(c.fsm.startup.home_q_rad, phri::paper_posture_target());
 }

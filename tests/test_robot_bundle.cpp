@@ -61,7 +61,7 @@ void expect_same_robot(const phri::Config& bundled, const phri::Config& spelled_
   EXPECT_EQ(std::filesystem::canonical(a.actuators_path), std::filesystem::canonical(b.actuators_path));
   EXPECT_EQ(std::filesystem::canonical(a.collision_path), std::filesystem::canonical(b.collision_path));
   EXPECT_EQ(a.end_effector_frame, b.end_effector_frame);
-  EXPECT_EQ(a.ft_sensor_offset_m, b.ft_sensor_offset_m);
+  EXPECT_EQ(a.ft_sensor_mount.matrix(), b.ft_sensor_mount.matrix());
   expect_same_payloads(a.payloads, b.payloads);
   EXPECT_EQ(a.wrench.tool_mass_kg, b.wrench.tool_mass_kg);
   EXPECT_EQ(a.wrench.tool_com_m, b.wrench.tool_com_m);
@@ -75,7 +75,7 @@ void expect_same_robot(const phri::Config& bundled, const phri::Config& spelled_
   const phri::SimRobotConfig &p = bundled.plant, &q = spelled_out.plant;
   EXPECT_EQ(std::filesystem::canonical(p.arm_file()), std::filesystem::canonical(q.arm_file()));
   EXPECT_EQ(p.ft_sensor.flange_site, q.ft_sensor.flange_site);
-  EXPECT_EQ(p.ft_sensor.sensor_offset_m, q.ft_sensor.sensor_offset_m);
+  EXPECT_EQ(p.ft_sensor.sensor_mount.matrix(), q.ft_sensor.sensor_mount.matrix());
   EXPECT_EQ(p.ft_sensor.flange_side_mass_kg, q.ft_sensor.flange_side_mass_kg);
   EXPECT_EQ(p.ft_sensor.flange_side_com_m, q.ft_sensor.flange_side_com_m);
   EXPECT_EQ(p.ft_sensor.flange_side_inertia_kgm2, q.ft_sensor.flange_side_inertia_kgm2);

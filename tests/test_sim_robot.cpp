@@ -56,7 +56,7 @@ Eigen::VectorXd to_vector(const std::vector<double>& v) {
 
 // The controller's view of the arm: gen3.urdf (phri::Model), plus point masses for the scene's
 // payload: adapter + sensor body at its COM in the flange frame, the tool at its COM in the sensor
-// frame (sensor_offset_m along the flange z). end_effector_link is the flange (= MJCF site).
+// frame (placed by the sensor's mount on the flange). end_effector_link is the flange (= MJCF site).
 struct Reference {
   phri::Model model;
   phri::Data data;
@@ -68,7 +68,7 @@ struct Reference {
     Eigen::Isometry3d a = Eigen::Isometry3d::Identity();
     a.translation() = c.ft_sensor.flange_side_com_m;
     Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
-    t.translation() = Eigen::Vector3d(0, 0, c.ft_sensor.sensor_offset_m) + c.tool.com_m;
+    t.translation() = c.ft_sensor.sensor_mount * c.tool.com_m;
     o.extra_frames.push_back({"flange_com", "end_effector_link", a});
     o.extra_frames.push_back({"tool_com", "end_effector_link", t});
     return phri::Model::from_urdf_file(kRoot + "/robots/kinova_gen3/gen3.urdf", o);

@@ -66,7 +66,7 @@ void bind_settings(py::module_& m) {
       .def_readwrite("tip_link", &S::tip_link, "Empty: the end of the only moving branch.")
       .def_readwrite("locked_joints", &S::locked_joints, "URDF joints held at 0 (gripper fingers).")
       .def_readwrite("collision_yaml", &S::collision_yaml, "A collision model's text, in place of collision_path when set.")
-      .def_readwrite("ft_sensor_offset_m", &S::ft_sensor_offset_m)
+      .def_readwrite("ft_sensor_mount", &S::ft_sensor_mount, "F/T measuring frame in the end-effector frame (4 x 4).")
       .def_readwrite("payloads", &S::payloads)
       .def_readwrite("period_s", &S::period_s)
       .def_readwrite("observer_gain", &S::observer_gain, "Momentum observer bandwidth K_O [rad/s].")

@@ -125,3 +125,22 @@ def test_record_returns_the_log_rows_of_the_run(rig):
     assert rows["cycle"].dtype == np.int64 and list(rows["cycle"][:3]) == [1, 2, 3]
     assert np.all(np.diff(rows["time_s"]) > 0)
     assert rows["compliance_mode"][0] == int(phri.ComplianceMode.null_space)
+
+
+def test_the_ft_sensor_mount_is_a_placement_that_reaches_the_controllers_model():
+    """ControllerSettings.ft_sensor_mount (4 x 4): the Gen3's straight 0.065 m, and a turned, offset one as the model's
+    "ft_sensor" frame on the end effector (the wrench estimator reads through it)."""
+    settings = phri.ControllerSettings()
+    straight = np.eye(4)
+    straight[2, 3] = 0.065
+    assert np.array_equal(settings.ft_sensor_mount, straight)
+    turned = np.eye(4)
+    turned[:3, :3] = [[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]  # its x along the flange's y
+    turned[:3, 3] = [0.02, -0.01, 0.065]
+    settings.ft_sensor_mount = turned
+    assert np.array_equal(settings.ft_sensor_mount, turned)
+    model = phri.Controller(settings).model
+    sensor = model.frames[model.frame_id("ft_sensor")]
+    end_effector = model.frames[model.frame_id(settings.end_effector_frame)]
+    assert sensor.body == end_effector.body
+    assert np.abs(sensor.placement - end_effector.placement @ turned).max() < 1e-15

@@ -78,7 +78,11 @@ void parse_robot(const YamlReader& r, const std::string& base_dir, ControllerSet
   c.actuators_path = input_file(r, "actuators", base_dir, false);
   c.collision_path = r.has("collision") ? input_file(r, "collision", base_dir, true) : "";
   c.end_effector_frame = r.text("end_effector_frame");  // no default: every arm names its own
-  c.ft_sensor_offset_m = r.number_or("ft_sensor_offset_m", c.ft_sensor_offset_m, 0.0, 0.5);  // an adapter, not a boom
+  // Straight along the end-effector z (a turned or offset mount: a robot bundle's end_of_arm).
+  if (r.has("ft_sensor_offset_m")) {
+    c.ft_sensor_mount = Eigen::Isometry3d::Identity();
+    c.ft_sensor_mount.translation().z() = r.number("ft_sensor_offset_m", 0.0, 0.5);  // an adapter, not a boom
+  }
   if (r.has("payloads")) {
     const YamlReader list = r.at("payloads");
     list.expect_sequence();

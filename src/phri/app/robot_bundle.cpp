@@ -2,6 +2,7 @@
 #include <phri/app/physical_ranges.hpp>
 
 #include <phri/core/format.hpp>
+#include <phri/core/rpy.hpp>
 #include <phri/core/yaml_reader.hpp>
 #include <phri/control/controller.hpp>
 #include <phri/model/capsule_fit.hpp>
@@ -106,9 +107,7 @@ Eigen::Isometry3d parse_base_placement(const YamlReader& b) {
   const Eigen::Vector3d rpy = b.vector3_or("rpy_rad", Eigen::Vector3d::Zero(), -kMaxJointAngle_rad, kMaxJointAngle_rad);
   Eigen::Isometry3d placement = Eigen::Isometry3d::Identity();
   placement.translation() = xyz;
-  placement.linear() = (Eigen::AngleAxisd(rpy.z(), Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(rpy.y(), Eigen::Vector3d::UnitY()) *
-                        Eigen::AngleAxisd(rpy.x(), Eigen::Vector3d::UnitX()))
-                           .toRotationMatrix();
+  placement.linear() = rpy_rotation(rpy);
   return placement;
 }
 
@@ -123,8 +122,8 @@ std::optional<EndOfArm> parse_end_of_arm(const YamlReader& e) {
   end.has_ft_sensor = e.has("ft_sensor");
   if (end.has_ft_sensor) {
     const YamlReader sensor = e.at("ft_sensor");
-    sensor.allow_keys({"offset_m", "flange_side"});
-    end.sensor_offset_m = sensor.number("offset_m", 0.0, 0.5);
+    sensor.allow_keys({"offset_m", "xyz_m", "rpy_rad", "flange_side"});
+    end.sensor_mount = read_sensor_mount(sensor, "offset_m", "xyz_m", "rpy_rad");
     end.flange_side = rigid_body(sensor.at("flange_side"));
   }
   end.tool = rigid_body(e.at("tool"));
@@ -289,7 +288,7 @@ void RobotBundle::apply_to(ControllerSettings& s) const {
   s.qp.compliance_deadband = compliance_deadband_Nm;
   s.set_end_of_arm(end_of_arm);
   for (const LinkPayload& p : payloads) {  // after the end of arm's, which set_end_of_arm replaces
-    s.payloads.push_back(ControllerSettings::end_of_arm_payload(p.name.c_str(), p.body, 0.0));
+    s.payloads.push_back(ControllerSettings::end_of_arm_payload(p.name.c_str(), p.body));
     s.payloads.back().frame = p.link;
   }
   s.gravity_m_s2 = gravity_m_s2;

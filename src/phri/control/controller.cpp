@@ -45,7 +45,7 @@ ModelOptions Controller::model_options(const ControllerSettings& settings) {
   ExtraFrame sensor;
   sensor.name = "ft_sensor";
   sensor.parent_frame = settings.end_effector_frame;
-  sensor.placement.translation() = Eigen::Vector3d(0.0, 0.0, settings.ft_sensor_offset_m);
+  sensor.placement = settings.ft_sensor_mount;
   options.extra_frames.push_back(sensor);
   for (Payload payload : settings.payloads) {
     if (payload.frame.empty()) payload.frame = settings.end_effector_frame;  // default: the end effector
@@ -116,6 +116,11 @@ const ControllerSettings& checked(const ControllerSettings& settings) {
         settings.observer_release_threshold_Nm >= 0 && settings.observer_release_speed_fraction >= 0)) {
     throw ConfigError("ControllerSettings", "observer_release_gain",
                       "must be >= 0 and < 1 / period_s, with a threshold and a speed fraction >= 0 (the same pole as observer_gain)");
+  }
+  // The sensor's frame on the end effector (the wrench estimator reads through it): rigid, finite.
+  const Eigen::Isometry3d& mount = settings.ft_sensor_mount;
+  if (!mount.matrix().allFinite() || !(mount.linear().transpose() * mount.linear()).isIdentity(1e-9)) {
+    throw ConfigError("ControllerSettings", "ft_sensor_mount", "must be finite, its linear part a rotation");
   }
   const SafetySettings& safety = settings.safety;
   if (!(safety.max_qp_fallback_s >= 0 && safety.brake_rate > 0 && safety.handover_speed_rad_s > 0 &&

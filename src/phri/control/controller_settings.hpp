@@ -103,17 +103,20 @@ struct ControllerSettings {
   /// a robot bundle's `gravity_m_s2` and `base` keys; the plant is given the same.
   Eigen::Vector3d gravity_m_s2 = Eigen::Vector3d(0.0, 0.0, -9.81);
   Eigen::Isometry3d base_placement = Eigen::Isometry3d::Identity();
-  /// F/T sensor measuring frame on the end-effector frame: offset along its z axis (0 without a sensor).
-  double ft_sensor_offset_m = 0.0;
+  /// F/T sensor measuring frame in the end-effector frame (EndOfArm::sensor_mount; the identity
+  /// without a sensor): the model's "ft_sensor" frame, where the wrench estimator reads from.
+  Eigen::Isometry3d ft_sensor_mount = Eigen::Isometry3d::Identity();
   /// What the arm carries beyond its URDF (frame '' : the end-effector frame). None by default:
   /// set_end_of_arm, a bundle's end_of_arm or a run YAML's robot.payloads add them.
   std::vector<Payload> payloads;
-  /// A body carried on the end-effector frame, its COM shifted along that frame's z by offset_z_m.
-  static Payload end_of_arm_payload(const char* name, const RigidBodyData& body, double offset_z_m) {
+  /// A body carried on the end-effector frame, given in a frame `placed` there (the tool: in the
+  /// F/T sensor's frame, so its COM and principal axes turn and move with the sensor's mount).
+  static Payload end_of_arm_payload(const char* name, const RigidBodyData& body,
+                                    const Eigen::Isometry3d& placed = Eigen::Isometry3d::Identity()) {
     Payload p{name, "", {}};
     p.inertia.mass = body.mass_kg;
-    p.inertia.com = body.com_m + Eigen::Vector3d(0.0, 0.0, offset_z_m);
-    p.inertia.inertia_com = body.principal_inertia_kgm2.asDiagonal();
+    p.inertia.com = placed.linear() * body.com_m + placed.translation();
+    p.inertia.inertia_com = placed.linear() * body.principal_inertia_kgm2.asDiagonal() * placed.linear().transpose();
     return p;
   }
   /// The controller's view of an end of arm (none: a bare flange): the F/T frame's offset, the
@@ -123,14 +126,14 @@ struct ControllerSettings {
     const EndOfArm none;
     const EndOfArm& e = end_of_arm ? *end_of_arm : none;
     const bool sensor = end_of_arm && e.has_ft_sensor;
-    ft_sensor_offset_m = sensor ? e.sensor_offset_m : 0.0;
+    ft_sensor_mount = sensor ? e.sensor_mount : Eigen::Isometry3d::Identity();
     payloads.clear();
     if (sensor) {
-      // The tool's COM is given below the sensor: shift it by the sensor's offset.
-      payloads = {end_of_arm_payload("ft_adapter_and_sensor", e.flange_side, 0.0),
-                  end_of_arm_payload("tool", e.tool, e.sensor_offset_m)};
+      // The tool is given in the sensor's frame: placed by the sensor's mount.
+      payloads = {end_of_arm_payload("ft_adapter_and_sensor", e.flange_side),
+                  end_of_arm_payload("tool", e.tool, e.sensor_mount)};
     } else if (end_of_arm) {
-      payloads = {end_of_arm_payload("tool", e.tool, 0.0)};  // on the flange, nothing between
+      payloads = {end_of_arm_payload("tool", e.tool)};  // on the flange, nothing between
     }
     // What the F/T reading carries below the sensor: nothing to remove without a sensor.
     wrench.tool_mass_kg = sensor ? e.tool.mass_kg : 0.0;

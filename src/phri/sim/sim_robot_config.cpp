@@ -136,11 +136,11 @@ void parse_noise(const YamlReader& z, int n, SimRobotConfig::Noise& s) {
 }
 
 void parse_ft_sensor(const YamlReader& f, SimRobotConfig::FtSensor& s) {
-  f.allow_keys({"flange_site", "sensor_offset_m", "flange_side_mass_kg", "flange_side_com_m", "flange_side_inertia_kgm2",
-                "rate_Hz", "force_std_N", "torque_std_Nm", "force_bias_N", "torque_bias_Nm"});
+  f.allow_keys({"flange_site", "sensor_offset_m", "sensor_xyz_m", "sensor_rpy_rad", "flange_side_mass_kg", "flange_side_com_m",
+                "flange_side_inertia_kgm2", "rate_Hz", "force_std_N", "torque_std_Nm", "force_bias_N", "torque_bias_Nm"});
   // The mount and the bodies have no default: they are the arm's (robots/<robot>/robot.yaml says them too).
   s.flange_site = f.text("flange_site");
-  s.sensor_offset_m = f.number("sensor_offset_m", 0.0, 0.5);  // an adapter, not a boom
+  s.sensor_mount = read_sensor_mount(f, "sensor_offset_m", "sensor_xyz_m", "sensor_rpy_rad");
   s.flange_side_mass_kg = f.number("flange_side_mass_kg", 1e-4, kMaxCarriedMass_kg);
   s.flange_side_com_m = f.vector3("flange_side_com_m", -0.5, 0.5);
   s.flange_side_inertia_kgm2 = f.vector3("flange_side_inertia_kgm2", 1e-9, kMaxCarriedInertia_kgm2);
@@ -511,6 +511,12 @@ void validate_end_of_arm(const SimRobotConfig& c) {
   }
   if (!(c.tool.mass_kg > 0.0)) throw ConfigError(f, "plant.tool.mass_kg", "must be > 0");
   if (!c.has_ft_sensor) return;
+  // A mount built in code: a rigid placement within the YAML's reach.
+  const Eigen::Isometry3d& mount = c.ft_sensor.sensor_mount;
+  if (!mount.matrix().allFinite() || !(mount.translation().norm() <= 0.5) ||
+      !(mount.linear().transpose() * mount.linear()).isIdentity(1e-9) || !(mount.linear().determinant() > 0.0)) {
+    throw ConfigError(f, "plant.ft_sensor.sensor_xyz_m", "the sensor mount must be a rotation and |xyz| <= 0.5 m");
+  }
   if (!(c.ft_sensor.flange_side_mass_kg > 0.0)) throw ConfigError(f, "plant.ft_sensor.flange_side_mass_kg", "must be > 0");
   if (!(c.ft_sensor.flange_side_inertia_kgm2.minCoeff() > 0.0)) {
     throw ConfigError(f, "plant.ft_sensor.flange_side_inertia_kgm2", "principal moments must be > 0");
@@ -586,7 +592,7 @@ std::optional<EndOfArm> SimRobotConfig::end_of_arm() const {
     e.tool = {tool.mass_kg, tool.com_m, tool.inertia_kgm2};
     return e;
   }
-  e.sensor_offset_m = ft_sensor.sensor_offset_m;
+  e.sensor_mount = ft_sensor.sensor_mount;
   e.flange_side = {ft_sensor.flange_side_mass_kg, ft_sensor.flange_side_com_m, ft_sensor.flange_side_inertia_kgm2};
   e.tool = {tool.mass_kg, tool.com_m, tool.inertia_kgm2};
   return e;
@@ -597,7 +603,7 @@ void SimRobotConfig::set_end_of_arm(const std::optional<EndOfArm>& end_of_arm) {
   const EndOfArm e = end_of_arm.value_or(EndOfArm{});
   has_ft_sensor = e.has_ft_sensor;
   const bool sensor = has_end_of_arm && has_ft_sensor;
-  ft_sensor.sensor_offset_m = sensor ? e.sensor_offset_m : 0.0;
+  ft_sensor.sensor_mount = sensor ? e.sensor_mount : Eigen::Isometry3d::Identity();
   ft_sensor.flange_side_mass_kg = sensor ? e.flange_side.mass_kg : 0.0;
   ft_sensor.flange_side_com_m = e.flange_side.com_m;
   ft_sensor.flange_side_inertia_kgm2 = e.flange_side.principal_inertia_kgm2;

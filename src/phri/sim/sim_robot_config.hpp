@@ -137,7 +137,9 @@ struct SimRobotConfig {
     /// MJCF site of the tool flange (z out of the flange), where the end of arm mounts (the tool
     /// itself when there is no sensor)
     std::string flange_site;
-    double sensor_offset_m = 0.0;   ///< flange -> sensor measuring frame, along flange z
+    /// The sensor's measuring frame in the flange site's frame (EndOfArm::sensor_mount): the
+    /// tool body's pose on the adapter, its origin the sensor site.
+    Eigen::Isometry3d sensor_mount = Eigen::Isometry3d::Identity();
     double flange_side_mass_kg = 0.0;  ///< not measured by the sensor
     Eigen::Vector3d flange_side_com_m = Eigen::Vector3d::Zero();  ///< flange frame
     Eigen::Vector3d flange_side_inertia_kgm2 = Eigen::Vector3d::Zero();

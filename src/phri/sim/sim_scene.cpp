@@ -106,6 +106,13 @@ std::string bare_tool_mjcf(const SimRobotConfig& config, const FlangeMount& moun
   return chain;
 }
 
+// A turned sensor mount as an MJCF quat attribute; none for a straight one (MuJoCo's identity).
+std::string mount_quat(const Eigen::Isometry3d& mount) {
+  if (mount.linear() == Eigen::Matrix3d::Identity()) return "";
+  const Eigen::Quaterniond q(mount.linear());
+  return " quat=\"" + num(q.w()) + " " + num(q.x()) + " " + num(q.y()) + " " + num(q.z()) + "\"";
+}
+
 // The F/T adapter and the tool below it, as a body tree for the flange body.
 std::string tool_chain_mjcf(const SimRobotConfig& config, const FlangeMount& mount) {
   const mjtNum* sp = mount.pos;
@@ -118,11 +125,12 @@ std::string tool_chain_mjcf(const SimRobotConfig& config, const FlangeMount& mou
            num(sp[2]) + "\" quat=\"" + num(sq[0]) + " " + num(sq[1]) + " " + num(sq[2]) + " " + num(sq[3]) + "\">\n";
   chain += "  <inertial pos=\"" + vec(ft.flange_side_com_m) + "\" mass=\"" + num(ft.flange_side_mass_kg) +
            "\" diaginertia=\"" + vec(ft.flange_side_inertia_kgm2) + "\"/>\n";
-  const double half = 0.5 * std::max(ft.sensor_offset_m, 1e-3);
+  const Eigen::Vector3d at = ft.sensor_mount.translation();
+  const double half = 0.5 * std::max(at.z(), 1e-3);  // the adapter's look only (no contact, no mass)
   chain += "  <geom name=\"ft_adapter_geom\" type=\"cylinder\" size=\"0.04 " + num(half) + "\" pos=\"0 0 " + num(half) +
            "\" contype=\"0\" conaffinity=\"0\" group=\"1\" rgba=\"0.3 0.3 0.35 0.6\"/>\n";
   chain += "  <!-- the tool (below the sensor): its origin is the sensor's measuring frame -->\n";
-  chain += "  <body name=\"" + std::string(SimScene::kToolBody) + "\" pos=\"0 0 " + num(ft.sensor_offset_m) + "\">\n";
+  chain += "  <body name=\"" + std::string(SimScene::kToolBody) + "\" pos=\"" + vec(at) + "\"" + mount_quat(ft.sensor_mount) + ">\n";
   chain += "    <inertial pos=\"" + vec(tool.com_m) + "\" mass=\"" + num(tool.mass_kg) + "\" diaginertia=\"" +
            vec(tool.inertia_kgm2) + "\"/>\n";
   chain += "    <geom name=\"tool_geom\" type=\"box\" size=\"0.03 0.05 0.03\" pos=\"" + vec(tool.com_m) +

@@ -5,7 +5,7 @@
 //
 //   <flange body> (the body of config.ft_sensor.flange_site, bracelet_link on the Gen3)
 //     ft_adapter       welded at the flange site: F/T adapter + sensor body (flange side, not measured)
-//       tool           welded at sensor_offset_m along the flange z: the tool (DS4 gamepad + mount);
+//       tool           welded at the sensor's mount (translated, turned): the tool (DS4 gamepad + mount);
 //                      its origin is the sensor's measuring frame, site "ft_sensor" with a MuJoCo
 //                      force and torque sensor; site "cable_anchor" when the drop test is enabled
 //   (a tool without an F/T sensor, SimRobotConfig::has_ft_sensor false: `tool` welded at the flange
