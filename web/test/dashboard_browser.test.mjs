@@ -87,6 +87,7 @@ spawnSync('renice', ['-n', '15', '-g', String(browser.process().pid)], { stdio: 
 try {
   const page = await browser.newPage();
   await page.setViewport({ width: 1400, height: 1300 });
+  page.setDefaultNavigationTimeout(120000);  // a loaded 2-core machine (the browser runs at nice 15) needs more than 30 s
   page.on('pageerror', (e) => check(false, 'page error: ' + e.message));
 
   // Without the token: refused.
