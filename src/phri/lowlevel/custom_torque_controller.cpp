@@ -6,6 +6,7 @@
 #include <cmath>
 
 namespace phri {
+
 CustomTorqueController::CustomTorqueController(const ActuatorTable& actuators, const CustomTorqueSettings& settings)
     : actuators_(actuators.joints()), settings_(settings) {
   auto fail = [](const std::string& key, const std::string& reason) {
