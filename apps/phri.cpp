@@ -261,14 +261,9 @@ int run_command(const RunArguments& args) {
 CLI::Validator duration_seconds() {
   return CLI::Validator(
       [](std::string& text) -> std::string {
-        std::size_t used = 0;
-        double value = 0.0;
-        try {
-          value = std::stod(text, &used);
-        } catch (const std::exception&) {
-          return "expected a number of seconds, got '" + text + "'";
-        }
-        if (used != text.size()) return "expected a number of seconds, got '" + text + "'";
+        const std::optional<double> number = phri::parse_number(text);
+        if (!number) return "expected a number of seconds, got '" + text + "'";
+        const double value = *number;
         if (!std::isfinite(value)) return "must be a finite number of seconds, got '" + text + "'";
         if (value < 0.001) return "must be at least 0.001 s, got " + text;
         if (value > phri::RunSettings::kMaxDuration_s) {

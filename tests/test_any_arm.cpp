@@ -635,9 +635,10 @@ TEST(AnyArm, AnFtSensorTurnedOnTheFlangeHasItsToolsWeightRemoved) {
 // naming robot.yaml (or the plant YAML) and the key.
 TEST(AnyArm, FtSensorMountMistakesAreOneLineErrorsNamingTheKey) {
   const std::string tool = "}\n  tool: {mass_kg: 0.3, com_m: [0.0, 0.0, 0.05], inertia_kgm2: [3.4e-4, 7.3e-4, 8.9e-4]}";
-  const struct {
+  struct MountCase {
     std::string mount, key, mention;
-  } cases[] = {
+  };
+  const MountCase cases[] = {
       {"offset_m: 0.065, xyz_m: [0, 0, 0.065]", "end_of_arm.ft_sensor.xyz_m", "not both"},
       {"xyz_m: [0.4, 0.0, 0.4]", "end_of_arm.ft_sensor.xyz_m", "|xyz| = 0.565685 m: at most 0.5"},
       {"xyz_m: [0.0, 0.0, 0.7]", "end_of_arm.ft_sensor.xyz_m[2]", "0.5"},
@@ -661,9 +662,7 @@ TEST(AnyArm, FtSensorMountMistakesAreOneLineErrorsNamingTheKey) {
   const std::string sensor = "  ft_sensor: {flange_site: flange, flange_side_mass_kg: 0.27, flange_side_com_m: [0, 0, 0.03], "
                              "flange_side_inertia_kgm2: [2.0e-4, 2.0e-4, 2.2e-4], ";
   const std::string plant_tool = "}\n  tool: {mass_kg: 0.8, com_m: [0, 0, 0.06], inertia_kgm2: [2.0e-3, 2.5e-3, 1.5e-3]}\n";
-  const struct {
-    std::string mount, key, mention;
-  } plant_cases[] = {
+  const MountCase plant_cases[] = {
       {"sensor_offset_m: 0.065, sensor_xyz_m: [0, 0, 0.065]", "plant.ft_sensor.sensor_xyz_m", "not both"},
       {"sensor_xyz_m: [0.3, 0.3, 0.3]", "plant.ft_sensor.sensor_xyz_m", "at most 0.5"},
       {"sensor_offset_m: 0.065, sensor_rpy_rad: [.nan, 0, 0]", "plant.ft_sensor.sensor_rpy_rad[0]", "finite"},

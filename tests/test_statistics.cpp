@@ -49,3 +49,13 @@ TEST(Format, FixedAndGeneralMatchPrintfAndTheStreams) {
 }
 
 }  // namespace
+
+namespace {
+TEST(Format, ParseNumberTakesTheWholeTextOrNothing) {
+  EXPECT_EQ(phri::parse_number("3.5"), 3.5);
+  EXPECT_EQ(phri::parse_number("-1e-3"), -1e-3);
+  EXPECT_TRUE(std::isinf(*phri::parse_number("inf")));  // the caller decides about these
+  EXPECT_TRUE(std::isnan(*phri::parse_number("nan")));
+  for (const char* bad : {"", "abc", "3.5s", "1e400", "0.01@3", " "}) EXPECT_FALSE(phri::parse_number(bad)) << bad;
+}
+}  // namespace

@@ -1,6 +1,7 @@
 #include <phri/core/format.hpp>
 
 #include <cstdio>
+#include <exception>
 
 namespace phri {
 namespace {
@@ -25,5 +26,17 @@ std::string format(bool fixed, int precision, double value) {
 std::string format_fixed(double value, int digits) { return format(true, digits, value); }
 
 std::string format_general(double value, int significant) { return format(false, significant, value); }
+
+std::optional<double> parse_number(const std::string& text) {
+  std::size_t used = 0;
+  double value = 0.0;
+  try {
+    value = std::stod(text, &used);
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
+  if (used != text.size()) return std::nullopt;
+  return value;
+}
 
 }  // namespace phri

@@ -1,5 +1,6 @@
 #pragma once
-// Numbers as text, one definition for tables, CSV files and messages.
+// Numbers as text, one definition for tables, CSV files and messages; and text as a number.
+#include <optional>
 #include <string>
 
 namespace phri {
@@ -10,5 +11,9 @@ std::string format_fixed(double value, int digits);
 /// `value` with up to `significant` significant digits, as printf "%.*g" (format_general(x, 6)
 /// equals what `std::ostream << x` writes with the default settings).
 std::string format_general(double value, int significant);
+
+/// The whole of `text` as one number (std::stod's syntax, so "inf" and "nan" too: the caller
+/// decides about them); nothing when it is not a number or has anything after it.
+std::optional<double> parse_number(const std::string& text);
 
 }  // namespace phri

@@ -1,11 +1,12 @@
 #include <phri/hardware/kortex_emulator.hpp>
 
 #include <phri/core/error.hpp>
+#include <phri/core/format.hpp>
 #include <phri/hardware/kortex_units.hpp>
 
 #include <algorithm>
 #include <cmath>
-#include <exception>
+#include <optional>
 #include <string>
 
 namespace phri {
@@ -325,15 +326,9 @@ namespace phri {
 ScheduledKortexFault ScheduledKortexFault::parse(const std::string& text, const std::string& option) {
   const std::string usage = "packet-loss:P@T (0 < P <= 1), stall:MS@T (1 to 1000 ms) or drop-session@T (T >= 0 s)";
   auto number = [&](const std::string& s) {
-    std::size_t used = 0;
-    double v = 0.0;
-    try {
-      v = std::stod(s, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used == 0 || used != s.size() || !std::isfinite(v)) throw ConfigError(option, text, "expected " + usage);
-    return v;
+    const std::optional<double> v = parse_number(s);
+    if (!v || !std::isfinite(*v)) throw ConfigError(option, text, "expected " + usage);
+    return *v;
   };
   const std::size_t at = text.rfind('@');
   if (at == std::string::npos) throw ConfigError(option, text, "expected " + usage);
