@@ -11,8 +11,7 @@
 
 #include "allocation_counter.hpp"
 #include "hand_push.hpp"
-
-#include "gen3_settings.hpp"
+#include "safety_rig.hpp"
 
 #include <gtest/gtest.h>
 
@@ -25,79 +24,14 @@
 namespace {
 
 const std::string kRoot = PHRI_SOURCE_DIR;
+using phri::test::distance;
 using phri::test::hand_push;
-using Corrupt = std::function<void(long cycle, phri::RobotState&)>;
-
-// URDF limits of the Gen3's limited joints (2, 4, 6), robots/kinova_gen3/gen3.urdf.
-constexpr double kLimit2 = 2.24, kLimit4 = 2.57, kLimit6 = 2.09;
-
-// The Gen3 plant at the paper demo's posture, a Controller, and a hook that may corrupt the state
-// the controller sees (the plant keeps its own, true, sensors for its built-in loops).
-class Rig {
-public:
-  Rig(phri::ComplianceMode mode, phri::LowLevelMode loop, std::vector<phri::ExternalForce> pushes = {},
-      const std::function<void(phri::ControllerSettings&)>& edit = {})
-      : config_(make_config(std::move(pushes))), robot_(config_), cycle_(settings(mode, loop, edit)), command_(7) {
-    for (int i = 0; i < 7; ++i) velocity_limit_[i] = robot_.plant_actuators()[i].velocity_limit_rad_s;
-  }
-
-  static phri::SimRobotConfig make_config(std::vector<phri::ExternalForce> pushes) {
-    phri::SimRobotConfig c = phri::SimRobotConfig::from_yaml_file(kRoot + "/configs/plant_gen3.yaml");
-    c.initial_q_rad = {0, 0.58, 3.14, -1.84, 0, 0.85, 1.57};
-    c.mismatch.enabled = true;
-    c.disturbances = std::move(pushes);
-    return c;
-  }
-  static phri::ControllerSettings settings(phri::ComplianceMode mode, phri::LowLevelMode loop,
-                                           const std::function<void(phri::ControllerSettings&)>& edit) {
-    phri::ControllerSettings s = phri::test::gen3_controller_settings(mode, loop);
-    if (edit) edit(s);
-    return s;
-  }
-
-  // Runs `seconds`; the hook (if any) corrupts the state of chosen cycles; records the plant's
-  // worst speed ratio, joint-limit excess and whether any write was refused.
-  void run(double seconds, const Corrupt& corrupt = {}, const std::function<void()>& each = {}) {
-    const long n = std::lround(seconds / robot_.period_s());
-    for (long k = 0; k < n; ++k, ++cycle_count_) {
-      const phri::RobotState& state = robot_.read();
-      if (corrupt) {
-        seen_ = state;
-        corrupt(cycle_count_, seen_);
-        cycle_.step(seen_, targets_, command_);
-      } else {
-        cycle_.step(state, targets_, command_);
-      }
-      targets_.clear();
-      if (robot_.write(command_) != phri::WriteStatus::kOk) ++refused_;
-      record();
-      if (each) each();
-    }
-  }
-  void record() {
-    const auto& t = robot_.truth();
-    for (int i = 0; i < 7; ++i) speed_ratio_ = std::max(speed_ratio_, std::abs(t.qd_rad_s[i]) / velocity_limit_[i]);
-    limit_excess_ = std::max({limit_excess_, std::abs(t.q_rad[1]) - kLimit2, std::abs(t.q_rad[3]) - kLimit4,
-                              std::abs(t.q_rad[5]) - kLimit6});
-  }
-  const Eigen::VectorXd& q() const { return robot_.truth().q_rad; }
-  const Eigen::VectorXd& qd() const { return robot_.truth().qd_rad_s; }
-
-  phri::SimRobotConfig config_;
-  phri::SimRobot robot_;
-  phri::Controller cycle_;
-  phri::RobotCommand command_;
-  phri::ControllerTargets targets_{7};
-  phri::RobotState seen_;
-  Eigen::VectorXd velocity_limit_ = Eigen::VectorXd::Zero(7);
-  long cycle_count_ = 0;
-  long refused_ = 0;
-  double speed_ratio_ = 0.0;
-  double limit_excess_ = -std::numeric_limits<double>::infinity();
-};
-
-// Largest joint distance between two runs' final postures.
-double distance(const Eigen::VectorXd& a, const Eigen::VectorXd& b) { return (a - b).cwiseAbs().maxCoeff(); }
+using phri::test::joint_direction;
+using phri::test::kLimit2;
+using phri::test::kLimit4;
+using phri::test::kLimit6;
+using Rig = phri::test::SafetyRig;
+using Corrupt = phri::test::Corrupt;
 
 // Defect 1: one finite but implausible sample (±1e6 on one joint's τ_s, q̇ or q) made the observer
 // report ~5e4 N.m of phantom push; the arm was slammed (39x the velocity limit). Now it is a
@@ -243,20 +177,6 @@ TEST(Safety, AHardStopIsNotReadAsAPushAndTheJointIsPushedOut) {
   EXPECT_GT(cycle.observer().external_torque()[3], 15.0) << "the observer does see the reaction";
   EXPECT_EQ(command.mode, phri::LowLevelMode::kKinovaTorque);
   EXPECT_GT(pressing, 2.15) << "out of the stop, against static friction";
-}
-
-// The direction in which joint `joint` (0-based) moves the origin of `link`, at the demo posture.
-Eigen::Vector3d joint_direction(const std::string& link, int joint) {
-  phri::Model model = phri::Model::from_urdf_file(kRoot + "/robots/kinova_gen3/gen3.urdf");
-  phri::Data data(model);
-  Eigen::VectorXd q0(7);
-  q0 << 0, 0.58, 3.14, -1.84, 0, 0.85, 1.57;
-  phri::forward_kinematics(model, data, q0);
-  phri::update_frame_placements(model, data);
-  const Eigen::Vector3d point = data.frame_placements[static_cast<std::size_t>(model.frame_id(link))].translation();
-  Eigen::MatrixXd jacobian(3, 7);
-  phri::body_point_linear_jacobian(model, data, model.frame(model.frame_id(link)).body, point, jacobian);
-  return jacobian.col(joint).normalized();
 }
 
 // Defect 4: the velocity limit in the custom loop against pushes the arm can easily resist: a

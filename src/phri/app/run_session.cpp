@@ -121,11 +121,12 @@ private:
     const double us = std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count();
     micros_[k] = us;
     // A refused command leaves the robot on its previous one (a stale torque, a set-point it may
-    // not reach): a fault the controller acts on, a safe stop from the next cycle.
-    const WriteStatus written = robot_.write(command_);
-    if (written != WriteStatus::kOk) {
+    // not reach): a fault the controller answers in this cycle (its safe stop, a hold re-targeted).
+    if (robot_.write(command_) != WriteStatus::kOk) {
       ++summary_.refused_writes;
-      cycle_.report_fault(SafetyFault::kWriteRefused, state.time_s);
+      if (cycle_.answer_refused_write(state, command_) && robot_.write(command_) != WriteStatus::kOk) {
+        ++summary_.refused_writes;
+      }
     }
     if (logger_ || live_) {
       fill_log_row(row_, state, cycle_, fsm_);

@@ -125,7 +125,7 @@ const ControllerSettings& checked(const ControllerSettings& settings) {
   const SafetySettings& safety = settings.safety;
   if (!(safety.max_qp_fallback_s >= 0 && safety.brake_rate > 0 && safety.handover_speed_rad_s > 0 &&
         safety.requested_stop_blend_s >= 0 && safety.requested_stop_blend_s <= 1.0 &&
-        safety.max_brake_s > 0 && safety.velocity_guard_fraction > 0 && safety.velocity_guard_fraction <= 1.5 &&
+        safety.max_brake_s > 0 && safety.max_hold_refusals >= 1 && safety.velocity_guard_fraction > 0 && safety.velocity_guard_fraction <= 1.5 &&
         safety.velocity_guard_rate >= 0 && safety.limit_guard_stiffness_Nm_per_rad >= 0 &&
         safety.collision_guard_stiffness_N_per_m >= 0 && safety.collision_guard_damping_Ns_per_m >= 0 &&
         safety.external_torque_bound_factor > 0)) {
@@ -350,21 +350,20 @@ void Controller::hold_previous(const RobotState& state, RobotCommand& command) {
   }
 }
 
-// The latched safe stop. Position loop (or no command yet): the robot's position hold at once.
-// Torque and current loops: gravity compensation with joint damping on the last good velocity
-// (decaying at brake_rate while no good sample comes: a stale velocity is not repeated for ever),
-// after a QP failure also -tau_ext while the samples stay good, then, at rest or after
-// max_brake_s, the hand-over to the position hold at the measured pose.
+// The latched safe stop. Position loop (or no command yet): the robot's position hold at once,
+// its reference braking from where it was. Torque and current loops: gravity compensation with
+// joint damping on the brake's state (brake_state()), after a QP failure also -tau_ext while the
+// samples stay good, then, at rest or after max_brake_s, the hand-over to the position hold there.
 void Controller::safe_stop(bool sample_good, RobotCommand& command) {
   status_ = CycleStatus::kSafeStop;
   const SafetySettings& s = settings_.safety;
-  const RobotState& good = supervisor_.last_good();
-  cycles_since_good_ = sample_good ? 0 : cycles_since_good_ + 1;
+  cycles_since_good_ = supervisor_.kinematics_fresh() ? 0 : cycles_since_good_ + 1;
+  brake_state();
   if (safe_stop_cycles_++ == 0) {
     const bool position_loop = have_command_ && low_level_.loop() == LowLevelMode::kPosition;
-    holding_ = !have_command_ || position_loop || !supervisor_.has_good();
+    holding_ = !have_command_ || position_loop || !supervisor_.has_kinematics();
     brake_against_push_ = !holding_ && supervisor_.safe_stop_transition().reason == SafetyFault::kQpFailure;
-    hold_q_ = supervisor_.has_good() ? good.q_rad : q_;
+    hold_q_ = supervisor_.has_kinematics() ? brake_q_ : q_;
     hold_qd_.setZero();
     stop_entry_tau_ = guarded_tau_;
     // In the position loop the reference brakes from where it is (kept within the following
@@ -377,12 +376,10 @@ void Controller::safe_stop(bool sample_good, RobotCommand& command) {
   }
   if (holding_) {
     brake_reference();
+    keep_hold_acceptable();
     low_level_.hold(hold_q_, command);
     return;
   }
-  const double age_s = static_cast<double>(cycles_since_good_) * settings_.period_s;
-  brake_q_ = good.q_rad;
-  brake_qd_ = std::exp(-s.brake_rate * age_s) * good.qd_rad_s;
   const bool at_rest = brake_qd_.cwiseAbs().maxCoeff() < s.handover_speed_rad_s;
   if (at_rest || static_cast<double>(safe_stop_cycles_) * settings_.period_s > s.max_brake_s) {
     holding_ = true;
@@ -391,7 +388,7 @@ void Controller::safe_stop(bool sample_good, RobotCommand& command) {
     return;
   }
   // A push the QP could not answer goes on being resisted (see step()); after a sensor fault the
-  // estimate is not trusted (a phantom push would be driven, defect 1 of issue 14).
+  // estimate is not trusted (a phantom push would be driven).
   if (!sample_good) brake_against_push_ = false;
   brake_tau_.setZero();  // zero velocity: data_.nonlinear_effects = g(q)
   compute_all_terms(model_, data_, brake_q_, brake_tau_);
@@ -410,6 +407,59 @@ void Controller::safe_stop(bool sample_good, RobotCommand& command) {
     brake_tau_ = share * brake_tau_ + (1.0 - share) * stop_entry_tau_;
   }
   low_level_.command_torque(brake_tau_, command);
+}
+
+// The state the brake works on: the measured joints while their part of the sample is plausible
+// (also when only τ_s or the current is wrong); while it is not, a bounded prediction from the last
+// plausible one, decelerating at brake_rate as the brake makes it: q + q̇ (1 - e^(-r t)) / r, within
+// the joint limits. Never a stale velocity repeated for longer than the data lasted.
+void Controller::brake_state() {
+  if (!supervisor_.has_kinematics()) return;
+  const double rate = settings_.safety.brake_rate;
+  const double age_s = static_cast<double>(cycles_since_good_) * settings_.period_s;
+  const double decay = std::exp(-rate * age_s);
+  brake_q_ = (supervisor_.kinematic_q() + (1.0 - decay) / rate * supervisor_.kinematic_qd())
+                 .cwiseMax(limit_lower_)
+                 .cwiseMin(limit_upper_);
+  brake_qd_ = decay * supervisor_.kinematic_qd();
+}
+
+// The hold's reference within the position loop's following bound of where the arm is (the
+// brake's state): the robot refuses a set-point further away, and keeps its last command then.
+void Controller::keep_hold_acceptable() {
+  if (!supervisor_.has_kinematics()) return;
+  const double bound = low_level_.following_error();
+  for (int i = 0; i < model_.nv(); ++i) {
+    const double error = hold_q_[i] - brake_q_[i];
+    if (std::abs(error) <= bound) continue;
+    hold_q_[i] = brake_q_[i] + std::copysign(bound, error);
+    hold_qd_[i] = 0.0;
+  }
+}
+
+bool Controller::answer_refused_write(const RobotState& state, RobotCommand& command) {
+  supervisor_.report(SafetyFault::kWriteRefused, state.time_s);
+  refusals_in_row_ = refused_step_ >= steps_ - 1 ? refusals_in_row_ + 1 : 1;
+  refused_step_ = steps_;
+  if (refusals_in_row_ > settings_.safety.max_hold_refusals) {
+    supervisor_.report(SafetyFault::kHoldRefused, state.time_s);
+  }
+  if (safe_stop_cycles_ == 0) {  // the stop starts now, from this cycle's state
+    safe_stop(supervisor_.kinematics_fresh(), command);
+    return true;
+  }
+  // Refused during the stop: hold where the arm is. The robot's own reading of its joints, when
+  // finite and within the joint range, is the nearest pose it accepts, even in a sample the
+  // supervisor rejected for another signal.
+  holding_ = true;
+  hold_qd_.setZero();
+  hold_q_ = brake_q_;
+  if (state.q_rad.size() == model_.nq() && state.q_rad.allFinite() &&
+      (state.q_rad.array() >= limit_lower_.array()).all() && (state.q_rad.array() <= limit_upper_.array()).all()) {
+    hold_q_ = state.q_rad;
+  }
+  low_level_.hold(hold_q_, command);
+  return true;
 }
 
 // The held reference's velocity decays at brake_rate (as the torque loops' brake), the reference
@@ -561,6 +611,7 @@ void Controller::shape_tasks() {
 }
 
 CycleStatus Controller::step(const RobotState& state, const ControllerTargets& targets, RobotCommand& command) {
+  ++steps_;
   const bool targets_accepted = apply(targets);
   const bool had_good = supervisor_.has_good();
   const double previous_good_stamp = supervisor_.last_good_time();

@@ -78,8 +78,14 @@ public:
   /// One cycle: apply the targets, then estimate, QP, inverse dynamics, low level. The first
   /// usable state becomes the targets (hold where the arm is) before the given ones apply.
   CycleStatus step(const RobotState& state, const ControllerTargets& targets, RobotCommand& command);
-  /// A fault the caller found (e.g. WriteStatus != kOk from the robot): safe stop from the next step.
+  /// A fault the caller found (e.g. a robot fault): safe stop from the next step.
   void report_fault(SafetyFault fault, double time_s) { supervisor_.report(fault, time_s); }
+  /// The robot refused `command` (WriteStatus != kOk): a fault, answered in the same cycle. Writes
+  /// into `command` what to send in its place (the safe stop's command; a refused hold re-targeted
+  /// at the measured pose, the closest one the robot accepts) and returns true; false: nothing
+  /// better to send. A hold refused max_hold_refusals cycles in a row is the stop's own fault
+  /// (SafetyFault::kHoldRefused, supervisor().escalation()). Allocates nothing.
+  bool answer_refused_write(const RobotState& state, RobotCommand& command);
   /// One cycle with no new targets.
   CycleStatus step(const RobotState& state, RobotCommand& command) { return step(state, no_targets_, command); }
 
@@ -122,6 +128,8 @@ private:
   bool apply(const ControllerTargets& targets);
   void hold_previous(const RobotState& state, RobotCommand& command);
   void safe_stop(bool sample_good, RobotCommand& command);
+  void brake_state();
+  void keep_hold_acceptable();
   // Model terms, observer, wrench from the measured state; then, in the open-loop position mode,
   // the model terms of the integrated state the cycle runs on.
   void estimate(const RobotState& state, double dt);
@@ -167,6 +175,9 @@ private:
   long qp_fallbacks_in_row_ = 0;
   long cycles_since_good_ = 0;
   long safe_stop_cycles_ = 0;
+  long steps_ = 0;                    // step() calls
+  long refused_step_ = -2;            // the step of the latest refused write
+  long refusals_in_row_ = 0;          // refused writes in consecutive steps
   bool holding_ = false;
   bool brake_against_push_ = false;  // the safe stop's brake resists tau_ext (after a QP failure)
   Eigen::VectorXd hold_q_, hold_qd_;  // the safe stop's held reference, braking to rest (position loop)

@@ -59,6 +59,10 @@ struct SafetySettings {
   /// link) is no emergency: the brake blends in from the last torque command over this time, with
   /// no step in the motor torque (a 0.6 rad/s joint met the full brake with a 13.6 N.m step).
   double requested_stop_blend_s = 0.05;
+  /// A hold the robot refuses this many cycles in a row, although re-targeted at the measured pose
+  /// each time, is the stop's own fault (SafetyFault::kHoldRefused): Kortex's low-level servoing
+  /// faults after a few missed 1 kHz frames, so a few cycles is all the robot gives.
+  int max_hold_refusals = 5;
   /// Velocity guard of the torque loops, the last line behind the QP's velocity constraint: above
   /// guard_fraction x the drive's velocity limit, damping rate x (M_ii + I_r) x the excess, scaled
   /// down where coupled joints would ring (torque_guards.hpp).

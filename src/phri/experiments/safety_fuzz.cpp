@@ -203,8 +203,11 @@ public:
     if (io_.write(command_) != WriteStatus::kOk) {
       const bool injected = io_.fault_active() && io_.fault().kind == FaultKind::kWriteRefused;
       if (!injected) ++m.refused_writes;
-      cycle_.report_fault(SafetyFault::kWriteRefused, state.time_s);
       refusal_pending_ = true;
+      // Answered in the same cycle (controller.hpp); a second refusal counts as well.
+      if (cycle_.answer_refused_write(state, command_) && io_.write(command_) != WriteStatus::kOk && !injected) {
+        ++m.refused_writes;
+      }
     }
     const SimRobot::Truth& truth = robot_->truth();
     monitor_.update(truth.q_rad, truth.qd_rad_s, m);

@@ -74,6 +74,8 @@ public:
   const Eigen::VectorXd& breakaway() const { return breakaway_; }
   const CustomTorqueController& custom() const { return custom_; }
   const Eigen::VectorXd& position_reference() const { return q_ref_; }
+  /// The position loop's re-sync bound [rad] (below the robot's following-error fault).
+  double following_error() const { return following_error_rad_; }
   const Eigen::VectorXd& velocity_reference() const { return qd_ref_; }
   /// True once the position loop runs and stays requested: its reference is the integrated state.
   bool integrating_position() const {

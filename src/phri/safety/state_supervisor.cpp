@@ -24,18 +24,6 @@ int first_beyond(const Eigen::VectorXd& v, const Eigen::VectorXd& range, double 
   return -1;
 }
 
-// Faults found after the sample's sequence and stamp passed (its stamp can be the next reference).
-bool stamp_checked(SafetyFault f) {
-  switch (f) {
-    case SafetyFault::kNone: case SafetyFault::kPositionRange: case SafetyFault::kPositionJump:
-    case SafetyFault::kVelocityRange: case SafetyFault::kVelocityMismatch: case SafetyFault::kTorqueRange:
-    case SafetyFault::kCurrentRange: case SafetyFault::kTorqueCurrentMismatch: case SafetyFault::kFrozenValues:
-      return true;
-    default:
-      return false;
-  }
-}
-
 double median_of_three(double a, double b, double c) { return std::max(std::min(a, b), std::min(std::max(a, b), c)); }
 
 bool identical(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
@@ -80,6 +68,7 @@ StateSupervisor::StateSupervisor(const SensorRanges& ranges, const SupervisorSet
   check_settings(ranges_, settings_);
   last_good_ = RobotState(n_);
   previous_ = RobotState(n_);
+  candidate_q_ = candidate_qd_ = kinematic_q_ = kinematic_qd_ = Eigen::VectorXd::Zero(n_);
   for (ResidualTrack& track : residual_track_) track.resize(n_);
   residual_qd_ = Eigen::VectorXd::Zero(n_);
   residual_tau_[0] = residual_tau_[1] = Eigen::VectorXd::Zero(n_);
@@ -102,7 +91,9 @@ double StateSupervisor::ResidualTrack::update(int i, double residual, double acc
 
 void StateSupervisor::reset() {
   state_ = SupervisorState::kNormal;
-  has_good_ = has_previous_ = has_sequence_ = false;
+  has_good_ = has_previous_ = has_sequence_ = has_seen_ = has_candidate_ = has_kinematics_ = false;
+  kinematics_fresh_ = resync_ = false;
+  escalation_ = SafetyTransition{};
   frozen_since_s_ = -1.0;
   residual_updates_ = 0;
   good_in_row_ = bad_in_row_ = 0;
@@ -111,23 +102,51 @@ void StateSupervisor::reset() {
   sample_fault_joint_ = -1;
 }
 
-// The sample's sequence and stamp against the last ones seen (kNone: fresh).
-SafetyFault StateSupervisor::check_freshness(const RobotState& s) const {
-  if (!has_sequence_) return SafetyFault::kNone;
-  const auto advance = static_cast<std::int32_t>(s.joints.sequence - last_sequence_);
+// The sample's sequence and stamp against a reference's (kNone: it follows on from it).
+SafetyFault StateSupervisor::freshness_against(const RobotState& s, std::uint32_t sequence, double stamp,
+                                               bool stamp_known) const {
+  const auto advance = static_cast<std::int32_t>(s.joints.sequence - sequence);
   if (advance <= 0) return SafetyFault::kStale;
   const long max_advance = static_cast<long>(std::ceil(settings_.max_degraded_s / settings_.period_s)) + 1;
   if (advance > max_advance) return SafetyFault::kStampJump;  // a jumping sequence: frames lost or garbage
-  if (!has_good_) return SafetyFault::kNone;
-  const double dt = s.joints.stamp_s - last_stamp_;
+  if (!stamp_known) return SafetyFault::kNone;
+  const double dt = s.joints.stamp_s - stamp;
   if (!(dt > 0.0)) return dt == 0.0 ? SafetyFault::kStampFrozen : SafetyFault::kStampJump;
   if (dt > settings_.max_degraded_s + static_cast<double>(advance) * settings_.period_s) return SafetyFault::kStampJump;
   return SafetyFault::kNone;
 }
 
-// Ranges of every value and the step since the last good sample; `joint` names the first culprit.
-SafetyFault StateSupervisor::check_ranges(const RobotState& s, int& joint) const {
+// Fresh against the reference; else, a sample that follows on from the last one whose counter or
+// stamp jumped re-synchronises (a gap, or a counter that restarted, is not invalid for ever).
+SafetyFault StateSupervisor::check_freshness(const RobotState& s) {
+  resync_ = false;
+  if (has_seen_ && s.joints.sequence == seen_sequence_) return SafetyFault::kStale;  // the same frame again
+  if (!has_sequence_) return SafetyFault::kNone;
+  const SafetyFault fault = freshness_against(s, last_sequence_, last_stamp_, has_good_);
+  if (fault == SafetyFault::kNone) return fault;
+  if (has_candidate_ && freshness_against(s, candidate_sequence_, candidate_stamp_, true) == SafetyFault::kNone) {
+    resync_ = true;
+    return SafetyFault::kNone;
+  }
+  return fault;
+}
+
+void StateSupervisor::keep_candidate(const RobotState& s) {
+  candidate_sequence_ = s.joints.sequence;
+  candidate_stamp_ = s.joints.stamp_s;
+  candidate_q_ = s.q_rad;
+  candidate_qd_ = s.qd_rad_s;
+  has_candidate_ = true;
+}
+
+// q and q̇ within range, and consistent with the last plausible kinematics (after a re-sync: with
+// the sample it follows on from); `joint` names the first culprit.
+SafetyFault StateSupervisor::check_kinematics(const RobotState& s, int& joint) const {
   const SupervisorSettings& c = settings_;
+  const bool compare = resync_ || has_kinematics_;
+  const Eigen::VectorXd& q_ref = resync_ ? candidate_q_ : kinematic_q_;
+  const Eigen::VectorXd& qd_ref = resync_ ? candidate_qd_ : kinematic_qd_;
+  const double stamp_ref = resync_ ? candidate_stamp_ : kinematic_stamp_;
   for (int i = 0; i < n_; ++i) {
     joint = i;
     const double q = s.q_rad[i];
@@ -136,19 +155,26 @@ SafetyFault StateSupervisor::check_ranges(const RobotState& s, int& joint) const
     }
     const double v_limit = ranges_.velocity_limit[i];
     if (std::abs(s.qd_rad_s[i]) > c.velocity_bound_factor * v_limit) return SafetyFault::kVelocityRange;
-    if (has_good_) {
-      const double dt = std::max(s.joints.stamp_s - last_good_.joints.stamp_s, c.period_s);
-      const double step = std::abs(q - last_good_.q_rad[i]);
+    if (compare) {
+      const double dt = std::max(s.joints.stamp_s - stamp_ref, c.period_s);
+      const double step = std::abs(q - q_ref[i]);
       if (step > c.position_step_factor * v_limit * dt + c.position_step_slack_rad) return SafetyFault::kPositionJump;
-      // q̇ must agree with the position's own rate: over the gap since the last good sample the mean
-      // velocity is (q̇ + q̇_last) / 2 at constant acceleration. A q̇ offset or spike within range
+      // q̇ must agree with the position's own rate: over the gap since the reference the mean
+      // velocity is (q̇ + q̇_ref) / 2 at constant acceleration. A q̇ offset or spike within range
       // would otherwise make the controller brake against a phantom motion.
-      const double mean_qd = 0.5 * (s.qd_rad_s[i] + last_good_.qd_rad_s[i]);
-      if (std::abs(mean_qd - (q - last_good_.q_rad[i]) / dt) > c.velocity_consistency_rad_s + 2.0 * c.encoder_quantum_rad / dt) {
+      const double mean_qd = 0.5 * (s.qd_rad_s[i] + qd_ref[i]);
+      if (std::abs(mean_qd - (q - q_ref[i]) / dt) > c.velocity_consistency_rad_s + 2.0 * c.encoder_quantum_rad / dt) {
         return SafetyFault::kVelocityMismatch;
       }
     }
   }
+  joint = -1;
+  return SafetyFault::kNone;
+}
+
+// τ_s and the current within what the drives can produce.
+SafetyFault StateSupervisor::check_drive_ranges(const RobotState& s, int& joint) const {
+  const SupervisorSettings& c = settings_;
   if ((joint = first_beyond(s.tau_sensor_Nm, ranges_.torque_range, c.torque_range_factor)) >= 0) {
     return SafetyFault::kTorqueRange;
   }
@@ -159,22 +185,33 @@ SafetyFault StateSupervisor::check_ranges(const RobotState& s, int& joint) const
   return SafetyFault::kNone;
 }
 
-SafetyFault StateSupervisor::classify(const RobotState& s, int& joint) const {
+// The joint part first (its verdict feeds the brake's kinematics), then torque and current.
+SafetyFault StateSupervisor::classify(const RobotState& s, int& joint) {
   joint = -1;
+  kinematics_passed_ = header_passed_ = false;
   if (s.q_rad.size() != n_ || s.qd_rad_s.size() != n_ || s.tau_sensor_Nm.size() != n_ ||
       (s.current.valid && s.current_A.size() != n_)) {
     return SafetyFault::kSize;
   }
   if (s.fault) return SafetyFault::kRobotFault;
-  if (!s.joints.valid || !s.torque.valid) return SafetyFault::kInvalid;
-  for (const Eigen::VectorXd* v : {&s.q_rad, &s.qd_rad_s, &s.tau_sensor_Nm}) {
+  if (!s.joints.valid) return SafetyFault::kInvalid;
+  for (const Eigen::VectorXd* v : {&s.q_rad, &s.qd_rad_s}) {
     if ((joint = first_not_finite(*v)) >= 0) return SafetyFault::kNotFinite;
   }
-  if (s.current.valid && (joint = first_not_finite(s.current_A)) >= 0) return SafetyFault::kNotFinite;
   if (!std::isfinite(s.joints.stamp_s)) return SafetyFault::kStampJump;
   const SafetyFault fresh = check_freshness(s);
-  if (fresh != SafetyFault::kNone) return fresh;
-  return check_ranges(s, joint);
+  if (fresh != SafetyFault::kNone) {
+    if (fresh != SafetyFault::kStale || s.joints.sequence != last_sequence_) keep_candidate(s);
+    return fresh;
+  }
+  header_passed_ = true;
+  const SafetyFault kinematic = check_kinematics(s, joint);
+  if (kinematic != SafetyFault::kNone) return kinematic;
+  kinematics_passed_ = true;
+  if (!s.torque.valid) return SafetyFault::kInvalid;
+  if ((joint = first_not_finite(s.tau_sensor_Nm)) >= 0) return SafetyFault::kNotFinite;
+  if (s.current.valid && (joint = first_not_finite(s.current_A)) >= 0) return SafetyFault::kNotFinite;
+  return check_drive_ranges(s, joint);
 }
 
 // Real sensors carry noise: q̇, τ_s and the current bit-identical for frozen_s while the sequence
@@ -265,10 +302,27 @@ bool StateSupervisor::check(const RobotState& s) {
       has_previous_ = true;
     }
   }
-  if (fault != SafetyFault::kStale && fault != SafetyFault::kSize) {
+  if (fault != SafetyFault::kSize) {
+    seen_sequence_ = s.joints.sequence;
+    has_seen_ = true;
+  }
+  // The reference moves to every sample whose sequence and stamp passed.
+  if (header_passed_) {
     last_sequence_ = s.joints.sequence;
-    if (stamp_checked(fault)) last_stamp_ = s.joints.stamp_s;
+    last_stamp_ = s.joints.stamp_s;
     has_sequence_ = true;
+    if (resync_) {
+      ++resyncs_;
+      has_candidate_ = false;
+    }
+  }
+  kinematics_fresh_ = kinematics_passed_ && fault != SafetyFault::kFrozenValues;
+  if (kinematics_fresh_) {
+    if (fault == SafetyFault::kNone) check_gap(s);
+    kinematic_q_ = s.q_rad;
+    kinematic_qd_ = s.qd_rad_s;
+    kinematic_stamp_ = s.joints.stamp_s;
+    has_kinematics_ = true;
   }
   if (fault == SafetyFault::kNone) {
     accept(s);
@@ -278,6 +332,16 @@ bool StateSupervisor::check(const RobotState& s) {
   }
   reject(s, fault, joint);
   return false;
+}
+
+// A good sample after a gap longer than the degraded budget, in both the sequence and the stamps
+// (the control thread stalled, frames were lost): the robot ran that long on its last command.
+void StateSupervisor::check_gap(const RobotState& s) {
+  if (!has_good_) return;
+  const double by_sequence =
+      static_cast<double>(static_cast<std::uint32_t>(s.joints.sequence - last_good_.joints.sequence)) * settings_.period_s;
+  const double gap = std::min(s.joints.stamp_s - last_good_.joints.stamp_s, by_sequence);
+  if (gap > settings_.max_degraded_s + 0.5 * settings_.period_s) report(SafetyFault::kDegradedTooLong, s.time_s);
 }
 
 void StateSupervisor::accept(const RobotState& s) {
@@ -330,7 +394,12 @@ void StateSupervisor::reject(const RobotState& s, SafetyFault fault, int joint) 
 }
 
 void StateSupervisor::report(SafetyFault fault, double t, int joint) {
-  if (state_ == SupervisorState::kSafeStop) return;
+  if (state_ == SupervisorState::kSafeStop) {
+    if (fault == SafetyFault::kHoldRefused && escalation_.reason == SafetyFault::kNone) {
+      escalation_ = SafetyTransition{t, state_, state_, fault, joint};
+    }
+    return;
+  }
   transition(SupervisorState::kSafeStop, fault, joint, t);
 }
 

@@ -9,7 +9,13 @@
 //   sequence advances (real sensors always carry noise).
 //
 // An implausible sample is treated as a missing one: the controller keeps the last good state and
-// does not feed its estimators (a single spike must never read as a push). States:
+// does not feed its estimators (a single spike must never read as a push). A sample whose joint
+// part (q, q̇) passed while its torque or current did not still updates the kinematics the safe
+// stop brakes on. A gap is not a permanent invalid state: a sample whose sequence or stamp jumped
+// is missing, and the next one that follows on from it (sequence +1.., stamp consistent, its
+// motion consistent with it) re-synchronises; a gap longer than max_degraded_s (in both the
+// sequence and the stamps: a stall, not a garbled counter) is a safe stop that brakes on the
+// samples after it. States:
 //
 //   kNormal   --implausible or missing sample-->  kDegraded (last good state held)
 //   kDegraded --`recovery_samples` good samples in a row--> kNormal
@@ -53,7 +59,8 @@ enum class SafetyFault : std::uint8_t {
   kVelocityMismatch,///< q̇ disagrees with the rate of q between consecutive samples
   kTorqueCurrentMismatch,  ///< τ_s disagrees with the motor torque K_T G_r i beyond friction and rotor inertia
   kRobotStopRequest,///< the robot asks for a safe stop while its samples are good (a degraded link)
-  kLast = kRobotStopRequest,
+  kHoldRefused,     ///< during the safe stop the robot refused its hold for several cycles in a row
+  kLast = kHoldRefused,
 };
 
 constexpr std::string_view to_string(SupervisorState s) {
@@ -80,6 +87,7 @@ constexpr std::string_view to_string(SafetyFault f) {
     case SafetyFault::kVelocityMismatch: return "velocity_mismatch";
     case SafetyFault::kTorqueCurrentMismatch: return "torque_current_mismatch";
     case SafetyFault::kRobotStopRequest: return "robot_stop_request";
+    case SafetyFault::kHoldRefused: return "hold_refused";
     case SafetyFault::kTorqueRange: return "torque_out_of_range";
     case SafetyFault::kCurrentRange: return "current_out_of_range";
     case SafetyFault::kFrozenValues: return "frozen_values";
@@ -184,7 +192,8 @@ public:
   /// Checks one sample; true: it is plausible and fresh (last_good() is now this sample). In
   /// kSafeStop the check still runs (the brake uses plausible measurements) but the state stays.
   bool check(const RobotState& state);
-  /// A fault found outside the state: safe stop, latched, at robot time t.
+  /// A fault found outside the state: safe stop, latched, at robot time t. In the safe stop, a
+  /// fault of the stop itself (kHoldRefused) is kept as its escalation().
   void report(SafetyFault fault, double t, int joint = -1);
   /// Back to kNormal with no good sample yet (after the operator cleared the cause).
   void reset();
@@ -196,6 +205,18 @@ public:
   const RobotState& last_good() const { return last_good_; }
   /// Robot time of the last good sample (its stamp) [s].
   double last_good_time() const { return last_good_.joints.stamp_s; }
+  /// The latest plausible joint positions and velocities, and their stamp: the last good sample's,
+  /// or a later one whose torque or current alone was implausible. kinematics_fresh(): from the
+  /// latest sample checked.
+  const Eigen::VectorXd& kinematic_q() const { return kinematic_q_; }
+  const Eigen::VectorXd& kinematic_qd() const { return kinematic_qd_; }
+  double kinematic_stamp() const { return kinematic_stamp_; }
+  bool has_kinematics() const { return has_kinematics_; }
+  bool kinematics_fresh() const { return kinematics_fresh_; }
+  /// Samples re-synchronised after a gap or a jumped counter.
+  long resyncs() const { return resyncs_; }
+  /// A fault of the safe stop itself (reason kNone: none).
+  const SafetyTransition& escalation() const { return escalation_; }
   /// The fault of the last implausible sample (kNone if the last one was good), its joint.
   SafetyFault sample_fault() const { return sample_fault_; }
   int sample_fault_joint() const { return sample_fault_joint_; }
@@ -208,9 +229,13 @@ public:
   const SensorRanges& ranges() const { return ranges_; }
 
 private:
-  SafetyFault classify(const RobotState& s, int& joint) const;
-  SafetyFault check_freshness(const RobotState& s) const;
-  SafetyFault check_ranges(const RobotState& s, int& joint) const;
+  SafetyFault classify(const RobotState& s, int& joint);
+  SafetyFault check_freshness(const RobotState& s);
+  SafetyFault freshness_against(const RobotState& s, std::uint32_t sequence, double stamp, bool stamp_known) const;
+  SafetyFault check_kinematics(const RobotState& s, int& joint) const;
+  SafetyFault check_drive_ranges(const RobotState& s, int& joint) const;
+  void keep_candidate(const RobotState& s);
+  void check_gap(const RobotState& s);
   bool frozen(const RobotState& s);
   int first_torque_current_mismatch(const RobotState& s);
   void accept(const RobotState& s);
@@ -225,9 +250,27 @@ private:
   RobotState previous_;  // the latest sample with the right sizes, good or not (frozen values)
   bool has_good_ = false;
   bool has_previous_ = false;
-  std::uint32_t last_sequence_ = 0;  // of the latest sample seen, good or not
+  // Freshness reference: the latest sample whose sequence and stamp passed.
+  std::uint32_t last_sequence_ = 0;
   double last_stamp_ = 0.0;
   bool has_sequence_ = false;
+  std::uint32_t seen_sequence_ = 0;  // of the latest sample with a readable header (a repeat is stale)
+  bool has_seen_ = false;
+  // The latest sample whose sequence or stamp jumped: the next one may follow on from it (re-sync).
+  std::uint32_t candidate_sequence_ = 0;
+  double candidate_stamp_ = 0.0;
+  Eigen::VectorXd candidate_q_, candidate_qd_;
+  bool has_candidate_ = false;
+  bool resync_ = false;              // this sample follows on from the candidate
+  long resyncs_ = 0;
+  // The kinematics the safe stop brakes on (see kinematic_q()).
+  Eigen::VectorXd kinematic_q_, kinematic_qd_;
+  double kinematic_stamp_ = 0.0;
+  bool has_kinematics_ = false;
+  bool kinematics_fresh_ = false;
+  bool kinematics_passed_ = false;   // classify(): the joint part of this sample passed
+  bool header_passed_ = false;       // classify(): its sequence and stamp passed
+  SafetyTransition escalation_;
   double frozen_since_s_ = -1.0;     // stamp at which the values stopped changing (-1: changing)
   // The residual K_T G_r i - τ_s - I_r G_r^2 a_r - τ_f under one hypothesis on the transmission.
   struct ResidualTrack {
