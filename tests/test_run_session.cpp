@@ -226,9 +226,12 @@ TEST(RunSession, BadJointDataBeyondTheDegradedBudgetEndInOneSafeStopHoldingTheLa
 }
 
 // A refused write leaves the robot on its previous command, which the controller no longer
-// controls: it is a fault. The loop reports it to the controller, which stops safely from the
-// next cycle (its hold commands are written, refused while the robot refuses, then accepted).
-TEST(RunSession, ARefusedWriteIsAFaultTheLoopActsOnWithASafeStop) {
+// controls: it is a fault, answered in the same cycle. The loop hands it to the controller, whose
+// safe stop sends a second command at once (here the arm is at rest: the hold where the robot says
+// it is); while the robot refuses, each cycle's hold is re-targeted at the pose it reports, and a
+// hold refused for more than max_hold_refusals cycles is the stop's own fault. Once the robot
+// accepts again, the last hold stays.
+TEST(RunSession, ARefusedWriteIsAFaultTheLoopAnswersInTheSameCycle) {
   Session session;
   session.robot_.refuse_writes({.first = 100, .count = 50}, phri::WriteStatus::kFault);
   const phri::RunSummary summary = session.run(0.3);
@@ -237,14 +240,19 @@ TEST(RunSession, ARefusedWriteIsAFaultTheLoopActsOnWithASafeStop) {
   ASSERT_TRUE(summary.safe_hold);
   EXPECT_NE(summary.safe_hold_reason.find("normal -> safe_stop (write_refused) at t = 0.100 s"), std::string::npos)
       << summary.safe_hold_reason;
-  // From write 101 on: the hold of the last reference (the arm at rest: no braking), within the
-  // servo's following error of the last read before the refusal; the arm, once the robot accepts
-  // again, holds it.
-  for (std::size_t k = 100; k < session.positions_.size(); ++k) {
-    ASSERT_EQ(session.positions_[k], session.positions_[100]) << "write " << k + 1;
+  EXPECT_EQ(session.controller_.supervisor().escalation().reason, phri::SafetyFault::kHoldRefused);
+  EXPECT_NE(session.out_.str().find("the stop failed: hold_refused"), std::string::npos) << session.out_.str();
+  // Two writes per cycle while refused: writes 100..149 are 25 cycles, the answer the second of each.
+  ASSERT_GT(session.positions_.size(), 160u);
+  for (std::size_t k = 99; k < 149; ++k) {
+    EXPECT_EQ(session.statuses_[k], phri::WriteStatus::kFault) << "write " << k + 1;
+    EXPECT_LE((session.positions_[k] - session.read_q_[k]).cwiseAbs().maxCoeff(), 1e-3) << "write " << k + 1;
   }
-  EXPECT_EQ(session.robot_.state().q_rad, session.positions_[100]);
-  EXPECT_LE((session.positions_[100] - session.read_q_[99]).cwiseAbs().maxCoeff(), 1e-3);
+  for (std::size_t k = 149; k < session.positions_.size(); ++k) {
+    ASSERT_EQ(session.statuses_[k], phri::WriteStatus::kOk) << "write " << k + 1;
+    ASSERT_EQ(session.positions_[k], session.positions_[149]) << "write " << k + 1;
+  }
+  EXPECT_EQ(session.robot_.state().q_rad, session.positions_[149]);
 }
 
 // A scripted stop: the FSM brakes the start-up move, holds, and the loop stops at the cycle where

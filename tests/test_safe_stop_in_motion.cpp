@@ -95,6 +95,7 @@ TEST(SafeStopInMotion, OneSequenceJumpUnderAPushIsOneMissingSample) {
     });
     expect_safe_end(rig, clean, what);
     EXPECT_FALSE(rig.cycle_.supervisor().safe_stop()) << "one missing sample is no reason to stop";
+    EXPECT_LT(phri::test::distance(rig.q(), clean.q()), 0.02) << "on the fault-free path";
   }
 }
 
@@ -116,6 +117,32 @@ TEST(SafeStopInMotion, ATorqueSensorOffsetStopsWithoutOverspeed) {
     }
   }
   }
+}
+
+}  // namespace
+
+namespace {
+
+// A robot that refuses every command: the first refusal starts the stop in the same cycle, the
+// next ones re-target the hold at the pose the robot reports, and a hold refused more than
+// max_hold_refusals cycles in a row is the stop's own fault.
+TEST(SafeStopInMotion, ARefusedHoldIsRetargetedEachCycleAndThenAFaultOfItsOwn) {
+  Rig rig(ComplianceMode::kNullSpace, LowLevelMode::kCurrent);
+  rig.run(0.5);
+  const int allowed = rig.cycle_.settings().safety.max_hold_refusals;
+  for (int k = 0; k <= allowed + 1; ++k) {
+    const phri::RobotState& state = rig.robot_.read();
+    rig.cycle_.step(state, rig.targets_, rig.command_);
+    ASSERT_TRUE(rig.cycle_.answer_refused_write(state, rig.command_));
+    EXPECT_TRUE(rig.cycle_.supervisor().safe_stop());
+    if (k >= 1) {
+      EXPECT_EQ(rig.command_.mode, LowLevelMode::kPosition);
+      EXPECT_EQ(rig.command_.q_rad, state.q_rad) << "the hold where the robot says it is";
+    }
+    const phri::SafetyFault escalation = rig.cycle_.supervisor().escalation().reason;
+    EXPECT_EQ(escalation, k >= allowed ? phri::SafetyFault::kHoldRefused : phri::SafetyFault::kNone) << k;
+  }
+  EXPECT_EQ(rig.cycle_.supervisor().safe_stop_transition().reason, phri::SafetyFault::kWriteRefused);
 }
 
 }  // namespace

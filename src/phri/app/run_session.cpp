@@ -245,6 +245,11 @@ private:
         if (summary_.safety_transitions == kMaxPrintedTransitions) out_ << "phri: safety: further transitions are only logged\n";
       }
     }
+    if (supervisor.escalation().reason != SafetyFault::kNone && !escalation_shown_) {
+      escalation_shown_ = true;
+      out_ << "phri: safety: the stop failed: " << to_string(supervisor.escalation().reason) << " at t = "
+           << supervisor.escalation().time_s << " s\n";
+    }
     if (summary_.safe_hold || status != CycleStatus::kSafeStop) return;
     safe_hold("safety: " + describe(supervisor.safe_stop_transition()));
   }
@@ -360,6 +365,7 @@ private:
   LivePush push_;
   LiveSnapshot snapshot_;
   bool paused_ = false;
+  bool escalation_shown_ = false;  // the stop's own fault (a refused hold) was printed
   int steps_ = 0;
 };
 

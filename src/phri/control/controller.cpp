@@ -615,9 +615,13 @@ CycleStatus Controller::step(const RobotState& state, const ControllerTargets& t
   const bool targets_accepted = apply(targets);
   const bool had_good = supervisor_.has_good();
   const double previous_good_stamp = supervisor_.last_good_time();
+  const std::uint32_t previous_good_sequence = supervisor_.last_good().joints.sequence;
   const bool good = supervisor_.check(state);
-  // The observer integrates over the time since the last sample it saw (missed ones included).
-  const double dt = had_good ? std::clamp(state.joints.stamp_s - previous_good_stamp, settings_.period_s,
+  // The observer integrates over the time since the last sample it saw (missed ones included): by
+  // the stamps and by the sequence, whichever says less (after a re-sync one of them jumped).
+  const double by_sequence =
+      static_cast<double>(static_cast<std::uint32_t>(state.joints.sequence - previous_good_sequence)) * settings_.period_s;
+  const double dt = had_good ? std::clamp(std::min(state.joints.stamp_s - previous_good_stamp, by_sequence), settings_.period_s,
                                           settings_.period_s + supervisor_.settings().max_degraded_s)
                              : settings_.period_s;
   if (supervisor_.safe_stop()) {
