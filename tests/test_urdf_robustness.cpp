@@ -221,6 +221,16 @@ TEST(UrdfOrigins, AnglesInDegreesAndHugeOffsetsAreRefused) {
                       {.element = "joint 'joint_3' <origin> xyz", .mentions = {"1e+308", "100 m"}});
 }
 
+// Finite but meaningless limits (NaN and infinity were already refused).
+TEST(UrdfOrigins, LimitsBeyondAnyArmAreRefused) {
+  const std::string limit = "<limit effort=\"39\" velocity=\"1.3963\"/>";
+  ASSERT_NE(read_file(kGen3Urdf).find(limit), std::string::npos);
+  expect_config_error(loading(gen3_with(limit, "<limit effort=\"39\" velocity=\"1e308\"/>")),
+                      {.element = "joint 'joint_1' <limit>", .mentions = {"velocity 1e+308"}});
+  expect_config_error(loading(gen3_with(limit, "<limit effort=\"1e308\" velocity=\"1.3963\"/>")),
+                      {.element = "joint 'joint_1' <limit>", .mentions = {"effort 1e+308"}});
+}
+
 TEST(UrdfOrigins, RoundedTurnsAndCommentsAreNotNumbersToRefuse) {
   // 6.2832 is 2 pi rounded up; a comment's text is no origin.
   EXPECT_NO_THROW(phri::Model::from_urdf_string(

@@ -98,6 +98,10 @@ bool is_movable(const urdf::Joint& joint) { return joint.type != urdf::Joint::FI
 // corrupted file or degrees typed as radians. No arm's frame lies 100 m from its parent.
 constexpr double kMaxOriginAngle_rad = kMaxRevoluteLimit_rad + 0.01;
 constexpr double kMaxOriginOffset_m = 100.0;
+// <limit>: a joint speed of 100 rad/s (or m/s) and an effort of 1e5 N.m (or N) are beyond any arm's
+// drive (an industrial arm's strongest joint: ~1e4 N.m); a prismatic travel within 100 m.
+constexpr double kMaxLimitVelocity = 100.0;
+constexpr double kMaxLimitEffort = 1e5;
 
 // The value of attribute `name` in the tag text `tag` ("" when absent).
 std::string attribute(const std::string& tag, const std::string& name) {
@@ -342,6 +346,17 @@ private:
       }
       if (limits->velocity < 0.0) fail(where + " <limit>", "velocity must be >= 0 (got " + format_general(limits->velocity, 6) + ")");
       if (limits->effort < 0.0) fail(where + " <limit>", "effort must be >= 0 (got " + format_general(limits->effort, 6) + ")");
+      if (limits->velocity > kMaxLimitVelocity) {
+        fail(where + " <limit>", "velocity " + format_general(limits->velocity, 6) + " is beyond any arm's joint (<= 100)");
+      }
+      if (limits->effort > kMaxLimitEffort) {
+        fail(where + " <limit>", "effort " + format_general(limits->effort, 6) + " is beyond any arm's drive (<= 1e5)");
+      }
+      if (joint.type == JointType::kPrismatic &&
+          std::max(std::abs(limits->lower), std::abs(limits->upper)) > kMaxOriginOffset_m) {
+        fail(where + " <limit>", "prismatic limits [" + format_general(limits->lower, 6) + ", " +
+                                     format_general(limits->upper, 6) + "] m reach beyond 100 m");
+      }
       // URDF uses 0 for "not given" in practice; the controller configuration can set limits.
       if (limits->velocity > 0.0) joint.velocity_limit = limits->velocity;
       if (limits->effort > 0.0) joint.effort_limit = limits->effort;
