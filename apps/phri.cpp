@@ -17,7 +17,10 @@
 //   phri experiment dashboard-load [options]   loop cycle time with vs without the dashboard and its clients
 //   phri ft-monitor [--device DEV | --emulate] the Bota F/T sensor's wrench and counters (apps/ft_monitor.cpp)
 // Every bad argument or file, and every failure of a run or an experiment (phri::Error: ConfigError,
-// IoError, ExperimentError), gives one line on stderr naming what is wrong and a non-zero exit status.
+// IoError, ExperimentError), gives one line on stderr naming what is wrong and exit status 2.
+// `phri run` exits 0, 3 after a safe hold, and 128 + the signal's number (130 SIGINT, 143 SIGTERM)
+// when a signal ended it early: the run then stops as if its duration had run out, and the log,
+// summary.md and figure are still written (a second signal kills as usual).
 #include "ft_monitor.hpp"
 #include "kortex_backend.hpp"
 
@@ -29,6 +32,7 @@
 #include <phri/core/error.hpp>
 #include <phri/core/format.hpp>
 #include <phri/core/process.hpp>
+#include <phri/sim/mujoco_handles.hpp>
 #include <phri/sim/sim_robot.hpp>
 #include <phri/sim/urdf_plant.hpp>
 #include <phri/core/version.hpp>
@@ -48,7 +52,9 @@
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -161,6 +167,48 @@ std::unique_ptr<phri::DashboardServer> start_dashboard(const DashboardArguments&
   return server;
 }
 
+// SIGINT and SIGTERM during `phri run`: the handler only stores lock-free atomics; the loop polls
+// the flag once a cycle (RunOptions::stop_requested). SA_RESETHAND: a second signal kills.
+std::atomic<bool> g_stop_requested{false};
+std::atomic<int> g_stop_signal{0};
+static_assert(std::atomic<bool>::is_always_lock_free && std::atomic<int>::is_always_lock_free);
+
+extern "C" void request_stop(int signal) {
+  g_stop_signal.store(signal);
+  g_stop_requested.store(true);
+}
+
+class StopOnSignals {
+public:
+  StopOnSignals() {
+    struct sigaction action {};
+    action.sa_handler = request_stop;
+    action.sa_flags = SA_RESETHAND;
+    sigemptyset(&action.sa_mask);
+    sigaction(SIGINT, &action, &old_int_);
+    sigaction(SIGTERM, &action, &old_term_);
+  }
+  ~StopOnSignals() {
+    sigaction(SIGINT, &old_int_, nullptr);
+    sigaction(SIGTERM, &old_term_, nullptr);
+  }
+  StopOnSignals(const StopOnSignals&) = delete;
+  StopOnSignals& operator=(const StopOnSignals&) = delete;
+
+private:
+  struct sigaction old_int_ {};
+  struct sigaction old_term_ {};
+};
+
+// 128 + the signal's number when one ended the run (said on stderr), 3 after a safe hold, else 0.
+int run_exit_status(const phri::RunSummary& summary, double duration_s) {
+  if (!summary.interrupted) return summary.safe_hold ? 3 : 0;
+  const int signal = g_stop_signal.load();
+  std::fprintf(stderr, "phri: interrupted by %s after %.3f s of the %.1f s run; it ended there, its files written\n",
+               signal == SIGINT ? "SIGINT" : "SIGTERM", summary.simulated_s, duration_s);
+  return 128 + signal;
+}
+
 struct RunArguments {
   DashboardArguments dashboard;
   std::string config_path;
@@ -230,6 +278,10 @@ int run_command(const RunArguments& args) {
 
   phri::RunOptions options;
   if (dashboard || kortex) options.live = &live;
+  // Until the files are written. On the arm, Ctrl-C brakes to rest first (InterruptToStop replaces
+  // the SIGINT handler); SIGTERM ends the loop there too, then the backend's exit sequence.
+  const StopOnSignals stop_on_signals;
+  options.stop_requested = &g_stop_requested;
   std::optional<InterruptToStop> interrupt;
   if (kortex) interrupt.emplace(live);
   options.duration_s = config.run.duration_s;
@@ -253,7 +305,7 @@ int run_command(const RunArguments& args) {
     if (stats.dropped > 0 || stats.write_error) std::fprintf(stderr, "phri: warning: log incomplete\n");
     if (args.figure) draw_demo_figure(logger->path(), (out / "demo.png").string(), config.controller.compliance);
   }
-  return summary.safe_hold ? 3 : 0;
+  return run_exit_status(summary, config.run.duration_s);
 }
 
 // `--duration`: a finite number of seconds (CLI::Range lets NaN through: every comparison with it
@@ -272,6 +324,26 @@ CLI::Validator duration_seconds() {
         return std::string();
       },
       "SECONDS");
+}
+
+// Checks every command's options share, added after the commands are built: an empty --out would
+// write into the working directory; CLI11 reads a seed with strtoull, which wraps "-1" to 2^64 - 1.
+void add_shared_checks(CLI::App& app) {
+  const CLI::Validator non_empty(
+      [](std::string& text) { return text.empty() ? std::string("must not be empty") : std::string(); }, "PATH");
+  const CLI::Validator seed(
+      [](std::string& text) {
+        const bool digits = !text.empty() && text.find_first_not_of("0123456789") == std::string::npos;
+        return digits ? std::string() : "a seed is a whole number from 0 to 2^64 - 1, got '" + text + "'";
+      },
+      "SEED");
+  for (CLI::Option* option : app.get_options()) {
+    for (const std::string& name : option->get_lnames()) {
+      if (name == "out") option->check(non_empty);
+      if (name.find("seed") != std::string::npos) option->check(seed);
+    }
+  }
+  for (CLI::App* command : app.get_subcommands([](CLI::App*) { return true; })) add_shared_checks(*command);
 }
 
 CLI::App* add_run_command(CLI::App& app, RunArguments& args) {
@@ -573,8 +645,12 @@ std::string command_word_error(CLI::App& app, int argc, char** argv) {
     }
     const std::string word = argv[i];
     if (!word.empty() && word[0] == '-') {
-      // Before the first command only phri's own options (--help, --version) may come.
+      // Before the first command only phri's own options (--help, --version) may come. CLI11 prints
+      // the version and ignores whatever follows --version.
       const std::string name = word.substr(0, word.find('='));
+      if (level == &app && name == "--version" && i + 1 < argc) {
+        return "--version takes nothing after it, got '" + std::string(argv[i + 1]) + "'";
+      }
       if (level != &app || app.get_option_no_throw(name) != nullptr || name == "-h" || name == "--help") return "";
       return "unknown option '" + name + "' before the command (commands: " + names + ")";
     }
@@ -600,9 +676,17 @@ int print_error(const char* what) {
   return 2;
 }
 
+// Progress lines reach a pipe as they are printed, not at exit (std::cout writes through stdout:
+// sync_with_stdio stays on); MuJoCo's own messages become phri lines on stderr.
+void set_up_output() {
+  std::setvbuf(stdout, nullptr, _IOLBF, 0);
+  phri::route_mujoco_messages_to_stderr();
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
+  set_up_output();
   CLI::App app{"phri: control framework for physical human-robot interaction"};
   app.set_version_flag("--version", std::string("phri ") + phri::version());
   app.require_subcommand(1);
@@ -647,11 +731,13 @@ int main(int argc, char** argv) {
   FtMonitorArguments ft_args;
   const CLI::App* ft_monitor = add_ft_monitor_command(app, ft_args);
 
+  add_shared_checks(app);
   if (const std::string error = command_word_error(app, argc, argv); !error.empty()) return print_error(error.c_str());
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    // --help and --version exit 0; every refusal 2, as phri's own (CLI11 has a code per kind).
+    return app.exit(e) == 0 ? 0 : 2;
   }
   try {
     if (run->parsed()) return run_command(run_args);

@@ -233,6 +233,34 @@ TEST(Config, OutOfRangeValuesNameTheirPath) {
                       {.element = "plant.noise.torque_sensor_std_Nm", .file = "test.yaml"});
 }
 
+// Values that loaded and then meant nothing (issue 37): each refused naming its key; the ends of
+// the ranges still load.
+TEST(Config, NonsenseValuesNameTheirKey) {
+  expect_config_error(loading_demo_with("safety_distance_m: 0.015", "safety_distance_m: 0"),
+                      {.element = "controller.qp.collision.safety_distance_m", .mentions = {"> 0"}, .file = "test.yaml"});
+  expect_config_error(loading_demo_with("velocity_limit_fraction: 0.9", "velocity_limit_fraction: 1e-9"),
+                      {.element = "controller.qp.velocity_limit_fraction", .mentions = {"[0.05, 1]"}, .file = "test.yaml"});
+  expect_config_error(loading_demo_with("bias_samples: 200", "bias_samples: 0"),
+                      {.element = "controller.wrench.bias_samples", .mentions = {"[1, 1000000]"}, .file = "test.yaml"});
+  EXPECT_DOUBLE_EQ(load_edited("safety_distance_m: 0.015", "safety_distance_m: 0.001").controller.qp.collision.safety_distance, 0.001);
+  EXPECT_DOUBLE_EQ(load_edited("velocity_limit_fraction: 0.9", "velocity_limit_fraction: 0.05").controller.qp.velocity_limit_fraction, 0.05);
+  EXPECT_EQ(load_edited("bias_samples: 200", "bias_samples: 1").controller.wrench.bias_samples, 1);
+}
+
+// The reader's bounds (tests/test_yaml_reader.cpp) on a whole configuration: an alias bomb added
+// to the demo is refused at load, naming the file.
+TEST(Config, AnAliasBombIsRefusedAtLoad) {
+  std::string bomb = "lol: &l0 [lol, lol, lol, lol, lol, lol, lol, lol, lol]\n";
+  for (int level = 1; level < 9; ++level) {
+    const std::string n = std::to_string(level), previous = std::to_string(level - 1);
+    bomb.append("lol").append(n).append(": &l").append(n).append(" [");
+    for (int i = 0; i < 9; ++i) bomb.append(i == 0 ? "*l" : ", *l").append(previous);
+    bomb.append("]\n");
+  }
+  expect_config_error(loading_demo_with("run:                                     # the run itself", bomb + "run:"),
+                      {.mentions = {"alias bomb"}, .file = "test.yaml"});
+}
+
 // Sizes that would exhaust memory before the run starts: run.duration_s (one cycle time per period
 // is kept) and logging.buffer_rows (the log ring, ~700 B a row).
 TEST(Config, RunLengthAndLogRingAreCapped) {

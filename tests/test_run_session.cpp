@@ -24,6 +24,7 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cstdio>
 #include <fstream>
 #include <functional>
@@ -73,6 +74,7 @@ class Session {
       positions_.push_back(command.q_rad);
       read_q_.push_back(robot_.state().q_rad);
       finished_at_write_.push_back(fsm_.finished());
+      if (statuses_.size() == stop_at_write_) stop_requested_.store(true);  // as a signal handler would
     });
   }
 
@@ -83,6 +85,7 @@ class Session {
     options.real_time = real_time;
     options.status_line = false;
     options.phases = std::move(phases);
+    options.stop_requested = &stop_requested_;
     return phri::run_session(robot_, controller_, fsm_, nullptr, logger, options, out_);
   }
 
@@ -94,6 +97,8 @@ class Session {
   std::vector<Eigen::VectorXd> positions_;
   std::vector<Eigen::VectorXd> read_q_;
   std::vector<bool> finished_at_write_;
+  std::atomic<bool> stop_requested_{false};
+  std::size_t stop_at_write_ = 0;  ///< the write at which the stop is asked (0: never)
 };
 
 TEST(RunSession, RunsDurationOverPeriodCyclesOneReadAndOneWriteEach) {
@@ -116,6 +121,34 @@ TEST(RunSession, RunsDurationOverPeriodCyclesOneReadAndOneWriteEach) {
   // A partial period is one more cycle: ceil(0.2505 / 0.001) = 251.
   Session longer;
   EXPECT_EQ(longer.run(0.2505).cycles, 251u);
+}
+
+// A stop asked from outside (apps/phri.cpp's SIGINT/SIGTERM handler) during cycle 100 ends the
+// run after that cycle, as if its duration had run out: 100 cycles, summarized, said interrupted.
+TEST(RunSession, AStopRequestEndsTheRunAfterThatCycle) {
+  Session session;
+  session.stop_at_write_ = 100;
+  const phri::RunSummary summary = session.run(0.5, {{0.0, "startup"}, {0.05, "later"}});
+  EXPECT_TRUE(summary.interrupted);
+  EXPECT_EQ(summary.cycles, 100u);
+  EXPECT_EQ(session.robot_.reads(), 100u);
+  EXPECT_EQ(session.robot_.writes(), 100u);
+  EXPECT_NEAR(summary.simulated_s, 0.1, 1e-12);
+  ASSERT_EQ(summary.phases.size(), 2u);
+  EXPECT_NEAR(summary.phases[1].end_s, 0.1, 1e-12);
+  EXPECT_FALSE(summary.safe_hold);
+  std::ostringstream printed;
+  phri::print_run_summary(summary, printed);
+  EXPECT_NE(printed.str().find("100 cycles"), std::string::npos) << printed.str();
+  EXPECT_NE(printed.str().find("INTERRUPTED"), std::string::npos) << printed.str();
+  // Without a stop the same run is whole and not said interrupted.
+  Session whole;
+  const phri::RunSummary full = whole.run(0.5);
+  EXPECT_FALSE(full.interrupted);
+  EXPECT_EQ(full.cycles, 500u);
+  std::ostringstream full_printed;
+  phri::print_run_summary(full, full_printed);
+  EXPECT_EQ(full_printed.str().find("INTERRUPTED"), std::string::npos);
 }
 
 // The start-up's move, through the loop: after 0.5 s the arm has moved toward the home posture, at

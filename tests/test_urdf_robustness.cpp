@@ -204,4 +204,38 @@ TEST(UrdfInertia, AMissingInertialMidChainNamesTheLinkNotAMasslessJoint) {
   expect_config_error(loading(bare_end), {.element = "joint 'joint_7'", .mentions = {"moves no mass", "bracelet_link"}});
 }
 
+// ------------------------------------------------------------------------------- origins
+// urdfdom turns rpy into a quaternion, finite for any finite angle: the numbers are checked as
+// written (issue 37), each naming the joint or link and the attribute.
+TEST(UrdfOrigins, AnRpyOf1e308IsRefusedNamingTheJoint) {
+  expect_config_error(loading(gen3_with("rpy=\"1.5708 2.1343E-17 -1.1102E-16\"", "rpy=\"1e308 0 0\"")),
+                      {.element = "joint 'joint_2' <origin> rpy", .mentions = {"1e+308", "beyond one turn"}, .file = "bad.urdf"});
+}
+
+TEST(UrdfOrigins, AnglesInDegreesAndHugeOffsetsAreRefused) {
+  // An inertial's origin: the link is named.
+  expect_config_error(loading(gen3_with("<origin xyz=\"-4.4E-05 -0.09958 -0.013278\" rpy=\"0 0 0\"/>",
+                                        "<origin xyz=\"-4.4E-05 -0.09958 -0.013278\" rpy=\"0 90 0\"/>")),
+                      {.element = "link 'half_arm_1_link' <origin> rpy", .mentions = {"90", "degrees"}});
+  expect_config_error(loading(gen3_with("xyz=\"0 -0.21038 -0.006375\"", "xyz='0 -1e308 -0.006375'")),
+                      {.element = "joint 'joint_3' <origin> xyz", .mentions = {"1e+308", "100 m"}});
+}
+
+// Finite but meaningless limits (NaN and infinity were already refused).
+TEST(UrdfOrigins, LimitsBeyondAnyArmAreRefused) {
+  const std::string limit = "<limit effort=\"39\" velocity=\"1.3963\"/>";
+  ASSERT_NE(read_file(kGen3Urdf).find(limit), std::string::npos);
+  expect_config_error(loading(gen3_with(limit, "<limit effort=\"39\" velocity=\"1e308\"/>")),
+                      {.element = "joint 'joint_1' <limit>", .mentions = {"velocity 1e+308"}});
+  expect_config_error(loading(gen3_with(limit, "<limit effort=\"1e308\" velocity=\"1.3963\"/>")),
+                      {.element = "joint 'joint_1' <limit>", .mentions = {"effort 1e+308"}});
+}
+
+TEST(UrdfOrigins, RoundedTurnsAndCommentsAreNotNumbersToRefuse) {
+  // 6.2832 is 2 pi rounded up; a comment's text is no origin.
+  EXPECT_NO_THROW(phri::Model::from_urdf_string(
+      gen3_with("rpy=\"1.5708 2.1343E-17 -1.1102E-16\"", "rpy=\"6.2832 0 -6.2832\"")));
+  EXPECT_NO_THROW(phri::Model::from_urdf_string(gen3_plus("<!-- <origin rpy=\"1e308 0 0\"/> -->")));
+}
+
 }  // namespace

@@ -16,6 +16,7 @@ Mutations (the table CASES below):
     ("text", "old", "new")                    the first occurrence of a text (YAML syntax cases:
                                               duplicate keys and nulls, which PyYAML cannot write)
     ("xml", "tag[@attr='v']/child", "attribute ...", value)   attributes of an XML element (URDF, MJCF)
+    ("whole", text)                           the whole file replaced (an empty MJCF)
 """
 import pathlib
 import re
@@ -39,6 +40,10 @@ FOLDED = [0.0, 2.2, 0.0, 2.5, 0.0, 2.0, 0.0]
 GEN3_TORQUE_LIMITS = [95, 95, 95, 95, 26, 45, 26]
 GEN3_VELOCITY_LIMITS = [2.09, 2.09, 2.09, 2.09, 3.05, 3.05, 3.05]
 
+# A "billion laughs" of 9 levels of 9 aliases (387 million strings in ~550 bytes), as a top-level key.
+ALIAS_BOMB = "lol0: &l0 [lol, lol, lol, lol, lol, lol, lol, lol, lol]\n" + "".join(
+    f"lol{i}: &l{i} [" + ", ".join([f"*l{i - 1}"] * 9) + "]\n" for i in range(1, 9))
+
 # name, file, mutation, fragments the error line must contain (the key path first).
 CASES = [
     # -- YAML syntax: duplicate keys, explicit nulls
@@ -49,11 +54,30 @@ CASES = [
     ("actuators_duplicate_key", ACTUATORS, ("text", "    gear_ratio: 100 ", "    gear_ratio: 10\n    gear_ratio: 100 "),
      ["actuators.yaml", "joints[0].gear_ratio", "duplicate key"]),
     ("collision_duplicate_key", COLLISION, ("text", "pairs:\n", "pairs: []\npairs:\n"), ["collision.yaml", "pairs", "duplicate key"]),
+    # -- hostile YAML (issue 37): an alias bomb, an alias cycle, deep nesting
+    ("yaml_alias_bomb", DEMO, ("text", "run:                                     # the run itself", ALIAS_BOMB + "run:"),
+     ["demo.yaml", "alias bomb"]),
+    ("yaml_alias_cycle", DEMO, ("text", "run:                                     # the run itself", "loop: &a [1, *a]\nrun:"),
+     ["demo.yaml", "loop[1]", "cycle"]),
+    ("yaml_deep_nesting", DEMO, ("text", "run:                                     # the run itself",
+                                 "deep: " + "[" * 100 + "]" * 100 + "\nrun:"), ["demo.yaml", "nested deeper than 64 levels"]),
+    ("yaml_deeper_than_the_parser", DEMO, ("text", "run:                                     # the run itself",
+                                           "deep: " + "[" * 5000 + "]" * 5000 + "\nrun:"), ["demo.yaml", "nested too deeply"]),
     # -- sizes that exhausted memory
     ("run_duration_1e9", DEMO, ("set", "run.duration_s", 1e9), ["run.duration_s", "3600"]),
     ("log_buffer_4194304_rows", DEMO, ("set", "logging.buffer_rows", 4194304), ["logging.buffer_rows", "100 MiB"]),
     # -- a broken plant MJCF: MuJoCo's several lines as one
     ("mjcf_unknown_attribute", MJCF, ("xml", ".//joint[@name='joint_2']", "bogus", "1"), ["gen3_plant.xml", "bogus", "line"]),
+    # MuJoCo 2.2.2 exits on an empty file after "Press Enter to exit" (issue 37).
+    ("mjcf_empty", MJCF, ("whole", ""), ["gen3_plant.xml", "empty"]),
+    ("mjcf_not_xml", MJCF, ("whole", "not a model\n"), ["gen3_plant.xml", "XML parse error"]),
+    # -- URDF origins: urdfdom makes any finite rpy a finite quaternion (issue 37)
+    ("urdf_joint_rpy_1e308", URDF, ("xml", "joint[@name='joint_3']/origin", "rpy", "1e308 0 0"),
+     ["gen3.urdf", "joint 'joint_3' <origin> rpy", "beyond one turn"]),
+    ("urdf_inertial_rpy_in_degrees", URDF, ("xml", "link[@name='forearm_link']/inertial/origin", "rpy", "0 90 0"),
+     ["gen3.urdf", "link 'forearm_link' <origin> rpy", "degrees"]),
+    ("urdf_joint_xyz_1e308", URDF, ("xml", "joint[@name='joint_5']/origin", "xyz", "0 1e308 0"),
+     ["gen3.urdf", "joint 'joint_5' <origin> xyz", "100 m"]),
     # -- URDF inertials
     ("urdf_link_mass_1e300", URDF, ("xml", "link[@name='half_arm_1_link']/inertial/mass", "value", "1e300"),
      ["gen3.urdf", "link 'half_arm_1_link' <inertial>", "1000 kg"]),
@@ -148,6 +172,12 @@ CASES = [
     ("custom_transfer_gain_500", DEMO, ("set", "low_level.custom.transfer_gain", 500.0), ["low_level.custom.transfer_gain"]),
     ("custom_integral_leak_1e4", DEMO, ("set", "low_level.custom.integral_leak", 1e4), ["low_level.custom.integral_leak"]),
     ("custom_integral_gain_1e4", DEMO, ("set", "low_level.custom.integral_gain", 1e4), ["low_level.custom.integral_gain"]),
+    # -- values that loaded and meant nothing (issue 37)
+    ("collision_safety_distance_0", DEMO, ("set", "controller.qp.collision.safety_distance_m", 0),
+     ["controller.qp.collision.safety_distance_m", "> 0"]),
+    ("qp_velocity_fraction_1e-9", DEMO, ("set", "controller.qp.velocity_limit_fraction", 1e-9),
+     ["controller.qp.velocity_limit_fraction", "[0.05, 1]"]),
+    ("wrench_bias_samples_0", DEMO, ("set", "controller.wrench.bias_samples", 0), ["controller.wrench.bias_samples", "[1, 1000000]"]),
 ]
 
 PATH_PART = re.compile(r"([^.\[\]]+)|\[(\d+)\]")
@@ -182,6 +212,8 @@ def mutate(text, mutation):
         document = yaml.safe_load(text)
         set_in(document, mutation[1], mutation[2], append=kind == "append")
         return yaml.safe_dump(document, sort_keys=False, default_flow_style=None, width=1000)
+    if kind == "whole":
+        return mutation[1]
     if kind == "xml":
         _, where, attribute, value = mutation
         root = ET.fromstring(text)

@@ -18,7 +18,8 @@ def main():
     parser.add_argument("--touch", type=float, default=8.0)
     parser.add_argument("--release", type=float, default=4.0)
     args = parser.parse_args()
-    data = np.genfromtxt(args.log, delimiter=",", names=True)
+    # atleast_1d: a one-row log (a run stopped in its first cycle) reads as a 0-d array.
+    data = np.atleast_1d(np.genfromtxt(args.log, delimiter=",", names=True))
     t = data["time_s"]
     tau_d = np.column_stack([data[n] for n in data.dtype.names if n.startswith("tau_d_")])
 

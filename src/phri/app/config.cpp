@@ -237,7 +237,8 @@ void parse_joint_limit_damper(const YamlReader& j, WholeBodyQpSettings& s) {
 void parse_collision_damper(const YamlReader& k, VelocityDamperSettings& d) {
   k.allow_keys({"influence_distance_m", "safety_distance_m", "approach_speed_m_s", "amortization"});
   d.influence_distance = positive_or(k, "influence_distance_m", d.influence_distance, 1.0);
-  d.safety_distance = non_negative_or(k, "safety_distance_m", d.safety_distance, 1.0);
+  // 0 would let capsules touch before the damper stops their approach.
+  d.safety_distance = positive_or(k, "safety_distance_m", d.safety_distance, 1.0);
   d.xi = positive_or(k, "approach_speed_m_s", d.xi, 10.0);
   d.amortization = k.number_or("amortization", d.amortization, 1.0, 100.0);
   require_below(k, "safety_distance_m", d.safety_distance, d.influence_distance,
@@ -266,7 +267,8 @@ void parse_qp(const YamlReader& q, const ActuatorTable& drives, WholeBodyQpSetti
   if (q.has("velocity_limit_rad_s")) {
     s.velocity_limit = q.per_joint<Eigen::VectorXd>("velocity_limit_rad_s", dof, 1e-3, kMaxJointVelocity_rad_s);
   }
-  s.velocity_limit_fraction = positive_or(q, "velocity_limit_fraction", s.velocity_limit_fraction, 1.0);
+  // Below 5 % of the joints' speed limits the arm can neither yield to a hand nor follow a reference.
+  s.velocity_limit_fraction = q.number_or("velocity_limit_fraction", s.velocity_limit_fraction, 0.05, 1.0);
   if (q.has("joint_limits")) parse_joint_limit_damper(q.at("joint_limits"), s);
   s.velocity_limit_gain = positive_or(q, "velocity_limit_gain", s.velocity_limit_gain, kMaxTaskDamping_per_s);
   if (q.has("braking_reserve")) {
@@ -293,7 +295,8 @@ void parse_wrench(const YamlReader& w, WrenchEstimatorSettings& s) {
   w.allow_keys({"tool_mass_kg", "tool_com_m", "bias_samples"});
   s.tool_mass_kg = non_negative_or(w, "tool_mass_kg", s.tool_mass_kg, kMaxPayload_kg);
   s.tool_com_m = w.vector3_or("tool_com_m", s.tool_com_m, -1.0, 1.0);
-  s.bias_samples = static_cast<int>(w.integer_or("bias_samples", s.bias_samples, 0, 1000000));
+  // 0 would estimate no bias: the sensor's offset would stay in the wrench (a touch that is not there).
+  s.bias_samples = static_cast<int>(w.integer_or("bias_samples", s.bias_samples, 1, 1000000));
 }
 
 void parse_controller(const YamlReader& r, const ActuatorTable& drives, ControllerSettings& c) {

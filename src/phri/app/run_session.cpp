@@ -93,6 +93,11 @@ public:
         ++k;
         break;
       }
+      if (stop_requested()) {
+        summary_.interrupted = true;
+        ++k;
+        break;
+      }
     }
     if (tty_) out_ << "\n";
     summary_.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
@@ -101,6 +106,10 @@ public:
   }
 
 private:
+  bool stop_requested() const {
+    return options_.stop_requested != nullptr && options_.stop_requested->load(std::memory_order_relaxed);
+  }
+
   // Moves to the phases that have started by t; without a status line, says so.
   void enter_phases(double t, std::size_t k) {
     while (phase_ + 1 < phases_.size() && t >= phases_[phase_ + 1].start_s) {
@@ -154,7 +163,7 @@ private:
     for (LiveCommand c; live_->receive(c);) handle_live(c);
     if (!paused_) return;
     bool waited = false, shown = row_.time_s <= 0.0;
-    while (paused_ && steps_ == 0) {
+    while (paused_ && steps_ == 0 && !stop_requested()) {
       // The page learns it is paused, and sees the last cycle (retried: the queue may be full
       // of the snapshots of a burst of steps).
       if (!shown) shown = publish_snapshot();
@@ -380,11 +389,12 @@ void print_run_summary(const RunSummary& s, std::ostream& out) {
   char line[700];
   std::snprintf(line, sizeof line,
                 "%llu cycles, %.1f s simulated in %.1f s of wall time; controller cycle: median %.1f us, p99 %.1f us, "
-                "p99.9 %.1f us, max %.1f us; %llu overruns; %ld held cycles; %llu degraded spells; %llu refused writes%s\n\n",
+                "p99.9 %.1f us, max %.1f us; %llu overruns; %ld held cycles; %llu degraded spells; %llu refused writes%s%s\n\n",
                 static_cast<unsigned long long>(s.cycles), s.simulated_s, s.wall_s, s.cycle_median_us, s.cycle_p99_us,
                 s.cycle_p999_us, s.cycle_max_us, static_cast<unsigned long long>(s.overruns), s.held_cycles, static_cast<unsigned long long>(s.degraded_spells),
                 static_cast<unsigned long long>(s.refused_writes),
-                s.safe_hold ? (" ; SAFE HOLD: " + s.safe_hold_reason).c_str() : "");
+                s.safe_hold ? (" ; SAFE HOLD: " + s.safe_hold_reason).c_str() : "",
+                s.interrupted ? " ; INTERRUPTED before the end of its duration" : "");
   out << line;
   out << "| phase | from s | to s | EE pos max mm | EE pos RMS mm | EE ori max deg | EE ori RMS deg | wrench max | mode switches | loop switches | cycle median us | cycle p99.9 us |\n";
   out << "|---|---|---|---|---|---|---|---|---|---|---|---|\n";

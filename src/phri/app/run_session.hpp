@@ -17,6 +17,7 @@
 #include <phri/app/logger.hpp>
 #include <phri/robot/robot_interface.hpp>
 
+#include <atomic>
 #include <iosfwd>
 #include <string>
 #include <vector>
@@ -38,6 +39,10 @@ struct RunOptions {
   /// snapshots published every `decimation` cycles. While paused the loop holds between two
   /// cycles (the simulation and the controller stop together) and polls the channel every 1 ms.
   LiveChannel* live = nullptr;
+  /// A stop asked from outside the loop (apps/phri.cpp: SIGINT, SIGTERM), or null. Loaded once a
+  /// cycle (no wait, no allocation); once true, the run ends after that cycle as if its duration had
+  /// run out, with RunSummary::interrupted set.
+  const std::atomic<bool>* stop_requested = nullptr;
 };
 
 struct PhaseSummary {
@@ -62,11 +67,12 @@ struct RunSummary {
   std::uint64_t degraded_spells = 0;     ///< entries into the degraded state
   bool safe_hold = false;
   std::string safe_hold_reason;
+  bool interrupted = false;              ///< ended by RunOptions::stop_requested before its duration
   std::vector<PhaseSummary> phases;
 };
 
 /// Runs the loop for options.duration_s of robot time (or until the FSM has stopped and the arm
-/// is at rest after a stop event). `gamepad` and `logger` may be null.
+/// is at rest after a stop event, or options.stop_requested is set). `gamepad` and `logger` may be null.
 RunSummary run_session(RobotInterface& robot, Controller& cycle, Fsm& fsm, Gamepad* gamepad, Logger* logger,
                        const RunOptions& options, std::ostream& out);
 

@@ -2,6 +2,8 @@
 
 #include <phri/core/format.hpp>
 
+#include <yaml-cpp/depthguard.h>
+
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -20,32 +22,68 @@ std::string range_text(double min, double max) {
 
 std::string child_path(const std::string& path, const std::string& key) { return path.empty() ? key : path + "." + key; }
 
+// Bounds of a document's walk. yaml-cpp shares an aliased node instead of copying it, so a few
+// hundred bytes of nested aliases ("billion laughs") stand for 10^9 nodes, and an alias inside its
+// own anchor (`&a [*a]`) is a cycle: the walk counts every node it reaches (through aliases too)
+// and refuses a document past kMaxNodes or kMaxDepth, long before the loaders would walk it.
+// Configuration files have a few thousand nodes at most and nest fewer than 10 levels.
+constexpr std::size_t kMaxNodes = 100000;
+constexpr std::size_t kMaxDepth = 64;
+
 // What yaml-cpp lets through silently, refused for the whole document as soon as it is parsed:
 // a key given twice in one map (yaml-cpp keeps both, and node[key] answers the first) and a key
 // whose value is an explicit null (`key:`, `key: ~`, `key: null`), which the loaders would take as
 // "absent" and replace by the default. No configuration file documents null as a value: to use the
-// default, leave the key out.
-void check_document(const YAML::Node& node, const std::string& file, const std::string& path) {
-  if (node.IsSequence()) {
-    for (std::size_t i = 0; i < node.size(); ++i) check_document(node[i], file, path + "[" + std::to_string(i) + "]");
-    return;
-  }
-  if (!node.IsMap()) return;
-  std::vector<std::string> seen;
-  for (const auto& item : node) {
-    if (!item.first.IsScalar()) throw ConfigError(file, path, "keys must be strings");
-    const std::string key = item.first.Scalar();
-    const std::string key_path = child_path(path, key);
-    if (std::find(seen.begin(), seen.end(), key) != seen.end()) {
-      throw ConfigError(file, key_path, "duplicate key (given twice in the same map)");
+// default, leave the key out. Also the bounds above.
+class DocumentCheck {
+public:
+  explicit DocumentCheck(const std::string& file) : file_(file) {}
+
+  void check(const YAML::Node& node, const std::string& path) {
+    if (++nodes_ > kMaxNodes) {
+      throw ConfigError(file_, path, "more than " + std::to_string(kMaxNodes) +
+                                         " YAML nodes counting those reached through aliases (an alias bomb?)");
     }
-    seen.push_back(key);
-    if (!item.second || item.second.IsNull()) {
-      throw ConfigError(file, key_path, "no value (explicit null); leave the key out to use the default");
+    for (const YAML::Node& ancestor : ancestors_) {
+      if (node.is(ancestor)) throw ConfigError(file_, path, "an alias refers to a node that contains it (a cycle)");
     }
-    check_document(item.second, file, key_path);
+    if (ancestors_.size() >= kMaxDepth) {
+      // The key path's head says where; 64 levels of it would fill the line.
+      const std::string shown = path.size() > 60 ? path.substr(0, 60) + "..." : path;
+      throw ConfigError(file_, shown, "nested deeper than " + std::to_string(kMaxDepth) + " levels");
+    }
+    if (!node.IsSequence() && !node.IsMap()) return;
+    ancestors_.push_back(node);
+    if (node.IsSequence()) {
+      for (std::size_t i = 0; i < node.size(); ++i) check(node[i], path + "[" + std::to_string(i) + "]");
+    } else {
+      check_map(node, path);
+    }
+    ancestors_.pop_back();
   }
-}
+
+private:
+  void check_map(const YAML::Node& node, const std::string& path) {
+    std::vector<std::string> seen;
+    for (const auto& item : node) {
+      if (!item.first.IsScalar()) throw ConfigError(file_, path, "keys must be strings");
+      const std::string key = item.first.Scalar();
+      const std::string key_path = child_path(path, key);
+      if (std::find(seen.begin(), seen.end(), key) != seen.end()) {
+        throw ConfigError(file_, key_path, "duplicate key (given twice in the same map)");
+      }
+      seen.push_back(key);
+      if (!item.second || item.second.IsNull()) {
+        throw ConfigError(file_, key_path, "no value (explicit null); leave the key out to use the default");
+      }
+      check(item.second, key_path);
+    }
+  }
+
+  const std::string& file_;
+  std::size_t nodes_ = 0;
+  std::vector<YAML::Node> ancestors_;
+};
 
 }  // namespace
 
@@ -68,10 +106,12 @@ YamlReader YamlReader::load_string(const std::string& text, const std::string& s
   YAML::Node root;
   try {
     root = YAML::Load(text);
+  } catch (const YAML::DeepRecursion& e) {  // its own message says "bad file"
+    throw ConfigError(source_name, "", "invalid YAML: nested too deeply (line " + std::to_string(e.mark.line + 1) + ")");
   } catch (const YAML::Exception& e) {
     throw ConfigError(source_name, "", std::string("invalid YAML: ") + e.what());
   }
-  check_document(root, source_name, "");
+  DocumentCheck(source_name).check(root, "");
   return YamlReader(std::move(root), source_name, "");
 }
 

@@ -11,7 +11,9 @@
 #include <Eigen/Eigenvalues>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <locale>
 #include <fstream>
 #include <map>
 #include <mutex>
@@ -90,6 +92,60 @@ bool pose_is_finite(const urdf::Pose& p) {
 }
 
 bool is_movable(const urdf::Joint& joint) { return joint.type != urdf::Joint::FIXED; }
+
+// An <origin>'s numbers as written: urdfdom turns rpy into a quaternion, which is finite for any
+// finite angle (1e308 rad included). One turn each way, with room for rounded 2 pi: beyond is a
+// corrupted file or degrees typed as radians. No arm's frame lies 100 m from its parent.
+constexpr double kMaxOriginAngle_rad = kMaxRevoluteLimit_rad + 0.01;
+constexpr double kMaxOriginOffset_m = 100.0;
+// <limit>: a joint speed of 100 rad/s (or m/s) and an effort of 1e5 N.m (or N) are beyond any arm's
+// drive (an industrial arm's strongest joint: ~1e4 N.m); a prismatic travel within 100 m.
+constexpr double kMaxLimitVelocity = 100.0;
+constexpr double kMaxLimitEffort = 1e5;
+
+// The value of attribute `name` in the tag text `tag` ("" when absent).
+std::string attribute(const std::string& tag, const std::string& name) {
+  for (std::size_t at = tag.find(name); at != std::string::npos; at = tag.find(name, at + 1)) {
+    if (at == 0 || !std::isspace(static_cast<unsigned char>(tag[at - 1]))) continue;
+    std::size_t i = tag.find_first_not_of(" \t\r\n", at + name.size());
+    if (i == std::string::npos || tag[i] != '=') continue;
+    i = tag.find_first_not_of(" \t\r\n", i + 1);
+    if (i == std::string::npos || (tag[i] != '"' && tag[i] != '\'')) continue;
+    const std::size_t end = tag.find(tag[i], i + 1);
+    if (end != std::string::npos) return tag.substr(i + 1, end - i - 1);
+  }
+  return "";
+}
+
+// Every <origin> of the URDF text (comments skipped), named by its enclosing <joint> or <link>.
+void check_origins(const std::string& urdf, const std::string& source) {
+  std::string owner = "robot";
+  for (std::size_t at = urdf.find('<'); at != std::string::npos; at = urdf.find('<', at + 1)) {
+    if (urdf.compare(at, 4, "<!--") == 0) {
+      at = urdf.find("-->", at);
+      if (at == std::string::npos) return;  // urdfdom reports the broken comment
+      continue;
+    }
+    const std::size_t end = urdf.find('>', at);
+    if (end == std::string::npos) return;
+    const std::string tag = urdf.substr(at, end - at);
+    const std::string element = tag.substr(1, tag.find_first_of(" \t\r\n/") - 1);
+    if (element == "joint" || element == "link") owner = element + " '" + attribute(tag, "name") + "'";
+    if (element != "origin") continue;
+    for (const char* key : {"xyz", "rpy"}) {
+      std::istringstream values(attribute(tag, key));
+      values.imbue(std::locale::classic());
+      const bool angle = std::string(key) == "rpy";
+      const double bound = angle ? kMaxOriginAngle_rad : kMaxOriginOffset_m;
+      for (double v; values >> v;) {
+        if (std::isfinite(v) && std::abs(v) <= bound) continue;
+        throw ConfigError(source, owner + " <origin> " + key,
+                          format_general(v, 6) + (angle ? " rad is beyond one turn (|angle| <= 2 pi; degrees typed as radians?)"
+                                                        : " m is not a link offset (|offset| <= 100 m)"));
+      }
+    }
+  }
+}
 
 }  // namespace
 
@@ -290,6 +346,17 @@ private:
       }
       if (limits->velocity < 0.0) fail(where + " <limit>", "velocity must be >= 0 (got " + format_general(limits->velocity, 6) + ")");
       if (limits->effort < 0.0) fail(where + " <limit>", "effort must be >= 0 (got " + format_general(limits->effort, 6) + ")");
+      if (limits->velocity > kMaxLimitVelocity) {
+        fail(where + " <limit>", "velocity " + format_general(limits->velocity, 6) + " is beyond any arm's joint (<= 100)");
+      }
+      if (limits->effort > kMaxLimitEffort) {
+        fail(where + " <limit>", "effort " + format_general(limits->effort, 6) + " is beyond any arm's drive (<= 1e5)");
+      }
+      if (joint.type == JointType::kPrismatic &&
+          std::max(std::abs(limits->lower), std::abs(limits->upper)) > kMaxOriginOffset_m) {
+        fail(where + " <limit>", "prismatic limits [" + format_general(limits->lower, 6) + ", " +
+                                     format_general(limits->upper, 6) + "] m reach beyond 100 m");
+      }
       // URDF uses 0 for "not given" in practice; the controller configuration can set limits.
       if (limits->velocity > 0.0) joint.velocity_limit = limits->velocity;
       if (limits->effort > 0.0) joint.effort_limit = limits->effort;
@@ -500,6 +567,7 @@ Model Model::from_urdf_string(const std::string& urdf, const ModelOptions& optio
     throw ConfigError(source_name, link_named_in(capture.errors),
                       "urdfdom could not parse it and would drop the value (" + capture.errors + ")");
   }
+  check_origins(urdf, source_name);
   return UrdfModelBuilder(*parsed, options, source_name, std::move(capture.warnings)).build();
 }
 

@@ -2,6 +2,8 @@
 
 #include <mujoco/mujoco.h>
 
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
 
 namespace phri {
@@ -10,7 +12,13 @@ void MjModelDeleter::operator()(mjModel_* model) const noexcept { mj_deleteModel
 
 void MjDataDeleter::operator()(mjData_* data) const noexcept { mj_deleteData(data); }
 
+bool is_blank(const std::string& xml) { return xml.find_first_not_of(" \t\r\n") == std::string::npos; }
+
 MjModelPtr load_mjcf_text(const std::string& xml, std::string& error) {
+  if (is_blank(xml)) {
+    error = "the file is empty (expected a <mujoco> model)";
+    return nullptr;
+  }
   mjVFS vfs;
   mj_defaultVFS(&vfs);
   const char* name = "phri_text.xml";
@@ -24,6 +32,23 @@ MjModelPtr load_mjcf_text(const std::string& xml, std::string& error) {
   mj_deleteVFS(&vfs);
   if (!m) error = mujoco_error_line(buffer);
   return m;
+}
+
+namespace {
+
+// One line each: MuJoCo's messages may hold line breaks.
+void print_mujoco_message(const char* prefix, const char* message) {
+  std::fprintf(stderr, "%s%s\n", prefix, mujoco_error_line(message).c_str());
+}
+
+}  // namespace
+
+void route_mujoco_messages_to_stderr() {
+  mju_user_error = [](const char* message) {
+    print_mujoco_message("phri: error: MuJoCo: ", message);
+    std::exit(2);
+  };
+  mju_user_warning = [](const char* message) { print_mujoco_message("phri: warning: MuJoCo: ", message); };
 }
 
 std::string mujoco_error_line(const char* error) {

@@ -39,6 +39,7 @@ SimRobotConfig completed(SimRobotConfig config) {
 }
 
 MjModelPtr load_scene(const std::string& xml, const std::string& source) {
+  if (is_blank(xml)) throw ConfigError(source, "scene", "the composed scene is empty");  // MuJoCo would exit
   mjVFS vfs;
   mj_defaultVFS(&vfs);
   const char* name = "phri_scene.xml";

@@ -26,6 +26,7 @@ std::string read_mjcf_text(const std::string& file) {
   if (!in) throw ConfigError(file, "", "cannot open the MJCF file");
   std::stringstream buffer;
   buffer << in.rdbuf();
+  if (is_blank(buffer.str())) throw ConfigError(file, "", "the MJCF file is empty (expected a <mujoco> model)");
   return buffer.str();
 }
 
