@@ -622,6 +622,20 @@ TEST(SafetyFuzz, MotionAndSwitchWindowsReplayAlone) {
                 fault.duration_s, fault.push_link.c_str(), fault.fault_offset_s,
                 fault.verdict.violations == 0 ? "none" : "some (expected until the controller fixes land)");
   }
+  // The subset on one pair: three faults in motion, three after the switch, each with its
+  // reference; the rows do not depend on the threads.
+  o.replay.clear();
+  o.faults = phri::FaultSet::kSubset;
+  o.fault_modes = {phri::ComplianceMode::kDual};
+  o.loops = {phri::LowLevelMode::kCurrent};
+  o.jobs = 1;
+  const phri::SafetyFuzzResult one = phri::run_safety_fuzz(o);
+  EXPECT_EQ(one.faults_in("motion"), 3);
+  EXPECT_EQ(one.faults_in("switch"), 3);
+  o.jobs = 2;
+  EXPECT_EQ(phri::safety_fuzz_csv(phri::run_safety_fuzz(o)), phri::safety_fuzz_csv(one));
+  o.motion_faults = false;
+  EXPECT_EQ(phri::run_safety_fuzz(o).faults(), one.faults_in("rest"));
 }
 
 }  // namespace
