@@ -12,6 +12,7 @@
 #include <phri/model/algorithms.hpp>
 #include <phri/robot/fake_robot.hpp>
 
+#include "allocation_counter.hpp"
 #include "temp_dir.hpp"
 
 #include <gtest/gtest.h>
@@ -235,6 +236,214 @@ TEST(FaultInjectingRobot, StaleFramesShortVectorsAndRefusedWrites) {
   EXPECT_EQ(io3.injected_refusals(), 1);
 }
 
+// A small scripted robot for the new fault kinds: every signal (joints, torque, current, wrench,
+// their sequences, stamps and validity) a distinct function of the read number k (1-based), so that
+// a corrupted value, a frozen one and a passed-through one can be told apart exactly.
+class ScriptedRobot final : public phri::RobotInterface {
+public:
+  static constexpr int kDof = 3;
+  ScriptedRobot() : state_(kDof) {}
+  int dof() const override { return kDof; }
+  double period_s() const override { return 1e-3; }
+  const phri::RobotState& read() override {
+    ++reads_;
+    const double k = static_cast<double>(reads_);
+    state_.cycle = reads_;
+    state_.time_s = 1e-3 * k;
+    for (int i = 0; i < kDof; ++i) {
+      state_.q_rad[i] = 0.1 * k + i;
+      state_.qd_rad_s[i] = 0.01 * k - i;
+      state_.tau_sensor_Nm[i] = 2.0 * k + 10.0 * i;
+      state_.current_A[i] = 0.5 * k + 0.25 * i;
+    }
+    for (int a = 0; a < 6; ++a) state_.wrench_sensor[a] = 3.0 * k + a;
+    for (phri::SignalStatus* s : {&state_.joints, &state_.torque, &state_.current, &state_.wrench}) {
+      s->valid = true;
+      s->sequence = static_cast<std::uint32_t>(reads_);
+      s->stamp_s = state_.time_s;
+    }
+    return state_;
+  }
+  phri::WriteStatus write(const phri::RobotCommand&) override {
+    ++writes_;
+    return phri::WriteStatus::kOk;
+  }
+  std::uint64_t reads() const { return reads_; }
+  long writes() const { return writes_; }
+
+private:
+  phri::RobotState state_;
+  std::uint64_t reads_ = 0;
+  long writes_ = 0;
+};
+
+// Bit for bit the same state (NaN compared by its bits: none occurs outside a window).
+void expect_same_state(const phri::RobotState& a, const phri::RobotState& b, long k) {
+  SCOPED_TRACE("read " + std::to_string(k));
+  EXPECT_EQ(a.time_s, b.time_s);
+  EXPECT_EQ(a.cycle, b.cycle);
+  EXPECT_EQ(a.q_rad, b.q_rad);
+  EXPECT_EQ(a.qd_rad_s, b.qd_rad_s);
+  EXPECT_EQ(a.tau_sensor_Nm, b.tau_sensor_Nm);
+  EXPECT_EQ(a.current_A, b.current_A);
+  EXPECT_EQ(a.wrench_sensor, b.wrench_sensor);
+  for (auto [x, y] : {std::pair{&a.joints, &b.joints}, std::pair{&a.torque, &b.torque}, std::pair{&a.current, &b.current},
+                      std::pair{&a.wrench, &b.wrench}}) {
+    EXPECT_EQ(x->valid, y->valid);
+    EXPECT_EQ(x->sequence, y->sequence);
+    EXPECT_EQ(x->stamp_s, y->stamp_s);
+  }
+  EXPECT_EQ(a.rejected_writes, b.rejected_writes);
+}
+
+// Drives a decorated and a clean ScriptedRobot side by side for `reads` reads; `inside(k, clean,
+// faulty)` checks each read k (0-based) in [start, start + cycles), every other read must be the clean
+// one bit for bit. The clean robot is read as often as the wrapped one (a stall reads it more).
+template <typename Check>
+void drive(const phri::FaultSpec& spec, long reads, Check inside) {
+  ScriptedRobot clean_robot, wrapped;
+  phri::FaultInjectingRobot io(wrapped, spec);
+  phri::RobotCommand command(ScriptedRobot::kDof);
+  for (long k = 0; k < reads; ++k) {
+    const phri::RobotState& b = io.read();
+    while (clean_robot.reads() < wrapped.reads() - 1) clean_robot.read();
+    const phri::RobotState& a = clean_robot.read();
+    const bool in = spec.active(k);
+    EXPECT_EQ(io.fault_active(), in) << k;
+    if (in) {
+      inside(k, a, b);
+    } else {
+      expect_same_state(a, b, k);
+    }
+    EXPECT_EQ(io.write(command), phri::WriteStatus::kOk);
+    clean_robot.write(command);
+  }
+  EXPECT_EQ(wrapped.writes(), reads);  // every command reaches the robot
+}
+
+phri::FaultSpec spec_of(phri::FaultKind kind, phri::FaultSignal signal, double value, long start, long cycles, int joint = 0) {
+  phri::FaultSpec f;
+  f.kind = kind;
+  f.signal = signal;
+  f.value = value;
+  f.joint = joint;
+  f.start_cycle = start;
+  f.cycles = cycles;
+  return f;
+}
+
+TEST(FaultInjectingRobot, AStallRunsTheRobotOnAndShowsOnlyItsLastState) {
+  // 19 extra periods at read 4: the wrapped robot is read 20 times there, the controller sees the
+  // 20th state (sequence and stamp 19 ahead of the clean next), and the reads after pass through.
+  ScriptedRobot wrapped;
+  phri::FaultInjectingRobot io(wrapped, spec_of(phri::FaultKind::kStall, phri::FaultSignal::kPosition, 19.0, 4, 1));
+  for (int k = 0; k < 4; ++k) EXPECT_EQ(io.read().joints.sequence, static_cast<std::uint32_t>(k + 1));
+  const phri::RobotState& s = io.read();
+  EXPECT_TRUE(io.fault_active());
+  EXPECT_EQ(wrapped.reads(), 4u + 20u);
+  EXPECT_EQ(s.joints.sequence, 24u);
+  EXPECT_EQ(s.cycle, 24u);
+  EXPECT_DOUBLE_EQ(s.q_rad[1], 0.1 * 24 + 1);
+  EXPECT_EQ(io.stalled_periods(), 19);
+  EXPECT_EQ(io.cycles(), 5);
+  const phri::RobotState& after = io.read();
+  EXPECT_FALSE(io.fault_active());
+  EXPECT_EQ(after.joints.sequence, 25u);
+  EXPECT_EQ(wrapped.reads(), 25u);
+  // And the same seen through drive(): bit for bit outside, the 20th state inside.
+  drive(spec_of(phri::FaultKind::kStall, phri::FaultSignal::kPosition, 50.0, 2, 1), 6,
+        [](long, const phri::RobotState& a, const phri::RobotState& b) { expect_same_state(a, b, -1); });
+}
+
+TEST(FaultInjectingRobot, ADriftGrowsLinearlyFromZeroOverItsWindow) {
+  const long start = 3, cycles = 4;
+  drive(spec_of(phri::FaultKind::kDrift, phri::FaultSignal::kTorque, 50.0, start, cycles, 2), 10,
+        [&](long k, const phri::RobotState& a, const phri::RobotState& b) {
+          const double added = 50.0 * static_cast<double>(k - start) / static_cast<double>(cycles);
+          EXPECT_EQ(b.tau_sensor_Nm[2], a.tau_sensor_Nm[2] + added) << k;
+          EXPECT_EQ(b.tau_sensor_Nm.head(2), a.tau_sensor_Nm.head(2));
+          EXPECT_EQ(b.q_rad, a.q_rad);
+          EXPECT_EQ(b.torque.sequence, a.torque.sequence);
+        });
+  // On the wrench: f_z only.
+  drive(spec_of(phri::FaultKind::kDrift, phri::FaultSignal::kWrench, 10.0, 1, 2), 5,
+        [&](long k, const phri::RobotState& a, const phri::RobotState& b) {
+          EXPECT_EQ(b.wrench_sensor[2], a.wrench_sensor[2] + 10.0 * static_cast<double>(k - 1) / 2.0) << k;
+          EXPECT_EQ(b.wrench_sensor.head(2), a.wrench_sensor.head(2));
+          EXPECT_EQ(b.wrench_sensor.tail(3), a.wrench_sensor.tail(3));
+        });
+}
+
+TEST(FaultInjectingRobot, WrenchStuckStaleAndInvalid) {
+  const long start = 2, cycles = 3;
+  // Stuck: the values of the window's first read (read 3, 1-based) while the sequence and stamp advance.
+  drive(spec_of(phri::FaultKind::kWrenchStuck, phri::FaultSignal::kWrench, 0.0, start, cycles), 7,
+        [&](long k, const phri::RobotState& a, const phri::RobotState& b) {
+          for (int i = 0; i < 6; ++i) EXPECT_EQ(b.wrench_sensor[i], 3.0 * (start + 1) + i) << k;
+          EXPECT_EQ(b.wrench.sequence, a.wrench.sequence);
+          EXPECT_EQ(b.wrench.stamp_s, a.wrench.stamp_s);
+          EXPECT_TRUE(b.wrench.valid);
+          EXPECT_EQ(b.q_rad, a.q_rad);
+        });
+  // Stale: values, sequence and stamp of the window's first read.
+  drive(spec_of(phri::FaultKind::kWrenchStale, phri::FaultSignal::kWrench, 0.0, start, cycles), 7,
+        [&](long k, const phri::RobotState& a, const phri::RobotState& b) {
+          for (int i = 0; i < 6; ++i) EXPECT_EQ(b.wrench_sensor[i], 3.0 * (start + 1) + i) << k;
+          EXPECT_EQ(b.wrench.sequence, static_cast<std::uint32_t>(start + 1));
+          EXPECT_EQ(b.wrench.stamp_s, 1e-3 * static_cast<double>(start + 1));
+          EXPECT_EQ(b.joints.sequence, a.joints.sequence);
+          EXPECT_EQ(b.q_rad, a.q_rad);
+        });
+  // Invalid: the flag only.
+  drive(spec_of(phri::FaultKind::kWrenchInvalid, phri::FaultSignal::kWrench, 0.0, start, cycles), 7,
+        [&](long k, const phri::RobotState& a, const phri::RobotState& b) {
+          EXPECT_FALSE(b.wrench.valid) << k;
+          EXPECT_EQ(b.wrench_sensor, a.wrench_sensor);
+          EXPECT_EQ(b.wrench.sequence, a.wrench.sequence);
+          EXPECT_TRUE(b.joints.valid);
+        });
+  // The existing F/T faults through the same harness: NaN f_z, a +1e6 N spike on f_z.
+  drive(spec_of(phri::FaultKind::kNaN, phri::FaultSignal::kWrench, 0.0, start, 1), 5,
+        [&](long, const phri::RobotState& a, const phri::RobotState& b) {
+          EXPECT_TRUE(std::isnan(b.wrench_sensor[2]));
+          EXPECT_EQ(b.wrench_sensor.head(2), a.wrench_sensor.head(2));
+        });
+  drive(spec_of(phri::FaultKind::kAdd, phri::FaultSignal::kWrench, 1e6, start, 1), 5,
+        [&](long, const phri::RobotState& a, const phri::RobotState& b) { EXPECT_EQ(b.wrench_sensor[2], a.wrench_sensor[2] + 1e6); });
+}
+
+TEST(FaultInjectingRobot, HeldTorqueOffsetAndAMillionSequenceJump) {
+  drive(spec_of(phri::FaultKind::kAdd, phri::FaultSignal::kTorque, 50.0, 1, 4, 1), 8,
+        [&](long k, const phri::RobotState& a, const phri::RobotState& b) {
+          EXPECT_EQ(b.tau_sensor_Nm[1], a.tau_sensor_Nm[1] + 50.0) << k;
+          EXPECT_EQ(b.tau_sensor_Nm[0], a.tau_sensor_Nm[0]);
+        });
+  drive(spec_of(phri::FaultKind::kSequenceJump, phri::FaultSignal::kPosition, 1e6, 3, 1), 6,
+        [&](long, const phri::RobotState& a, const phri::RobotState& b) {
+          EXPECT_EQ(b.joints.sequence, a.joints.sequence + 1000000u);
+          EXPECT_EQ(b.torque.sequence, a.torque.sequence + 1000000u);
+          EXPECT_EQ(b.current.sequence, a.current.sequence + 1000000u);
+          EXPECT_EQ(b.wrench.sequence, a.wrench.sequence);
+          EXPECT_EQ(b.q_rad, a.q_rad);
+        });
+}
+
+TEST(FaultInjectingRobot, NewKindsAllocateNothing) {
+  for (phri::FaultKind kind : {phri::FaultKind::kStall, phri::FaultKind::kDrift, phri::FaultKind::kWrenchStuck,
+                               phri::FaultKind::kWrenchStale, phri::FaultKind::kWrenchInvalid}) {
+    ScriptedRobot wrapped;
+    phri::FaultInjectingRobot io(wrapped, spec_of(kind, phri::FaultSignal::kTorque, 5.0, 2, 3));
+    phri::RobotCommand command(ScriptedRobot::kDof);
+    io.read();
+    const phri::test::AllocationCounter count;
+    for (int k = 0; k < 8; ++k) {
+      io.read();
+      io.write(command);
+    }
+    EXPECT_EQ(count.allocations(), 0u) << phri::to_string(kind);
+  }
+}
+
 // ---- the harness end to end
 
 TEST(SafetyFuzz, ABrokenToleranceFlagsEveryPush) {
@@ -266,12 +475,15 @@ TEST(SafetyFuzz, SmallRunWritesItsFilesAndPrintsItsCounts) {
   o.faults = phri::FaultSet::kSubset;
   o.fault_modes = {phri::ComplianceMode::kFullBody};
   o.targeted_pushes = false;
+  o.motion_faults = false;  // the windows in motion: MotionAndSwitchWindowsReplayAlone
   std::ostringstream progress;
   const phri::SafetyFuzzResult r = phri::run_safety_fuzz(o, &progress);
   EXPECT_EQ(r.pushes() + std::count_if(r.records.begin(), r.records.end(),
                                        [](const phri::FuzzRecord& x) { return x.kind == phri::FuzzCaseKind::kStartup; }),
             48);
-  EXPECT_EQ(r.faults(), 6 * 2 * 4);
+  // Six faults for 1 and 100 cycles, a 50-period stall (one read), the F/T stuck for 1 and 100.
+  EXPECT_EQ(r.faults(), (6 * 2 + 1 + 2) * 4);
+  EXPECT_EQ(r.faults_in("rest"), r.faults());
   ASSERT_TRUE(std::filesystem::exists(out + "/safety_fuzz.csv"));
   ASSERT_TRUE(std::filesystem::exists(out + "/report.md"));
   EXPECT_EQ(count_lines(out + "/safety_fuzz.csv"), r.records.size() + 1);
@@ -321,6 +533,109 @@ TEST(SafetyFuzz, ResultsDoNotDependOnThreadsAndARunReplaysAlone) {
   while (std::getline(rows, line)) EXPECT_NE(one.find(line + "\n"), std::string::npos) << line;
   o.replay = "push/dual/custom/99";
   EXPECT_THROW(phri::run_safety_fuzz(o), phri::ConfigError);
+}
+
+TEST(SafetyFuzzCatalogue, IssueThirtySevenFaultsAndTheirLengths) {
+  const std::vector<phri::FaultCase> all = phri::fault_catalogue(phri::FaultSet::kAll, 7, 3);
+  auto find = [&](const std::string& prefix) -> const phri::FaultCase* {
+    for (const phri::FaultCase& c : all) {
+      if (c.name.rfind(prefix, 0) == 0) return &c;
+    }
+    return nullptr;
+  };
+  for (const char* name : {"stall_19", "stall_20", "stall_50", "stall_random_", "sequence_jump_1e6", "offset_tau_50Nm",
+                           "drift_tau_50Nm", "wrench_stuck", "wrench_stale", "wrench_invalid", "wrench_nan", "wrench_spike_1e6N"}) {
+    ASSERT_NE(find(name), nullptr) << name;
+  }
+  EXPECT_EQ(find("stall_50")->spec.kind, phri::FaultKind::kStall);
+  EXPECT_EQ(find("stall_50")->spec.value, 50.0);
+  EXPECT_EQ(find("stall_50")->cycles_in_motion(), 1);
+  const double random_stall = find("stall_random_")->spec.value;
+  EXPECT_GE(random_stall, 1.0);
+  EXPECT_LE(random_stall, 100.0);
+  EXPECT_EQ(find("stall_random_")->name, "stall_random_" + std::to_string(static_cast<int>(random_stall)));
+  EXPECT_EQ(find("sequence_jump_1e6")->spec.value, 1e6);
+  EXPECT_EQ(find("sequence_jump_1e6")->fixed_cycles, 1);
+  EXPECT_EQ(find("offset_tau_50Nm")->fixed_cycles, 100);
+  EXPECT_EQ(find("drift_tau_50Nm")->spec.kind, phri::FaultKind::kDrift);
+  EXPECT_EQ(find("drift_tau_50Nm")->fixed_cycles, 100);
+  EXPECT_EQ(find("wrench_stuck")->cycles_in_motion(), 100);
+  EXPECT_EQ(find("spike_1e6_q")->cycles_in_motion(), 1);
+  EXPECT_EQ(find("nan_q")->cycles_in_motion(), 100);
+  // Drawn from the seed: the same seed, the same catalogue.
+  const std::vector<phri::FaultCase> again = phri::fault_catalogue(phri::FaultSet::kAll, 7, 3);
+  ASSERT_EQ(again.size(), all.size());
+  for (std::size_t i = 0; i < all.size(); ++i) {
+    EXPECT_EQ(again[i].name, all[i].name);
+    EXPECT_EQ(again[i].spec.joint, all[i].spec.joint);
+  }
+}
+
+// A handful of windows in motion and after a loop switch, replayed alone (each with its reference):
+// the push and the fault's time come from the seed, the faulted run leaves its reference's path only
+// at its fault, and a replay gives the same rows.
+TEST(SafetyFuzz, MotionAndSwitchWindowsReplayAlone) {
+  phri::SafetyFuzzOptions o = small_options("");
+  o.seed = 3;
+  o.pushes = 0;
+  o.targeted_pushes = false;
+  struct Case {
+    const char* run;
+    const char* context;
+  };
+  for (const Case c : {Case{"motion/full_body/custom/stall_50", "motion"}, Case{"motion/dual/kinova_torque/wrench_stuck", "motion"},
+                       Case{"switch/null_space/custom/nan_q", "switch"}}) {
+    SCOPED_TRACE(c.run);
+    o.replay = c.run;
+    const phri::SafetyFuzzResult r = phri::run_safety_fuzz(o);
+    ASSERT_EQ(r.records.size(), 2u);
+    const phri::FuzzRecord& ref = r.records[0];
+    const phri::FuzzRecord& fault = r.records[1];
+    EXPECT_EQ(ref.kind, phri::FuzzCaseKind::kReference);
+    EXPECT_EQ(fault.kind, phri::FuzzCaseKind::kFault);
+    EXPECT_EQ(fault.run_id, c.run);
+    EXPECT_EQ(fault.context, c.context);
+    EXPECT_EQ(ref.context, c.context);
+    EXPECT_EQ(r.faults_in(c.context), 1);
+    EXPECT_EQ(fault.error, "") << "the faulted run must follow its reference until the fault";
+    EXPECT_GE(fault.force_N, 20.0);
+    EXPECT_LE(fault.force_N, 80.0);
+    EXPECT_GE(fault.duration_s, 1.0);
+    EXPECT_LE(fault.duration_s, 2.0);
+    EXPECT_EQ(fault.profile, "ramp");
+    EXPECT_EQ(fault.push_link, ref.push_link);
+    if (fault.mode == phri::ComplianceMode::kDual) {
+      EXPECT_EQ(fault.push_link, "tool");
+    }
+    if (std::string(c.context) == "motion") {
+      EXPECT_GE(fault.fault_offset_s, 0.1 - 1e-9);
+      EXPECT_LE(fault.fault_offset_s, 0.5 + 1e-9);
+      // The fault's first state: one period after its start, plus a stall's periods.
+      EXPECT_GE(fault.start_s - ref.start_s, fault.fault_offset_s + 1e-3 - 1e-9);
+      EXPECT_LE(fault.start_s - ref.start_s, fault.fault_offset_s + 1e-3 + 0.05 + 1e-9);
+    } else {
+      EXPECT_LE(fault.fault_offset_s, 0.05 + 1e-9);
+    }
+    // Replayed again: the same rows.
+    EXPECT_EQ(phri::safety_fuzz_csv(phri::run_safety_fuzz(o)), phri::safety_fuzz_csv(r));
+    std::printf("%s: %s, %.0f N for %.2f s on %s, fault %.3f s in; violations %s\n", c.run, fault.target.c_str(), fault.force_N,
+                fault.duration_s, fault.push_link.c_str(), fault.fault_offset_s,
+                fault.verdict.violations == 0 ? "none" : "some (expected until the controller fixes land)");
+  }
+  // The subset on one pair: three faults in motion, three after the switch, each with its
+  // reference; the rows do not depend on the threads.
+  o.replay.clear();
+  o.faults = phri::FaultSet::kSubset;
+  o.fault_modes = {phri::ComplianceMode::kDual};
+  o.loops = {phri::LowLevelMode::kCurrent};
+  o.jobs = 1;
+  const phri::SafetyFuzzResult one = phri::run_safety_fuzz(o);
+  EXPECT_EQ(one.faults_in("motion"), 3);
+  EXPECT_EQ(one.faults_in("switch"), 3);
+  o.jobs = 2;
+  EXPECT_EQ(phri::safety_fuzz_csv(phri::run_safety_fuzz(o)), phri::safety_fuzz_csv(one));
+  o.motion_faults = false;
+  EXPECT_EQ(phri::run_safety_fuzz(o).faults(), one.faults_in("rest"));
 }
 
 }  // namespace

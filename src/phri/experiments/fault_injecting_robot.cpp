@@ -1,6 +1,7 @@
 #include <phri/experiments/fault_injecting_robot.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <utility>
 
@@ -23,10 +24,17 @@ void FaultInjectingRobot::restore_sizes() {
 }
 
 const RobotState& FaultInjectingRobot::read() {
-  const RobotState& clean = inner_.read();
+  const RobotState* inner = &inner_.read();
   const long c = cycle_++;
   active_ = fault_.active(c);
   restore_sizes();
+  if (active_ && c == fault_.start_cycle && fault_.kind == FaultKind::kStall) {
+    // The controller's thread missed these periods: the robot ran on, on its last command.
+    const long extra = std::lround(std::max(0.0, fault_.value));
+    for (long k = 0; k < extra; ++k) inner = &inner_.read();
+    stalled_periods_ += extra;
+  }
+  const RobotState& clean = *inner;
   if (active_ && c == fault_.start_cycle) frozen_ = clean;
   // A stale frame: the previous state again, whatever the robot now reports.
   if (active_ && fault_.kind == FaultKind::kStaleFrame) return out_;
@@ -65,12 +73,24 @@ void FaultInjectingRobot::corrupt_value(double replacement, bool add) {
   x = add ? x + replacement : replacement;
 }
 
+double FaultInjectingRobot::drift_fraction(long cycle) const {
+  return fault_.cycles > 0 ? static_cast<double>(cycle - fault_.start_cycle) / static_cast<double>(fault_.cycles) : 0.0;
+}
+
 void FaultInjectingRobot::corrupt() {
   SignalStatus* signals[] = {&out_.joints, &out_.torque, &out_.current};
   switch (fault_.kind) {
     case FaultKind::kNone:
     case FaultKind::kStaleFrame:
-    case FaultKind::kWriteRefused: return;
+    case FaultKind::kWriteRefused:
+    case FaultKind::kStall: return;
+    case FaultKind::kDrift: corrupt_value(fault_.value * drift_fraction(cycle_ - 1), true); return;
+    case FaultKind::kWrenchStuck: out_.wrench_sensor = frozen_.wrench_sensor; return;
+    case FaultKind::kWrenchStale:
+      out_.wrench_sensor = frozen_.wrench_sensor;
+      out_.wrench = frozen_.wrench;
+      return;
+    case FaultKind::kWrenchInvalid: out_.wrench.valid = false; return;
     case FaultKind::kNaN: corrupt_value(std::numeric_limits<double>::quiet_NaN(), false); return;
     case FaultKind::kInf: corrupt_value(std::numeric_limits<double>::infinity(), false); return;
     case FaultKind::kAdd: corrupt_value(fault_.value, true); return;

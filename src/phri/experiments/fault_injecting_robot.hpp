@@ -15,6 +15,19 @@
 //   kStampFrozen         the stamps keep their value of the window's first cycle; sequence advances
 //   kShortVector         current_A of size `size` (0 or dof - 1) while current.valid stays true
 //   kWriteRefused        write() refuses every command (WriteStatus::kFault), the robot keeps its last
+//   kStall               a control-thread stall: at the window's first read() the wrapped robot is
+//                        read `value` extra times (rounded, >= 0), so the plant runs that many more
+//                        periods on its last accepted command and the controller sees only the last
+//                        state (its sequences and stamps jump by value + 1); later reads pass through
+//   kDrift               `value` x (k / cycles) added to one joint's signal (kWrench: f_z), k = 0 at
+//                        the window's first read: a drift growing linearly from 0 by value / cycles
+//                        per read (value x (cycles - 1) / cycles at its last read)
+//   kWrenchStuck         wrench_sensor keeps the window's first value while wrench.sequence, stamp
+//                        and valid advance (an F/T sensor stuck, its bus alive)
+//   kWrenchStale         wrench_sensor, wrench.sequence, stamp and valid keep the window's first
+//                        values (no new F/T sample); the joints pass through
+//   kWrenchInvalid       wrench.valid = false (the values pass through)
+// The F/T wrench's NaN and spikes are kNaN / kAdd on FaultSignal::kWrench (f_z).
 //
 // Outside the window the wrapped robot's state passes through unchanged (same values, bit for bit),
 // so a run with a fault and a fault-free run with the same plant seed share their path until the
@@ -41,7 +54,34 @@ enum class FaultKind : std::uint8_t {
   kStampFrozen,
   kShortVector,
   kWriteRefused,
+  kStall,
+  kDrift,
+  kWrenchStuck,
+  kWrenchStale,
+  kWrenchInvalid,
 };
+
+constexpr std::string_view to_string(FaultKind k) {
+  switch (k) {
+    case FaultKind::kNone: return "none";
+    case FaultKind::kNaN: return "nan";
+    case FaultKind::kInf: return "inf";
+    case FaultKind::kAdd: return "add";
+    case FaultKind::kFrozenValues: return "frozen_values";
+    case FaultKind::kStaleFrame: return "stale_frame";
+    case FaultKind::kSequenceJump: return "sequence_jump";
+    case FaultKind::kStampJump: return "stamp_jump";
+    case FaultKind::kStampFrozen: return "stamp_frozen";
+    case FaultKind::kShortVector: return "short_vector";
+    case FaultKind::kWriteRefused: return "write_refused";
+    case FaultKind::kStall: return "stall";
+    case FaultKind::kDrift: return "drift";
+    case FaultKind::kWrenchStuck: return "wrench_stuck";
+    case FaultKind::kWrenchStale: return "wrench_stale";
+    case FaultKind::kWrenchInvalid: return "wrench_invalid";
+  }
+  return "unknown";
+}
 
 enum class FaultSignal : std::uint8_t { kPosition = 0, kVelocity, kTorque, kCurrent, kWrench };
 
@@ -61,7 +101,8 @@ struct FaultSpec {
   FaultKind kind = FaultKind::kNone;
   FaultSignal signal = FaultSignal::kPosition;
   int joint = 0;
-  double value = 0.0;      ///< kAdd: added; kSequenceJump: sequence steps; kStampJump: seconds
+  double value = 0.0;      ///< kAdd: added; kDrift: reached at the window's end; kSequenceJump:
+                           ///< sequence steps; kStampJump: seconds; kStall: extra periods
   int size = 0;            ///< kShortVector: length of current_A
   long start_cycle = 0;    ///< index of the first corrupted read()
   long cycles = 1;         ///< length of the window
@@ -86,10 +127,13 @@ public:
   bool fault_active() const { return active_; }
   /// Writes refused by the injection (not by the wrapped robot).
   long injected_refusals() const { return injected_refusals_; }
+  /// Extra reads of the wrapped robot so far (kStall).
+  long stalled_periods() const { return stalled_periods_; }
 
 private:
   void corrupt();
   void corrupt_value(double replacement, bool add);
+  double drift_fraction(long cycle) const;
   void restore_sizes();
 
   RobotInterface& inner_;
@@ -101,6 +145,7 @@ private:
   bool active_ = false;
   long cycle_ = 0;
   long injected_refusals_ = 0;
+  long stalled_periods_ = 0;
 };
 
 }  // namespace phri

@@ -9,6 +9,7 @@
 #include <phri/model/algorithms.hpp>
 #include <phri/model/capsule_fit.hpp>
 #include <phri/sim/sim_robot.hpp>
+#include <phri/sim/sim_scene.hpp>
 
 #include <algorithm>
 #include <numbers>
@@ -18,6 +19,7 @@
 #include <exception>
 #include <fstream>
 #include <functional>
+#include <iterator>
 #include <limits>
 #include <memory>
 #include <mutex>
@@ -176,6 +178,36 @@ std::unique_ptr<SimRobot> make_plant(const Shared& s, std::uint64_t plant_seed) 
   return std::make_unique<SimRobot>(config);
 }
 
+// Between the plant and the fault injector: checks the plant's truth after every read the
+// controller does not see (a stall reads the plant many times in one control cycle), so that what
+// the arm does during a stall is judged too. The state the controller sees is checked by Rig::step.
+class PlantTap final : public RobotInterface {
+public:
+  explicit PlantTap(SimRobot& plant) : plant_(plant) {}
+  int dof() const override { return plant_.dof(); }
+  double period_s() const override { return plant_.period_s(); }
+  const RobotState& read() override {
+    if (reads_ > 0 && monitor_ != nullptr && metrics_ != nullptr) {
+      monitor_->update(plant_.truth().q_rad, plant_.truth().qd_rad_s, *metrics_);
+    }
+    ++reads_;
+    return plant_.read();
+  }
+  WriteStatus write(const RobotCommand& command) override { return plant_.write(command); }
+  // Before each control cycle's read.
+  void begin_cycle(SafetyMonitor* monitor, WindowMetrics* m) {
+    monitor_ = monitor;
+    metrics_ = m;
+    reads_ = 0;
+  }
+
+private:
+  SimRobot& plant_;
+  SafetyMonitor* monitor_ = nullptr;
+  WindowMetrics* metrics_ = nullptr;
+  long reads_ = 0;
+};
+
 // One plant, its fault injector and one controller, driven read -> step -> write as
 // app/run_session.cpp does, with the checks of SafetyMonitor on the plant's truth every cycle.
 class Rig {
@@ -184,7 +216,8 @@ public:
       : s_(s),
         loop_(loop),
         robot_(make_plant(s, plant_seed)),
-        io_(*robot_, fault),
+        tap_(*robot_),
+        io_(tap_, fault),
         cycle_(s.model, s.actuators, s.collision, controller_settings(s, mode)),
         command_(robot_->dof()),
         targets_(robot_->dof()),
@@ -192,6 +225,7 @@ public:
 
   // One control cycle; the checks go into m.
   void step(WindowMetrics& m) {
+    tap_.begin_cycle(&monitor_, &m);
     const RobotState& state = io_.read();
     if (state.fault) m.crashed = true;
     const CycleStatus status = cycle_.step(state, targets_, command_);
@@ -216,10 +250,12 @@ public:
 
   // Position loop for position_phase_s, the switch to the loop under test, settle_s. The checks
   // into m (recovery does not apply); false when the start-up already violated something or stopped.
-  bool warm_up(WindowMetrics& m) {
+  // With stay_in_position the run stays in the position loop (a loop switch comes later:
+  // request_loop()).
+  bool warm_up(WindowMetrics& m, bool stay_in_position = false) {
     const long n1 = std::lround(s_.o.position_phase_s / s_.dt), n2 = std::lround(s_.o.settle_s / s_.dt);
     for (long k = 0; k < n1 + n2; ++k) {
-      if (k == n1) targets_.low_level_mode = loop_;
+      if (k == n1 && !stay_in_position) targets_.low_level_mode = loop_;
       step(m);
     }
     m.recovery_time_s = 0.0;
@@ -260,7 +296,10 @@ public:
   }
 
   double time() const { return robot_->state().time_s; }
-  long cycles() const { return io_.cycles(); }
+  long cycles() const { return io_.cycles(); }  ///< control cycles (reads the controller saw)
+  long plant_cycles() const { return static_cast<long>(robot_->state().cycle); }  ///< periods the plant ran
+  void request_loop(LowLevelMode loop) { targets_.low_level_mode = loop; }  ///< at the next step
+  const FaultInjectingRobot& injector() const { return io_; }
   double speed() const { return speed_; }
   double safe_stop_time() const {
     return cycle_.supervisor().safe_stop() ? cycle_.supervisor().safe_stop_transition().time_s : -1.0;
@@ -303,6 +342,7 @@ private:
   const Shared& s_;
   LowLevelMode loop_;
   std::unique_ptr<SimRobot> robot_;
+  PlantTap tap_;
   FaultInjectingRobot io_;
   Controller cycle_;
   RobotCommand command_;
@@ -354,8 +394,8 @@ bool run_push(Rig& rig, const Shared& s, const PushSpec& p, const Eigen::VectorX
   const double start = rig.time();
   r.start_s = start;
   const ExternalForce force = p.disturbance(start);
-  const int plant_body = rig.robot().body_id(p.link);
-  if (plant_body < 0) throw ConfigError(s.o.plant_config_path, "bodies", "the plant has no body '" + p.link + "' to push");
+  const int plant_body = rig.robot().body_id(p.plant_link());
+  if (plant_body < 0) throw ConfigError(s.o.plant_config_path, "bodies", "the plant has no body '" + p.plant_link() + "' to push");
   rig.robot().set_live_disturbance(plant_body, force);
   RecoveryTracker tracker(th, start + p.duration_s, s.o.min_pause_s);
   // Room for the longest walk back (half a turn beyond any joint's range is not possible: 2 pi).
@@ -447,6 +487,35 @@ std::uint64_t fault_seed(const Shared& s, ComplianceMode mode, LowLevelMode loop
   return mix_seed(mix_seed(s.o.seed, 0xFA17), static_cast<std::uint64_t>(static_cast<int>(mode) * 8 + static_cast<int>(loop))) >> 2;
 }
 
+// Extra plant periods a fault takes in one control cycle (a stall's), 0 for the others.
+long stall_periods(const FaultSpec& f) { return f.kind == FaultKind::kStall ? std::lround(std::max(0.0, f.value)) : 0; }
+
+// The lengths a fault runs at rest: its own, or each of the options'.
+std::vector<long> rest_cycles(const Shared& s, const FaultCase& f) {
+  return f.fixed_cycles > 0 ? std::vector<long>{f.fixed_cycles} : s.o.fault_cycles;
+}
+
+// The longest window at rest in plant periods (a stall's periods count).
+long longest_rest_fault(const Shared& s) {
+  long longest = 0;
+  for (const FaultCase& f : s.faults) {
+    for (long c : rest_cycles(s, f)) longest = std::max(longest, c + stall_periods(f.spec));
+  }
+  for (long c : s.o.fault_cycles) longest = std::max(longest, c);
+  return longest;
+}
+
+// Which record fields say what a fault is.
+void describe_fault(FuzzRecord& r, const FaultCase& fault, long cycles) {
+  r.target = fault.name;
+  const bool per_joint = fault.spec.signal != FaultSignal::kWrench &&
+                         (fault.spec.kind == FaultKind::kNaN || fault.spec.kind == FaultKind::kInf ||
+                          fault.spec.kind == FaultKind::kAdd || fault.spec.kind == FaultKind::kDrift);
+  r.joint = per_joint ? fault.spec.joint : -1;
+  r.fault_cycles = cycles;
+  r.fault_kind = std::string(to_string(fault.spec.kind));
+}
+
 // A run that threw (not a configuration error): a crash, with the exception's message.
 void record_crash(FuzzRecord& r, const std::exception& e) {
   r.metrics.crashed = true;
@@ -465,18 +534,17 @@ void reference_run(const Shared& s, const std::string& id, ComplianceMode mode, 
   const std::uint64_t seed = fault_seed(s, mode, loop);
   FuzzRecord r = base_record(id, 0, FuzzCaseKind::kReference, mode, loop, seed);
   r.target = "none";
-  long longest = 0;
-  for (long c : s.o.fault_cycles) longest = std::max(longest, c);
-  const long total = warm_up_cycles(s) + fault_window_cycles(s, longest);
+  r.context = "rest";
+  const long total = warm_up_cycles(s) + fault_window_cycles(s, longest_rest_fault(s));
   try {
     Rig rig(s, mode, loop, seed, FaultSpec{});
     ++out.rigs;
     path.q = Eigen::MatrixXd::Zero(s.model.nq(), total);
     rig.warm_up(r.metrics);
     r.start_s = rig.time();
-    while (rig.cycles() < total && !r.metrics.crashed) {
+    while (rig.plant_cycles() < total && !r.metrics.crashed) {
       rig.step(r.metrics);
-      path.q.col(rig.cycles() - 1) = rig.q();
+      path.q.col(rig.plant_cycles() - 1) = rig.q();
     }
     r.metrics.recovery_time_s = 0.0;
     r.metrics.safe_stop = rig.safe_stop_time() >= 0.0;
@@ -497,11 +565,8 @@ void fault_run(const Shared& s, const std::string& id, ComplianceMode mode, LowL
                long fault_cycles, const ReferencePath& path, TaskOutput& out) {
   const std::uint64_t seed = fault_seed(s, mode, loop);
   FuzzRecord r = base_record(id, 0, FuzzCaseKind::kFault, mode, loop, seed);
-  r.target = fault.name;
-  const bool per_joint = fault.spec.signal != FaultSignal::kWrench &&
-                         (fault.spec.kind == FaultKind::kNaN || fault.spec.kind == FaultKind::kInf || fault.spec.kind == FaultKind::kAdd);
-  r.joint = per_joint ? fault.spec.joint : -1;
-  r.fault_cycles = fault_cycles;
+  describe_fault(r, fault, fault_cycles);
+  r.context = "rest";
   FaultSpec spec = fault.spec;
   spec.start_cycle = warm_up_cycles(s);
   spec.cycles = fault_cycles;
@@ -513,12 +578,15 @@ void fault_run(const Shared& s, const std::string& id, ComplianceMode mode, LowL
     rig.warm_up(warm);  // identical to the reference's start-up (its record judges it)
     WindowMetrics& m = r.metrics;
     r.start_s = rig.time();
-    RecoveryTracker tracker(s.o.thresholds, rig.time() + static_cast<double>(fault_cycles) * s.dt, s.o.fault_observation_s);
-    const long end = std::min<long>(path.q.cols(), spec.start_cycle + fault_window_cycles(s, fault_cycles));
-    while (rig.cycles() < end && !tracker.done() && !m.crashed) {
+    // The window's end in plant time: a stall's periods run inside its one control cycle. The path
+    // is indexed by the plant's cycle (after a stall the controller's cycles lag the plant's).
+    const long periods = fault_cycles + stall_periods(spec);
+    RecoveryTracker tracker(s.o.thresholds, rig.time() + static_cast<double>(periods) * s.dt, s.o.fault_observation_s);
+    const long end = std::min<long>(path.q.cols(), spec.start_cycle + fault_window_cycles(s, periods));
+    while (rig.plant_cycles() < end && !tracker.done() && !m.crashed) {
       rig.step(m);
       int joint = -1;
-      const double deviation = rig.monitor().deviation(rig.q(), path.q.col(rig.cycles() - 1), joint);
+      const double deviation = rig.monitor().deviation(rig.q(), path.q.col(rig.plant_cycles() - 1), joint);
       m.max_deviation_rad = std::max(m.max_deviation_rad, deviation);
       m.final_deviation_rad = deviation;
       m.final_deviation_joint = joint;
@@ -529,6 +597,169 @@ void fault_run(const Shared& s, const std::string& id, ComplianceMode mode, LowL
     r.safe_stop_reason = rig.safe_stop_reason();
     if (m.crashed) r.error = "the simulated plant diverged";
     out.simulated_s += rig.time();
+  } catch (const ConfigError&) {
+    throw;
+  } catch (const std::exception& e) {
+    record_crash(r, e);
+  }
+  finish_record(s, r, out);
+}
+
+// ---- faults in motion and after a loop switch (safety_fuzz.hpp, 2b)
+
+// One (context, mode, loop): its push, its loop switch, its plant seed and the fault-free path.
+struct MotionScenario {
+  bool with_switch = false;  // "switch": position loop until switch_offset cycles into the push
+  ComplianceMode mode = ComplianceMode::kStiff;
+  LowLevelMode loop = LowLevelMode::kPosition;
+  std::uint64_t key = 0;     // seeds of the faults' start times
+  std::uint64_t plant_seed = 0;
+  PushSpec push;
+  long switch_offset = 0;    // cycles after the push began
+  // Filled by the reference run: the plant's true q after each read (column = plant cycle - 1),
+  // from the push on, and the control cycle the push began at.
+  Eigen::MatrixXd q;
+  long push_cycle = -1;
+  bool ready = false;
+
+  const char* context() const { return with_switch ? "switch" : "motion"; }
+};
+
+// Cycles a fault starts after the push began (motion) or after the loop switch (switch), drawn
+// from the seed, the pair and the fault's name (not its place in the catalogue).
+long motion_fault_offset(const Shared& s, const MotionScenario& sc, const FaultCase& fault) {
+  RandomGenerator rng(mix_seed(sc.key, name_hash(fault.name)), 3);
+  const MotionFaultRanges& r = s.o.motion;
+  const double offset_s = sc.with_switch ? rng.uniform(0.0, r.max_switch_delay_s) : rng.uniform(r.min_fault_start_s, r.max_fault_start_s);
+  return std::lround(offset_s / s.dt);
+}
+
+// Plant cycles a motion reference runs at least after its push began: past the latest fault start,
+// the longest fault, the push, the recovery time and the safe stop's rest time (and 2 s more).
+long motion_horizon_cycles(const Shared& s, const MotionScenario& sc) {
+  const SafetyFuzzThresholds& th = s.o.thresholds;
+  long longest = 0;
+  for (const FaultCase& f : s.faults) longest = std::max(longest, f.cycles_in_motion() + stall_periods(f.spec));
+  const double latest_fault_s = static_cast<double>(sc.switch_offset) * s.dt +
+                                (sc.with_switch ? s.o.motion.max_switch_delay_s : s.o.motion.max_fault_start_s);
+  const double after_s = std::max(sc.push.duration_s - latest_fault_s, static_cast<double>(longest) * s.dt);
+  return std::lround((latest_fault_s + after_s + th.recovery_time_s + th.safe_stop_rest_time_s + 2.0) / s.dt);
+}
+
+// One run of a motion scenario: the reference (fault null) records the path and is judged as a
+// push (back at the pose held before it, dual compliance: or at rest); a faulted run is judged from
+// its fault on against the reference's path.
+void motion_run(const Shared& s, const std::string& id, MotionScenario& sc, const FaultCase* fault, TaskOutput& out) {
+  const SafetyFuzzThresholds& th = s.o.thresholds;
+  const bool reference = fault == nullptr;
+  const bool dual = sc.mode == ComplianceMode::kDual;
+  FuzzRecord r = base_record(id, 0, reference ? FuzzCaseKind::kReference : FuzzCaseKind::kFault, sc.mode, sc.loop, sc.plant_seed);
+  r.context = sc.context();
+  r.push_link = sc.push.plant_link();
+  r.force_N = sc.push.magnitude_N;
+  r.profile = std::string(to_string(sc.push.profile));
+  r.duration_s = sc.push.duration_s;
+  FaultSpec spec;
+  long fault_cycles = 0, offset = 0;
+  if (reference) {
+    r.target = "none";
+  } else {
+    if (!sc.ready) throw ExperimentError("safety fuzz", "no reference path for " + id);
+    fault_cycles = fault->cycles_in_motion();
+    offset = motion_fault_offset(s, sc, *fault);
+    describe_fault(r, *fault, fault_cycles);
+    r.fault_offset_s = static_cast<double>(offset) * s.dt;
+    spec = fault->spec;
+    spec.start_cycle = sc.push_cycle + (sc.with_switch ? sc.switch_offset : 0) + offset;
+    spec.cycles = fault_cycles;
+  }
+  WindowMetrics& m = r.metrics;
+  try {
+    Rig rig(s, sc.mode, sc.loop, sc.plant_seed, spec);
+    ++out.rigs;
+    if (!s.o.trace_path.empty()) rig.trace_to(s.o.trace_path, false);
+    WindowMetrics warm;
+    WindowMetrics& start_metrics = reference ? m : warm;  // a faulted run's start-up is the reference's
+    rig.warm_up(start_metrics, sc.with_switch);
+    rig.settle(start_metrics, kFirstPushSettleMax_s);
+    const long push_cycle = rig.cycles();
+    // The reference runs at least the horizon, and on until its own window is decided (a carried arm
+    // walks back at the return leash's speed); the path grows as it goes. A faulted window may run as
+    // long (its deviation after the reference's end is taken from the reference's last pose).
+    const long horizon_end = push_cycle + motion_horizon_cycles(s, sc);
+    const long cap = horizon_end + std::lround(2.0 * std::numbers::pi / th.return_speed_rad_s / s.dt);
+    if (reference) {
+      sc.push_cycle = push_cycle;
+      sc.q = Eigen::MatrixXd::Zero(s.model.nq(), horizon_end);
+    } else if (push_cycle != sc.push_cycle) {
+      throw ExperimentError("safety fuzz", id + ": the run left its reference's path before the fault (push at cycle " +
+                                               std::to_string(push_cycle) + ", reference " + std::to_string(sc.push_cycle) + ")");
+    }
+    const Eigen::VectorXd q_held = rig.q();
+    const double push_start = rig.time();
+    const ExternalForce force = sc.push.disturbance(push_start);
+    const int plant_body = rig.robot().body_id(sc.push.plant_link());
+    if (plant_body < 0) {
+      throw ConfigError(s.o.plant_config_path, "bodies", "the plant has no body '" + sc.push.plant_link() + "' to push");
+    }
+    rig.robot().set_live_disturbance(plant_body, force);
+    const double push_end = push_start + sc.push.duration_s;
+    // The window's end in plant time (the reference's: the push's).
+    const double fault_end = reference ? push_end
+                                       : push_start + static_cast<double>(spec.start_cycle - push_cycle + fault_cycles +
+                                                                          stall_periods(spec)) * s.dt;
+    RecoveryTracker tracker(th, fault_end, reference ? s.o.min_pause_s : s.o.fault_observation_s);
+    const long switch_cycle = sc.with_switch ? push_cycle + sc.switch_offset : -1;
+    bool fault_seen = false;
+    auto go_on = [&]() {
+      if (m.crashed || rig.plant_cycles() >= cap) return false;
+      return reference ? rig.plant_cycles() < horizon_end || !tracker.done() : !tracker.done();
+    };
+    while (go_on()) {
+      if (rig.cycles() == switch_cycle) rig.request_loop(sc.loop);
+      // A faulted run is the reference until its fault: judged from the fault's first cycle on.
+      const bool judged = reference || rig.cycles() >= spec.start_cycle;
+      WindowMetrics& cycle_metrics = judged ? m : warm;
+      rig.step(cycle_metrics);
+      const double t = rig.time();
+      if (reference) {
+        if (rig.plant_cycles() > sc.q.cols()) sc.q.conservativeResize(Eigen::NoChange, sc.q.cols() + 1000);
+        sc.q.col(rig.plant_cycles() - 1) = rig.q();
+      }
+      const double scale = force.scale_at(t - 0.5 * s.dt);
+      if (scale > 0.0) {
+        rig.monitor().push_torque_ratio(sc.push.body, sc.push.point_local, scale * sc.push.force_N, sc.push.local_frame,
+                                        cycle_metrics);
+      }
+      if (!judged) continue;
+      if (!reference && !fault_seen) {
+        fault_seen = true;
+        r.start_s = t;
+      }
+      int joint = -1;
+      const double from_reference = rig.monitor().deviation(
+          rig.q(), reference ? Eigen::Ref<const Eigen::VectorXd>(q_held)
+                             : Eigen::Ref<const Eigen::VectorXd>(sc.q.col(std::min<long>(rig.plant_cycles(), sc.q.cols()) - 1)),
+          joint);
+      // Dual compliance keeps the pose the hand left it in: at rest after the push, it is back.
+      const bool rests_where_left = dual && t >= push_end && rig.speed() < th.rest_speed_rad_s;
+      const double deviation = rests_where_left ? 0.0 : from_reference;
+      if (!reference || t >= push_end) m.max_deviation_rad = std::max(m.max_deviation_rad, deviation);
+      m.final_deviation_rad = deviation;
+      m.final_deviation_joint = rests_where_left ? -1 : joint;
+      m.final_speed_rad_s = rig.speed();
+      tracker.sample(t, deviation, rig.speed(), rig.safe_stop_time());
+    }
+    rig.robot().set_live_disturbance(-1, force);
+    if (reference) r.start_s = push_start;
+    tracker.finish(m);
+    r.safe_stop_reason = rig.safe_stop_reason();
+    if (m.crashed) r.error = "the simulated plant diverged";
+    out.simulated_s += rig.time();
+    if (reference) {
+      sc.q.conservativeResize(Eigen::NoChange, std::min<long>(sc.q.cols(), rig.plant_cycles()));
+      sc.ready = true;
+    }
   } catch (const ConfigError&) {
     throw;
   } catch (const std::exception& e) {
@@ -609,7 +840,7 @@ void add_fault_tasks(const Shared& s, std::vector<Task>& references, std::vector
                               reference_run(s, ref_id, mode, loop, *path, out);
                             }});
       for (const FaultCase& fault : s.faults) {
-        for (long cycles : s.o.fault_cycles) {
+        for (long cycles : rest_cycles(s, fault)) {
           const std::string id = "fault/" + pair_id(mode, loop) + "/" + fault.name + "/" + std::to_string(cycles);
           tasks.push_back({id, 2.0, [&s, id, mode, loop, &fault, cycles, path, ref_id](TaskOutput& out) {
                              if (!path->ready) throw ExperimentError("safety fuzz", "no reference path for " + ref_id);
@@ -621,6 +852,51 @@ void add_fault_tasks(const Shared& s, std::vector<Task>& references, std::vector
   }
 }
 
+
+// The fault-in-motion and loop-switch windows: per context and pair a reference (its own phase)
+// and one task per fault. kAll: every fault on every modes x loops pair; kSubset: a few faults on
+// the fault_modes.
+void add_motion_tasks(const Shared& s, std::vector<Task>& references, std::vector<Task>& tasks,
+                      std::vector<std::unique_ptr<MotionScenario>>& scenarios) {
+  if (s.faults.empty() || !s.o.motion_faults) return;
+  static const char* const kSubsetMotionFaults[] = {"nan_q", "stall_50", "wrench_stuck"};
+  std::vector<const FaultCase*> faults;
+  for (const FaultCase& f : s.faults) {
+    const bool in_subset = std::any_of(std::begin(kSubsetMotionFaults), std::end(kSubsetMotionFaults),
+                                       [&](const char* name) { return f.name == name; });
+    if (s.o.faults == FaultSet::kAll || in_subset) faults.push_back(&f);
+  }
+  const std::vector<ComplianceMode>& modes = s.o.faults == FaultSet::kAll ? s.o.modes : s.o.fault_modes;
+  const bool hand_on_tool_possible = s.plant.ft_sensor_present() && s.model.has_frame("ft_sensor");
+  for (const bool with_switch : {false, true}) {
+    for (ComplianceMode mode : modes) {
+      for (LowLevelMode loop : s.o.loops) {
+        if (with_switch && loop == LowLevelMode::kPosition) continue;  // no switch to make
+        auto sc = std::make_unique<MotionScenario>();
+        sc->with_switch = with_switch;
+        sc->mode = mode;
+        sc->loop = loop;
+        const std::uint64_t pair_seed = mix_seed(mix_seed(s.o.seed, 0x307104ULL), pair_key(mode, loop));
+        sc->key = mix_seed(pair_seed, with_switch ? 0x5717C4ULL : 0x4071014ULL);
+        sc->plant_seed = mix_seed(sc->key, 2) >> 2;
+        RandomGenerator push_rng(mix_seed(pair_seed, 1), 1);  // the same push in both contexts
+        sc->push = draw_motion_push(push_rng, s.model, *s.collision, s.o.motion,
+                                    mode == ComplianceMode::kDual && hand_on_tool_possible, SimScene::kToolBody, "ft_sensor");
+        RandomGenerator switch_rng(mix_seed(sc->key, 4), 4);
+        sc->switch_offset = with_switch ? std::lround(switch_rng.uniform(s.o.motion.min_fault_start_s, s.o.motion.max_fault_start_s) / s.dt) : 0;
+        MotionScenario* scenario = sc.get();
+        scenarios.push_back(std::move(sc));
+        const std::string context = scenario->context();
+        const std::string ref_id = context + "-reference/" + pair_id(mode, loop);
+        references.push_back({ref_id, 8.0, [&s, ref_id, scenario](TaskOutput& out) { motion_run(s, ref_id, *scenario, nullptr, out); }});
+        for (const FaultCase* fault : faults) {
+          const std::string id = context + "/" + pair_id(mode, loop) + "/" + fault->name;
+          tasks.push_back({id, 3.0, [&s, id, scenario, fault](TaskOutput& out) { motion_run(s, id, *scenario, fault, out); }});
+        }
+      }
+    }
+  }
+}
 
 // Runs `tasks` on `jobs` threads (the longest first); each task's output lands at its index, so
 // the result does not depend on the scheduling. The first error (a ConfigError, say) is rethrown.
@@ -701,11 +977,14 @@ void keep_replay(const std::string& id, std::vector<Task>& references, std::vect
     throw ConfigError("<safety fuzz options>", "replay", "no run '" + id + "' with these options (see report.md for the ids)");
   }
   std::erase_if(tasks, [&](const Task& t) { return !named(t); });
-  // A fault run needs the reference of its (mode, loop): "fault/<mode>/<loop>/..." -> "reference/<mode>/<loop>".
+  // A fault run needs the reference of its (mode, loop): "fault/<mode>/<loop>/..." -> "reference/<mode>/<loop>",
+  // "motion/..." -> "motion-reference/...", "switch/..." -> "switch-reference/...".
   std::string reference = id;
-  if (id.rfind("fault/", 0) == 0) {
-    const std::size_t mode_end = id.find('/', 6), loop_end = id.find('/', mode_end + 1);
-    reference = "reference/" + id.substr(6, loop_end - 6);
+  for (const auto& [prefix, reference_prefix] : {std::pair<std::string, std::string>{"fault/", "reference/"},
+                                                 {"motion/", "motion-reference/"}, {"switch/", "switch-reference/"}}) {
+    if (id.rfind(prefix, 0) != 0) continue;
+    const std::size_t p = prefix.size(), mode_end = id.find('/', p), loop_end = id.find('/', mode_end + 1);
+    reference = reference_prefix + id.substr(p, loop_end - p);
   }
   std::erase_if(references, [&](const Task& t) { return t.id != reference; });
 }
@@ -730,6 +1009,11 @@ long SafetyFuzzResult::pushes() const {
   });
 }
 
+long SafetyFuzzResult::faults_in(std::string_view context) const {
+  return std::count_if(records.begin(), records.end(),
+                       [&](const FuzzRecord& r) { return r.kind == FuzzCaseKind::kFault && r.context == context; });
+}
+
 long SafetyFuzzResult::faults() const {
   return std::count_if(records.begin(), records.end(), [](const FuzzRecord& r) { return r.kind == FuzzCaseKind::kFault; });
 }
@@ -743,6 +1027,8 @@ SafetyFuzzResult run_safety_fuzz(const SafetyFuzzOptions& o, std::ostream* progr
   add_push_tasks(*shared, tasks);
   add_targeted_tasks(*shared, tasks);
   add_fault_tasks(*shared, references, tasks, paths);
+  std::vector<std::unique_ptr<MotionScenario>> scenarios;
+  add_motion_tasks(*shared, references, tasks, scenarios);
   if (!o.replay.empty()) keep_replay(o.replay, references, tasks);
   if (progress) {
     *progress << "safety-fuzz: seed " << o.seed << ", " << references.size() + tasks.size() << " runs (" << shared->faults.size()

@@ -13,11 +13,27 @@
 //    direction into it, step / ramp / half-sine, 0.05-2 s), pushes_per_run per run, the next one
 //    starting when the arm is back and settled; plus, per pair, sustained 60 N pushes driving each
 //    limited joint toward each of its limits (2 s) and a wrist fold toward the base (3 s).
-// 2. Sensor faults (FaultInjectingRobot between the plant and the controller): the catalogue of
-//    safety_fuzz_cases.hpp, each for 1 and for 100 cycles, on every loop and on fault_modes; each
+// 2. Sensor faults (FaultInjectingRobot between the plant and the controller) on an arm at rest:
+//    the catalogue of safety_fuzz_cases.hpp, each for 1 and for 100 cycles (a fault with a length of
+//    its own, a stall, a one-sample jump, a held offset or a drift, for that), on every loop and on
+//    fault_modes; each
 //    (mode, loop) has a fault-free reference run with the same plant seed whose path the faulted
 //    runs are compared with (the decorator passes the plant's state through bit for bit outside
 //    the fault's window, so both runs are identical until it opens).
+// 2b. Faults in motion (motion_faults): on every compliance mode x loop pair (kSubset: the
+//    fault_modes, three of the faults), one push drawn from the seed (a ramp to 20-80 N lasting
+//    1-2 s on a random moving link's capsule; in dual compliance a hand on the tool, below the F/T
+//    sensor, so that the dual trigger engages), and every fault of the catalogue starting at a random
+//    time 0.1-0.5 s into the push (drawn from the seed and the fault's name), for its length in motion
+//    (100 cycles for sustained faults, 1 for spikes and one-sample jumps; a stall is one read of its
+//    periods). Each pair has a fault-free reference run with the same push and plant seed (the
+//    "motion-reference"; judged itself as a push), whose path the faulted runs are compared with
+//    after the fault, indexed by the plant's cycle (a stall skips ahead). And after a loop switch:
+//    the run stays in the position loop through the warm-up, the push begins, 0.1-0.5 s into it the
+//    controller is switched to the loop under test on the moving arm, and each fault starts 0-50 ms
+//    after the switch (a "switch-reference" per pair; no such windows for the position loop).
+//    In dual compliance an arm at rest after the hand let go counts as back (it keeps the pose it is
+//    pushed to), as for the pushes.
 // 3. Every cycle, on the plant's truth: joint limits, |q̇| > 1.05 x its limit, capsule distances,
 //    non-finite commands, refused writes (the harness reports each to the controller; one not
 //    followed by a safe stop is "unhandled"), exceptions and a diverged plant. After each push or
@@ -28,6 +44,9 @@
 //    resist (safety_fuzz_metrics.hpp), a controller failure otherwise. After a safe stop, a window
 //    without recovery or a crash, the run goes on with a fresh plant and controller.
 //
+// Run ids: push/<mode>/<loop>/<n>, targeted/<mode>/<loop>, reference/<mode>/<loop>,
+// fault/<mode>/<loop>/<fault>/<cycles> (at rest), motion-reference/<mode>/<loop>,
+// motion/<mode>/<loop>/<fault>, switch-reference/<mode>/<loop>, switch/<mode>/<loop>/<fault>.
 // Runs are independent, deterministic functions of (seed, run id, pushes, pushes_per_run): they
 // run on `jobs` threads (each SimRobot has its own mjModel/mjData; MuJoCo's model compiler is
 // serialized) and any one can be replayed alone (`replay`, the ids in the report).
@@ -68,7 +87,9 @@ struct SafetyFuzzOptions {
                                      LowLevelMode::kKinovaTorqueHighVelocity, LowLevelMode::kCurrent};
   std::vector<ComplianceMode> modes = {ComplianceMode::kStiff, ComplianceMode::kNullSpace, ComplianceMode::kFullBody,
                                        ComplianceMode::kDual};
-  std::vector<long> fault_cycles = {1, 100};
+  std::vector<long> fault_cycles = {1, 100};  ///< at rest, for the faults without a length of their own
+  bool motion_faults = true;   ///< with faults: the fault-in-motion and loop-switch windows (2b above)
+  MotionFaultRanges motion;
   int jobs = 2;
   std::string replay;          ///< run only this run (an id of the report); empty: all
   std::string trace_path;      ///< with replay: every cycle of the replayed run as CSV; empty: none
@@ -118,6 +139,10 @@ struct FuzzRecord {
   double duration_s = 0.0;
   // fault
   long fault_cycles = 0;
+  std::string fault_kind;    ///< the decorator's FaultKind (to_string)
+  std::string context;       ///< fault or its reference: "rest", "motion" or "switch"; pushes: empty
+  std::string push_link;     ///< motion / switch: the link (or tool) the push lands on
+  double fault_offset_s = 0.0;  ///< motion: after the push began; switch: after the loop switch
   WindowMetrics metrics;
   FuzzVerdict verdict;
   std::string safe_stop_reason;
@@ -133,7 +158,8 @@ struct SafetyFuzzResult {
 
   long controller_failures() const;
   long pushes() const;    ///< push windows (random and targeted)
-  long faults() const;
+  long faults() const;    ///< fault windows, at rest, in motion and after a loop switch
+  long faults_in(std::string_view context) const;  ///< "rest", "motion" or "switch"
 };
 
 /// Runs everything the options ask for; progress lines on `progress` (may be null). Writes the

@@ -19,7 +19,7 @@ std::uint64_t mix_seed(std::uint64_t a, std::uint64_t b) {
 
 ExternalForce PushSpec::disturbance(double start_s) const {
   ExternalForce f;
-  f.point_m = point_local;
+  f.point_m = plant_body.empty() ? point_local : plant_point_local;
   f.frame = local_frame ? ExternalForce::Frame::kLocal : ExternalForce::Frame::kWorld;
   f.force_N = force_N;
   f.profile = profile;
@@ -84,6 +84,37 @@ PushSpec draw_random_push(RandomGenerator& rng, const Model& model, const Collis
   p.duration_s = rng.uniform(ranges.min_duration_s, ranges.max_duration_s);
   p.rise_s = p.duration_s * rng.uniform(0.1, 1.0);
   return p;
+}
+
+PushSpec draw_motion_push(RandomGenerator& rng, const Model& model, const CollisionModel& collision,
+                          const MotionFaultRanges& ranges, bool hand_on_tool, const std::string& tool_body,
+                          const std::string& tool_frame) {
+  RandomPushRanges push_ranges;
+  push_ranges.min_force_N = ranges.min_force_N;
+  push_ranges.max_force_N = ranges.max_force_N;
+  push_ranges.min_duration_s = ranges.min_duration_s;
+  push_ranges.max_duration_s = ranges.max_duration_s;
+  PushSpec p = draw_random_push(rng, model, collision, push_ranges);
+  p.profile = ExternalForce::Profile::kRamp;
+  if (!hand_on_tool) return p;
+  const Frame& frame = model.frame(model.frame_id(tool_frame));
+  p.body = frame.body;
+  p.link = tool_frame;
+  p.plant_body = tool_body;
+  p.plant_point_local = Eigen::Vector3d::Zero();
+  p.point_local = frame.placement.translation();
+  p.local_frame = false;
+  p.force_N = p.magnitude_N * random_unit(rng);
+  return p;
+}
+
+std::uint64_t name_hash(std::string_view name) {
+  std::uint64_t h = 0xCBF29CE484222325ULL;
+  for (const char c : name) {
+    h ^= static_cast<unsigned char>(c);
+    h *= 0x100000001B3ULL;
+  }
+  return h;
 }
 
 PushSpec joint_limit_push(const Model& model, const Data& data, int joint, int toward, double force_N, double duration_s) {
@@ -169,11 +200,29 @@ std::vector<FaultCase> fault_catalogue(FaultSet set, int dof, std::uint64_t seed
   all.push_back(make_case("wrench_spike_200N", K::kAdd, S::kWrench, 200.0, 0));
   all.push_back(make_case("wrench_nan", K::kNaN, S::kWrench, 0.0, 0));
   all.push_back(make_case("write_refused", K::kWriteRefused, S::kPosition, 0.0, 0));
+  // Spikes are one sample in motion (at rest: each of the options' lengths, as before).
+  for (FaultCase& c : all) {
+    if (c.name.rfind("spike_", 0) == 0 || c.name.rfind("wrench_spike_", 0) == 0) c.motion_cycles = 1;
+  }
+  // Issue 37's additions (drawn after the older entries so their joints and signs stay as they were).
+  auto fixed = [&](FaultCase c, long cycles) {
+    c.fixed_cycles = cycles;
+    all.push_back(std::move(c));
+  };
+  for (int periods : {19, 20, 50}) fixed(make_case("stall_" + std::to_string(periods), K::kStall, S::kPosition, periods, 0), 1);
+  const int random_stall = std::clamp(1 + static_cast<int>(rng.uniform() * 100.0), 1, 100);
+  fixed(make_case("stall_random_" + std::to_string(random_stall), K::kStall, S::kPosition, random_stall, 0), 1);
+  fixed(make_case("sequence_jump_1e6", K::kSequenceJump, S::kPosition, 1e6, 0), 1);
+  fixed(make_case("offset_tau_50Nm", K::kAdd, S::kTorque, 50.0, joint()), 100);
+  fixed(make_case("drift_tau_50Nm", K::kDrift, S::kTorque, 50.0, joint()), 100);
+  all.push_back(make_case("wrench_stuck", K::kWrenchStuck, S::kWrench, 0.0, 0));
+  all.push_back(make_case("wrench_stale", K::kWrenchStale, S::kWrench, 0.0, 0));
+  all.push_back(make_case("wrench_invalid", K::kWrenchInvalid, S::kWrench, 0.0, 0));
   if (set == FaultSet::kAll) return all;
   std::vector<FaultCase> subset;
   for (const FaultCase& c : all) {
     if (c.name == "nan_q" || c.name == "spike_tau_50Nm" || c.name == "stale_frame" || c.name == "short_current_0" ||
-        c.name == "wrench_spike_1e6N" || c.name == "write_refused") {
+        c.name == "wrench_spike_1e6N" || c.name == "write_refused" || c.name == "stall_50" || c.name == "wrench_stuck") {
       subset.push_back(c);
     }
   }

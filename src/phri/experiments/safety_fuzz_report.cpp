@@ -10,6 +10,7 @@
 #include <numbers>
 #include <ostream>
 #include <sstream>
+#include <tuple>
 
 namespace phri {
 namespace {
@@ -53,6 +54,13 @@ std::string what(const FuzzRecord& r) {
   } else if (r.kind == FuzzCaseKind::kFault) {
     s << r.target << " x" << r.fault_cycles;
     if (r.joint >= 0) s << " (joint " << r.joint + 1 << ")";
+    if (r.context == "motion" || r.context == "switch") {
+      s << " " << format_fixed(r.fault_offset_s, 3) << " s after " << (r.context == "switch" ? "the loop switch in " : "the start of ")
+        << format_fixed(r.force_N, 0) << " N " << r.profile << " " << format_fixed(r.duration_s, 2) << " s on " << r.push_link;
+    }
+  } else if (r.context == "motion" || r.context == "switch") {
+    s << r.context << " reference: " << format_fixed(r.force_N, 0) << " N " << r.profile << " " << format_fixed(r.duration_s, 2)
+      << " s on " << r.push_link;
   } else {
     s << to_string(r.kind);
   }
@@ -134,10 +142,10 @@ void fault_table(const SafetyFuzzResult& result, std::ostream& s) {
     unsigned categories = 0;
     std::string where;
   };
-  std::map<std::pair<std::string, long>, Row> rows;
+  std::map<std::tuple<std::string, std::string, long>, Row> rows;
   for (const FuzzRecord& r : result.records) {
     if (r.kind != FuzzCaseKind::kFault) continue;
-    Row& row = rows[{r.target, r.fault_cycles}];
+    Row& row = rows[{r.context, r.target, r.fault_cycles}];
     ++row.runs;
     row.safe_stops += r.metrics.safe_stop;
     if (!r.verdict.controller_failure()) continue;
@@ -146,11 +154,62 @@ void fault_table(const SafetyFuzzResult& result, std::ostream& s) {
     row.where += (row.where.empty() ? "" : ", ") + std::string(to_string(r.mode)) + "/" + std::string(to_string(r.loop));
   }
   if (rows.empty()) return;
-  s << "## Sensor faults\n\n| fault | cycles | runs | safe stops | controller failures | categories | where |\n"
-       "|---|---|---|---|---|---|---|\n";
+  s << "## Sensor faults\n\n| when | fault | cycles | runs | safe stops | controller failures | categories | where |\n"
+       "|---|---|---|---|---|---|---|---|\n";
   for (const auto& [key, row] : rows) {
-    s << "| " << key.first << " | " << key.second << " | " << row.runs << " | " << row.safe_stops << " | " << row.failures
+    s << "| " << std::get<0>(key) << " | " << std::get<1>(key) << " | " << std::get<2>(key) << " | " << row.runs << " | " << row.safe_stops << " | " << row.failures
       << " | " << violation_list(row.categories) << " | " << row.where << " |\n";
+  }
+  s << "\n";
+}
+
+// Every fault kind (catalogue entry) at rest, in motion and after a loop switch: windows, controller
+// failures, safe stops; then the same by the decorator's kind.
+void fault_kind_table(const SafetyFuzzResult& result, std::ostream& s) {
+  struct Cell {
+    long windows = 0, failures = 0, safe_stops = 0;
+  };
+  struct Row {
+    Cell cells[3];
+    unsigned categories = 0;
+  };
+  std::map<std::string, Row> by_name, by_kind;
+  std::map<std::string, std::string> kind_of;
+  long totals[3] = {0, 0, 0}, failures[3] = {0, 0, 0};
+  for (const FuzzRecord& r : result.records) {
+    if (r.kind != FuzzCaseKind::kFault) continue;
+    const int c = r.context == "motion" ? 1 : r.context == "switch" ? 2 : 0;
+    kind_of[r.target] = r.fault_kind;
+    for (Row* row : {&by_name[r.target], &by_kind[r.fault_kind]}) {
+      ++row->cells[c].windows;
+      row->cells[c].safe_stops += r.metrics.safe_stop;
+      if (r.verdict.controller_failure()) {
+        ++row->cells[c].failures;
+        row->categories |= r.verdict.violations;
+      }
+    }
+    ++totals[c];
+    failures[c] += r.verdict.controller_failure();
+  }
+  if (by_name.empty()) return;
+  auto cell = [](const Cell& x) {
+    return x.windows == 0 ? std::string("-")
+                          : std::to_string(x.failures) + " / " + std::to_string(x.windows) + " (" + std::to_string(x.safe_stops) + ")";
+  };
+  s << "## Sensor faults by kind, at rest and in motion\n\nController failures / windows (safe stops) per fault, at rest ("
+    << failures[0] << " / " << totals[0] << "), during a push (" << failures[1] << " / " << totals[1]
+    << ") and 0-50 ms after a loop switch on a pushed arm (" << failures[2] << " / " << totals[2] << ").\n\n"
+    << "| fault | kind | at rest | in motion | after a loop switch | categories |\n|---|---|---|---|---|---|\n";
+  for (const auto& [name, row] : by_name) {
+    s << "| " << name << " | " << kind_of[name];
+    for (const Cell& c : row.cells) s << " | " << cell(c);
+    s << " | " << violation_list(row.categories) << " |\n";
+  }
+  s << "\n| decorator kind | at rest | in motion | after a loop switch | categories |\n|---|---|---|---|---|\n";
+  for (const auto& [kind, row] : by_kind) {
+    s << "| " << kind;
+    for (const Cell& c : row.cells) s << " | " << cell(c);
+    s << " | " << violation_list(row.categories) << " |\n";
   }
   s << "\n";
 }
@@ -270,7 +329,7 @@ std::string safety_fuzz_csv(const SafetyFuzzResult& result) {
   s << "run_id,index,kind,mode,loop,plant_seed,start_s,target,joint,force_N,profile,duration_s,fault_cycles,"
        "max_speed_ratio,min_limit_margin_rad,min_capsule_distance_mm,required_torque_ratio,max_deviation_rad,final_deviation_rad,final_deviation_joint,final_speed_rad_s,"
        "recovery_time_s,safe_stop,safe_stop_reason,safe_stop_rest_time_s,refused_writes,unhandled_refusals,nan_command,"
-       "crashed,violations,operator_possible,controller_failure,error\n";
+       "crashed,violations,operator_possible,controller_failure,context,fault_kind,push_link,fault_offset_s,error\n";
   for (const FuzzRecord& r : result.records) {
     const WindowMetrics& m = r.metrics;
     std::string error = r.error;
@@ -285,7 +344,8 @@ std::string safety_fuzz_csv(const SafetyFuzzResult& result) {
       << r.safe_stop_reason << ',' << number(m.safe_stop_rest_time_s, 3) << ',' << m.refused_writes << ','
       << m.unhandled_refusals << ',' << (m.nan_command ? 1 : 0) << ',' << (m.crashed ? 1 : 0) << ','
       << violation_list(r.verdict.violations) << ',' << (r.verdict.operator_possible ? 1 : 0) << ','
-      << (r.verdict.controller_failure() ? 1 : 0) << ',' << error << '\n';
+      << (r.verdict.controller_failure() ? 1 : 0) << ',' << r.context << ',' << r.fault_kind << ',' << r.push_link << ','
+      << format_fixed(r.fault_offset_s, 3) << ',' << error << '\n';
   }
   return s.str();
 }
@@ -297,7 +357,9 @@ std::string safety_fuzz_report(const SafetyFuzzResult& result, const SafetyFuzzO
   const SafetyFuzzThresholds& t = o.thresholds;
   s << "# Safety fuzz, seed " << o.seed << "\n\n"
     << result.pushes() << " pushes (" << kinds[0] << " random, " << kinds[1] << " toward joint limits, " << kinds[2]
-    << " wrist folds) and " << result.faults() << " sensor faults (" << kinds[4] << " fault-free references) on "
+    << " wrist folds) and " << result.faults() << " sensor faults (" << result.faults_in("rest") << " at rest, "
+    << result.faults_in("motion") << " during a push, " << result.faults_in("switch") << " after a loop switch; " << kinds[4]
+    << " fault-free references) on "
     << result.runs << " plant + controller constructions; " << format_fixed(result.simulated_s, 0) << " s simulated in "
     << format_fixed(result.wall_s, 1) << " s of wall time with " << o.jobs << " jobs. **" << result.controller_failures()
     << " controller failures.**" << (o.replay.empty() ? "" : " Replay of `" + o.replay + "` only.") << "\n\n"
@@ -314,6 +376,7 @@ std::string safety_fuzz_report(const SafetyFuzzResult& result, const SafetyFuzzO
   pair_table(result, s);
   category_table(result, s);
   fault_table(result, s);
+  fault_kind_table(result, s);
   no_recovery_table(result, s);
   margins(result, s);
   failure_list(result, o, s);
@@ -326,7 +389,8 @@ int run_safety_fuzz_command(const SafetyFuzzOptions& options, bool fail_on_viola
       << " random pushes" << std::endl;
   const SafetyFuzzResult r = run_safety_fuzz(options, &out);
   std::ostringstream summary;
-  summary << r.pushes() << " pushes, " << r.faults() << " faults, " << r.runs << " runs: " << format_fixed(r.simulated_s, 0)
+  summary << r.pushes() << " pushes, " << r.faults() << " faults (" << r.faults_in("rest") << " at rest, " << r.faults_in("motion")
+          << " in motion, " << r.faults_in("switch") << " after a loop switch), " << r.runs << " runs: " << format_fixed(r.simulated_s, 0)
           << " s simulated in " << format_fixed(r.wall_s, 1) << " s of wall time\n";
   summary << "controller failures: " << r.controller_failures();
   for (int i = 0; i < kFuzzViolationCount; ++i) {
@@ -336,6 +400,16 @@ int run_safety_fuzz_command(const SafetyFuzzOptions& options, bool fail_on_viola
     if (n > 0) summary << ", " << violation_name(i) << " " << n;
   }
   summary << "\n";
+  if (r.faults() > 0) {
+    summary << "fault windows failed:";
+    for (const char* context : {"rest", "motion", "switch"}) {
+      const long n = std::count_if(r.records.begin(), r.records.end(), [&](const FuzzRecord& x) {
+        return x.kind == FuzzCaseKind::kFault && x.context == context && x.verdict.controller_failure();
+      });
+      summary << " " << context << " " << n << "/" << r.faults_in(context);
+    }
+    summary << "\n";
+  }
   const std::vector<const FuzzRecord*> f = failures_worst_first(r);
   for (std::size_t i = 0; i < std::min<std::size_t>(f.size(), 5); ++i) {
     summary << "  " << violation_list(f[i]->verdict.violations) << ": " << what(*f[i]) << " -> " << replay_command(*f[i], options)
