@@ -493,6 +493,7 @@ struct SafetyFuzzArguments {
   phri::SafetyFuzzOptions fuzz;
   std::string faults = "all";
   bool no_targeted = false;
+  bool no_motion_faults = false;
   bool fail_on_violation = false;
 };
 
@@ -512,6 +513,8 @@ CLI::App* add_safety_fuzz_command(CLI::App& experiment, SafetyFuzzArguments& arg
       ->check(CLI::Range(1, 1000))
       ->capture_default_str();
   fuzz->add_flag("--no-targeted", args.no_targeted, "leave out the pushes toward the joint limits and the wrist folds");
+  fuzz->add_flag("--no-motion-faults", args.no_motion_faults,
+                 "inject the faults only into an arm at rest (not during a push, nor after a loop switch)");
   fuzz->add_option("--replay", o.replay, "run only this run (an id from report.md)");
   fuzz->add_option("--trace", o.trace_path, "with --replay: the run's every cycle as CSV (plant truth, command, push)")
       ->needs("--replay");
@@ -538,6 +541,7 @@ int safety_fuzz_command(SafetyFuzzArguments& args) {
   phri::SafetyFuzzOptions& o = args.fuzz;
   o.faults = args.faults == "none" ? phri::FaultSet::kNone : args.faults == "subset" ? phri::FaultSet::kSubset : phri::FaultSet::kAll;
   o.targeted_pushes = !args.no_targeted;
+  o.motion_faults = !args.no_motion_faults;
   for (std::string* path : {&o.plant_config_path, &o.urdf_path, &o.actuators_path, &o.collision_path, &o.figure_script}) {
     *path = locate(*path);
   }
