@@ -5,7 +5,10 @@
 // stale, 100 samples of 1e6 N), the hand leaves. The F/T source must be dropped, the touch trigger
 // released and the arm held where it was when the fault began; the same run without a fault (and
 // with a push on the elbow the F/T does not see) must raise no alarm.
+#include <phri/app/log_row.hpp>
+#include <phri/app/logger.hpp>
 #include <phri/control/controller.hpp>
+#include <phri/dashboard/state_encoder.hpp>
 #include <phri/core/error.hpp>
 #include <phri/safety/wrench_supervisor.hpp>
 #include <phri/sim/sim_robot.hpp>
@@ -254,6 +257,7 @@ TEST(WrenchSupervisor, BadSettingsAreConfigErrors) {
   s = {};
   s.stale_s = 0.0;
   EXPECT_THROW(make_supervisor(s), phri::ConfigError);
+  EXPECT_NE(phri::Logger::legend_yaml().find("ft_status:\n  0: ok\n  1: no_signal\n  2: not_finite"), std::string::npos);
 }
 
 // ---------------------------------------------------------------- closed loop on the plant
@@ -329,6 +333,8 @@ struct Outcome {
   bool touched_at_end = false;
   double max_residual_ratio = 0.0;    // u / tolerance of the consistency check, largest
   phri::CycleStatus cycle_status = phri::CycleStatus::kOk;
+  std::int32_t logged_ft_status = 0;
+  std::string dashboard_frame;        // the dashboard stream's frame of the last cycle
   int touches = 0;
 };
 
@@ -377,6 +383,16 @@ Outcome run_dual(Fault fault, bool elbow_push = false, double ft_rate_Hz = 1000.
   out.touches = cycle.compliance().touch_count();
   out.max_residual_ratio = sup.max_residual_ratio();
   out.cycle_status = cycle.status();
+  phri::LogRow row;
+  phri::fill_log_row(row, last, cycle);
+  out.logged_ft_status = row.ft_status;
+  phri::StateEncoderSettings encoder_settings;
+  encoder_settings.end_effector_frame = settings.end_effector_frame;
+  phri::StateEncoder encoder(cycle.model(), nullptr, encoder_settings);
+  phri::LiveSnapshot snapshot;
+  snapshot.row = row;
+  snapshot.dof = 7;
+  out.dashboard_frame = encoder.frame_json(snapshot);
   return out;
 }
 
@@ -390,6 +406,7 @@ TEST(WrenchFaultClosedLoop, AFaultFreeDualComplianceRunRaisesNoAlarm) {
     EXPECT_EQ(o.touches, 1) << rate;  // the hand's push did free the end effector
     EXPECT_FALSE(o.touched_at_end) << rate;
     EXPECT_LT(o.max_residual_ratio, 0.8) << rate;  // a margin to the tolerance
+    EXPECT_EQ(o.logged_ft_status, 0) << rate;
   }
 }
 
@@ -421,6 +438,9 @@ TEST(WrenchFaultClosedLoop, ABadWrenchIsDroppedTheTriggerReleasedAndTheArmHeld) 
     EXPECT_LT(o.drift_rad, 0.05) << name(c.fault);
     EXPECT_LT(o.max_drift_rad, clean.max_drift_rad + 0.02) << name(c.fault);
     EXPECT_EQ(o.cycle_status, phri::CycleStatus::kOk) << name(c.fault);  // the joints' status is not the F/T's
+    EXPECT_EQ(o.logged_ft_status, static_cast<std::int32_t>(c.expected)) << name(c.fault);
+    const std::string streamed = "\"ft\":\"" + std::string(phri::to_string(c.expected)) + "\"";
+    EXPECT_NE(o.dashboard_frame.find(streamed), std::string::npos) << name(c.fault) << ": " << streamed;
   }
 }
 
@@ -439,7 +459,7 @@ TEST(WrenchFaultClosedLoop, APhantomWrenchInRangeIsCaughtByTheObserver) {
   EXPECT_LT(o.drop_latency_s, 0.2);
   EXPECT_FALSE(o.touched_at_end);
   EXPECT_LT(o.drift_rad, 0.25);
+  EXPECT_EQ(o.logged_ft_status, static_cast<std::int32_t>(WrenchStatus::kInconsistent));
 }
 
 }  // namespace
-
