@@ -54,6 +54,7 @@ void fill_log_row(LogRow& row, const RobotState& state, const Controller& cycle)
   row.cycle_status = static_cast<std::int32_t>(cycle.status());
   row.safety_state = static_cast<std::int32_t>(cycle.supervisor().state());
   row.safety_fault = static_cast<std::int32_t>(cycle.supervisor().sample_fault());
+  row.ft_status = static_cast<std::int32_t>(cycle.wrench_supervisor().status());
   row.controller_status = static_cast<std::int32_t>(qp.status());
   row.qp_status = static_cast<std::int32_t>(qp.qp_status());
   row.qp_iterations = qp.qp_iterations();

@@ -20,7 +20,7 @@
 //   wrench_fx wrench_fy wrench_fz wrench_mx wrench_my wrench_mz, wrench_norm
 //                                         operator wrench at the EE, world axes [N, N.m] (F/T)
 //   compliance_mode, touched, low_level_loop, fsm_state, event,
-//   cycle_status, safety_state, safety_fault, controller_status, qp_status, qp_iterations
+//   cycle_status, safety_state, safety_fault, ft_status, controller_status, qp_status, qp_iterations
 //                                         integer codes; the legend is the sidecar
 //                                         <log>.legend.yaml (Logger::legend_yaml())
 //   stiffness_scale                       live end-effector stiffness scale [-]
@@ -61,6 +61,7 @@ struct LogRow {
   std::int32_t cycle_status = 0;       ///< CycleStatus
   std::int32_t safety_state = 0;       ///< SupervisorState
   std::int32_t safety_fault = 0;       ///< SafetyFault of this cycle's sample (0: plausible)
+  std::int32_t ft_status = 0;          ///< WrenchStatus of the F/T source (from 2 on: dropped, why)
   std::int32_t controller_status = 0;  ///< WholeBodyQpStatus of the whole-body QP
   std::int32_t qp_status = 0;          ///< QpStatus of the solver
   std::int32_t qp_iterations = 0;
@@ -106,6 +107,7 @@ void visit_log_columns(const LogRow& r, int dof, Visitor&& v) {
   v.integer("cycle_status", r.cycle_status);
   v.integer("safety_state", r.safety_state);
   v.integer("safety_fault", r.safety_fault);
+  v.integer("ft_status", r.ft_status);
   v.integer("controller_status", r.controller_status);
   v.integer("qp_status", r.qp_status);
   v.integer("qp_iterations", r.qp_iterations);

@@ -97,6 +97,10 @@ std::string Logger::legend_yaml() {
   for (int f = 0; f <= static_cast<int>(SafetyFault::kLast); ++f) {
     out += "  " + std::to_string(f) + ": " + std::string(to_string(static_cast<SafetyFault>(f))) + "\n";
   }
+  out += "ft_status:\n";
+  for (int f = 0; f <= static_cast<int>(WrenchStatus::kLast); ++f) {
+    out += "  " + std::to_string(f) + ": " + std::string(to_string(static_cast<WrenchStatus>(f))) + "\n";
+  }
   legend_entry(out, "controller_status", {WholeBodyQpStatus::kOk, WholeBodyQpStatus::kQpInfeasible,
                                           WholeBodyQpStatus::kQpIterationLimit, WholeBodyQpStatus::kQpFailed,
                                           WholeBodyQpStatus::kInvalidInput});

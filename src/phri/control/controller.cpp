@@ -206,6 +206,7 @@ Controller::Controller(LoadedRobot robot, const ControllerSettings& settings)
       wrench_(wrench_settings(settings, model_)),
       low_level_(actuators_, custom_torque_settings(settings), settings.initial_loop),
       supervisor_(sensor_ranges(model_, actuators_), supervisor_settings(settings)),
+      wrench_supervisor_(settings.safety.wrench, settings.period_s, settings.observer_gain, model_.nv()),
       end_effector_frame_(model_.frame_id(settings.end_effector_frame)),
       sensor_frame_(model_.frame_id("ft_sensor")),
       q_(Eigen::VectorXd::Zero(model_.nq())),
@@ -293,8 +294,21 @@ void Controller::estimate(const RobotState& state, double dt) {
   compute_all_terms(model_, data_, q_, qd_);
   coriolis_transpose_times_velocity(model_, data_);
   observer_.update(data_, qd_, state.tau_sensor_Nm, dt);
-  if (state.wrench.valid && state.wrench.sequence != last_wrench_sequence_ && state.wrench_sensor.allFinite()) {
-    last_wrench_sequence_ = state.wrench.sequence;
+  estimate_wrench(state);
+  if (settings_.position_mode_open_loop && low_level_.integrating_position()) {
+    // The paper's position mode: from here on the cycle sees its own integrated state, not the
+    // arm (the estimates above used the measurements).
+    q_ = low_level_.position_reference();
+    qd_ = low_level_.velocity_reference();
+    compute_all_terms(model_, data_, q_, qd_);
+  }
+}
+
+// The F/T wrench, once the WrenchSupervisor found the sample plausible; then J^T F against the
+// observer. A dropped source leaves the estimate at zero (the trigger released, the hand's pose the
+// target, as when a hand lets go) and select_external_torque() on the observer.
+void Controller::estimate_wrench(const RobotState& state) {
+  if (wrench_supervisor_.check(state, qd_, observer_.external_torque())) {
     const Eigen::Isometry3d& sensor = data_.frame_placements[static_cast<std::size_t>(sensor_frame_)];
     const Eigen::Isometry3d& ee = data_.frame_placements[static_cast<std::size_t>(end_effector_frame_)];
     // Each axis through a median of its last three samples: a single-sample spike of any size
@@ -309,18 +323,24 @@ void Controller::estimate(const RobotState& state, double dt) {
     ++wrench_samples_;
     wrench_.update(wrench_median_, sensor, ee.translation());
   }
-  if (settings_.position_mode_open_loop && low_level_.integrating_position()) {
-    // The paper's position mode: from here on the cycle sees its own integrated state, not the
-    // arm (the estimates above used the measurements).
-    q_ = low_level_.position_reference();
-    qd_ = low_level_.velocity_reference();
-    compute_all_terms(model_, data_, q_, qd_);
+  if (wrench_supervisor_.usable() && wrench_.calibrated()) {
+    frame_jacobian(model_, data_, end_effector_frame_, ReferenceFrame::kLocalWorldAligned, ee_jacobian_);
+    ft_torque_.noalias() = ee_jacobian_.transpose() * wrench_.wrench_world();
+    wrench_supervisor_.check_consistency(ft_torque_, observer_.external_torque());
+  }
+  if (wrench_supervisor_.dropped() && !wrench_cleared_) {
+    wrench_cleared_ = true;
+    wrench_.recalibrate();  // zero estimate; a reset source would re-estimate the bias
+    wrench_history_.setZero();
+    wrench_samples_ = 0;
+    ft_torque_.setZero();
   }
 }
 
 // tau_ext for the QP and the inverse dynamics, from the source the settings choose.
 void Controller::select_external_torque() {
-  if (settings_.external_torque_source == ExternalTorqueSource::kObserver) {
+  // An F/T not fresh or dropped: the observer alone (a bad wrench must never drive the arm).
+  if (settings_.external_torque_source == ExternalTorqueSource::kObserver || !wrench_supervisor_.fresh()) {
     tau_ext_ = observer_.external_torque();
     return;
   }
@@ -576,7 +596,11 @@ void Controller::update_modes_and_targets() {
   // The trigger sees the wrench norm through a short low-pass (settings.wrench_trigger_filter_s):
   // single-sample spikes of the F/T signal (tool inertia during stick-slip jolts, noise) must not
   // free the end effector for a few milliseconds.
-  if (compliance_.update(trigger_filter_.update(wrench_.calibrated() ? wrench_.norm() : 0.0), qp_, data_)) {
+  // A wrench that is not fresh (WrenchSupervisor::fresh: stuck or stale beyond a few of the
+  // sensor's periods, or dropped) is no touch: released at once, as when the hand leaves.
+  const bool fresh = wrench_supervisor_.fresh() && wrench_.calibrated();
+  if (!fresh) trigger_filter_.reset(0.0);
+  if (compliance_.update(fresh ? trigger_filter_.update(wrench_.norm()) : 0.0, qp_, data_)) {
     // A hand let go in dual compliance: its pose is the end effector's new target (paper), and the
     // configuration it left the arm in is the posture's. The old posture target lies off the new
     // pose's self-motion manifold; the paper's posture stiffness of 0 there leaves the arm where the

@@ -102,6 +102,8 @@ public:
   const LowLevelController& low_level() const { return low_level_; }
   const ActuatorTable& actuators() const { return actuators_; }
   const StateSupervisor& supervisor() const { return supervisor_; }
+  /// The F/T wrench's plausibility; once dropped() the F/T is not used for the rest of the run.
+  const WrenchSupervisor& wrench_supervisor() const { return wrench_supervisor_; }
   /// Whether the safe stop has handed over to the position hold (false: braking, or no safe stop).
   bool holding() const { return holding_; }
   int end_effector_frame() const { return end_effector_frame_; }
@@ -133,6 +135,7 @@ private:
   // Model terms, observer, wrench from the measured state; then, in the open-loop position mode,
   // the model terms of the integrated state the cycle runs on.
   void estimate(const RobotState& state, double dt);
+  void estimate_wrench(const RobotState& state);
   void select_external_torque();
   void bound_external_torque();
   void update_modes_and_targets();
@@ -153,11 +156,12 @@ private:
   WrenchEstimator wrench_;
   LowLevelController low_level_;
   StateSupervisor supervisor_;
+  WrenchSupervisor wrench_supervisor_;
+  bool wrench_cleared_ = false;  // the estimate and the trigger cleared after a drop
   int end_effector_frame_ = 0;
   int sensor_frame_ = 0;
   Eigen::VectorXd q_, qd_;
   std::uint32_t last_joint_sequence_ = 0;
-  std::uint32_t last_wrench_sequence_ = 0;
   bool started_ = false;
   bool have_command_ = false;
   std::optional<ComplianceMode> pending_mode_;

@@ -14,6 +14,7 @@
 #include <phri/model/model.hpp>
 #include <phri/robot/end_of_arm.hpp>
 #include <phri/safety/state_supervisor.hpp>
+#include <phri/safety/wrench_supervisor.hpp>
 
 #include <Eigen/Geometry>
 
@@ -45,6 +46,9 @@ constexpr std::optional<ExternalTorqueSource> external_torque_source_from_string
 /// and the safe stop (Controller::step).
 struct SafetySettings {
   SupervisorSettings supervisor;  ///< plausibility of every sample (period_s: the controller's)
+  /// Plausibility of the F/T wrench; a failed check drops the F/T source for the run (the
+  /// observer alone, the dual-compliance trigger released): WrenchSupervisor.
+  WrenchSupervisorSettings wrench;
   /// [s] the QP may fall back to its brake this long in a row before a safe stop (a QP that stays
   /// infeasible, e.g. a posture in collision, must not leave the arm on a fallback for ever).
   double max_qp_fallback_s = 0.05;

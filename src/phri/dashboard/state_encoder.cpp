@@ -7,6 +7,7 @@
 #include <phri/model/algorithms.hpp>
 #include <phri/robot/low_level_mode.hpp>
 #include <phri/safety/state_supervisor.hpp>
+#include <phri/safety/wrench_supervisor.hpp>
 
 #include <nlohmann/json.hpp>
 
@@ -121,6 +122,7 @@ std::string StateEncoder::frame_json(const LiveSnapshot& s) {
             {"loop", std::string(to_string(static_cast<LowLevelMode>(r.low_level_loop)))},
             {"fsm", r.fsm_state >= 0 ? std::string(to_string(static_cast<FsmState>(r.fsm_state))) : std::string("none")},
             {"safety", std::string(to_string(static_cast<SupervisorState>(r.safety_state)))}, {"safety_code", r.safety_state},
+            {"ft", std::string(to_string(static_cast<WrenchStatus>(r.ft_status)))}, {"ft_code", r.ft_status},
             {"event", r.event >= 0 ? json(std::string(to_string(static_cast<Event>(r.event)))) : json(nullptr)},
             {"cycle_us", 1e6 * r.cycle_time_s}, {"overruns", s.overruns}, {"bodies", bodies}};
   j["gains"] = {{"stiffness_scale", r.stiffness_scale}, {"ee_gamma", s.ee_gamma_override},
