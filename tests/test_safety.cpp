@@ -436,7 +436,9 @@ TEST(Safety, ATorqueOffsetWithinRangeIsCaughtByTheMotorCurrent) {
       EXPECT_EQ(stop.reason, phri::SafetyFault::kTorqueCurrentMismatch);
       EXPECT_EQ(stop.joint, offset.joint);
       EXPECT_LT(faulty.speed_ratio_, 0.4);  // -12 N.m on joint 6 is caught at about 0.3x in Kinova's loops
-      EXPECT_LT(distance(faulty.q(), clean.q()), 0.02);
+      // The stop holds where the arm came to rest: a joint caught at up to ~0.5 rad/s travels
+      // v / brake_rate (~0.025 rad) on the hold's braking reference, after the drift before detection.
+      EXPECT_LT(distance(faulty.q(), clean.q()), 0.06);
     }
   }
 }

@@ -381,10 +381,18 @@ void Controller::safe_stop(bool sample_good, RobotCommand& command) {
   brake_state();
   if (safe_stop_cycles_++ == 0) {
     const bool position_loop = have_command_ && low_level_.loop() == LowLevelMode::kPosition;
-    holding_ = !have_command_ || position_loop || !supervisor_.has_kinematics();
-    brake_against_push_ = !holding_ && supervisor_.safe_stop_transition().reason == SafetyFault::kQpFailure;
+    // The torque brake where the torque loop still serves: resisting a push the QP could not
+    // answer, or a stop the robot asked for (blended in). Any other fault goes straight to the
+    // robot's position hold, its reference braking from the arm's state: the robot's servo closes
+    // on its own encoders (a sensor fault of ours does not reach it) and resists a hand that
+    // keeps pushing, which a damping brake only slows down.
+    const SafetyFault reason = supervisor_.safe_stop_transition().reason;
+    const bool torque_brake = reason == SafetyFault::kQpFailure || reason == SafetyFault::kRobotStopRequest;
+    holding_ = !have_command_ || position_loop || !torque_brake || !supervisor_.has_kinematics();
+    brake_against_push_ = !holding_ && reason == SafetyFault::kQpFailure;
     hold_q_ = supervisor_.has_kinematics() ? brake_q_ : q_;
     hold_qd_.setZero();
+    if (holding_ && have_command_ && !position_loop && supervisor_.has_kinematics()) hold_qd_ = brake_qd_;
     stop_entry_tau_ = guarded_tau_;
     // In the position loop the reference brakes from where it is (kept within the following
     // error of the measured pose, LowLevelController): a jump to the measured pose, or a reference
