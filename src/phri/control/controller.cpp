@@ -219,6 +219,7 @@ Controller::Controller(LoadedRobot robot, const ControllerSettings& settings)
       no_targets_(model_.nv()),
       hold_q_(Eigen::VectorXd::Zero(model_.nv())),
       hold_qd_(Eigen::VectorXd::Zero(model_.nv())),
+      speed_gain_(Eigen::VectorXd::Zero(model_.nv())),
       brake_q_(Eigen::VectorXd::Zero(model_.nv())),
       brake_qd_(Eigen::VectorXd::Zero(model_.nv())),
       brake_tau_(Eigen::VectorXd::Zero(model_.nv())),
@@ -444,7 +445,10 @@ void Controller::safe_stop(bool sample_good, RobotCommand& command) {
 void Controller::brake_state() {
   if (!supervisor_.has_kinematics()) return;
   const double rate = settings_.safety.brake_rate;
-  const double age_s = static_cast<double>(cycles_since_good_) * settings_.period_s;
+  // Cycles since the data, or the robot's time since it when longer (a stalled control thread runs
+  // no cycles); a jumped stamp can only lengthen it, and the prediction is bounded by q̇ / r.
+  const double by_clock = std::clamp(stop_stamp_s_ - supervisor_.kinematic_stamp(), 0.0, 1.0);
+  const double age_s = std::max(static_cast<double>(cycles_since_good_) * settings_.period_s, by_clock);
   const double decay = std::exp(-rate * age_s);
   brake_q_ = (supervisor_.kinematic_q() + (1.0 - decay) / rate * supervisor_.kinematic_qd())
                  .cwiseMax(limit_lower_)
@@ -644,6 +648,7 @@ void Controller::shape_tasks() {
 
 CycleStatus Controller::step(const RobotState& state, const ControllerTargets& targets, RobotCommand& command) {
   ++steps_;
+  if (std::isfinite(state.joints.stamp_s)) stop_stamp_s_ = state.joints.stamp_s;
   const bool targets_accepted = apply(targets);
   const bool had_good = supervisor_.has_good();
   const double previous_good_stamp = supervisor_.last_good_time();
@@ -672,10 +677,26 @@ CycleStatus Controller::step(const RobotState& state, const ControllerTargets& t
     return status_;
   }
   if (!good) {
+    // Near the velocity limit the torque loops' command is a brake the velocity guard shaped from
+    // the measured speed; repeated blind it is not one (a hand pulling at the tool took the arm
+    // from 0.9x to 1.2x its limit within the 20 ms budget). A missing sample stops at once where
+    // the last speed, plus what the recent acceleration adds over the budget, reaches the limit.
+    if (have_command_ && low_level_.loop() != LowLevelMode::kPosition && supervisor_.has_kinematics() &&
+        (supervisor_.kinematic_qd().cwiseAbs().array() + supervisor_.settings().max_degraded_s * speed_gain_.array() >
+         drive_velocity_limit_.array()).any()) {
+      supervisor_.report(SafetyFault::kMissedAtSpeed, state.time_s);
+      safe_stop(false, command);
+      return status_;
+    }
     hold_previous(state, command);
     return status_;
   }
   cycles_since_good_ = 0;
+  // The joints' recent acceleration (peak, fading over 20 ms) for the prediction above.
+  const double fade = std::exp(-dt / 0.02);
+  for (int i = 0; i < model_.nv(); ++i) {
+    speed_gain_[i] = std::max(std::abs(state.qd_rad_s[i] - qd_[i]) / dt, fade * speed_gain_[i]);
+  }
   q_ = state.q_rad;
   qd_ = state.qd_rad_s;
   estimate(state, dt);

@@ -180,11 +180,13 @@ private:
   long cycles_since_good_ = 0;
   long safe_stop_cycles_ = 0;
   long steps_ = 0;                    // step() calls
+  double stop_stamp_s_ = 0.0;         // the latest finite joint stamp (the brake's prediction age)
   long refused_step_ = -2;            // the step of the latest refused write
   long refusals_in_row_ = 0;          // refused writes in consecutive steps
   bool holding_ = false;
   bool brake_against_push_ = false;  // the safe stop's brake resists tau_ext (after a QP failure)
   Eigen::VectorXd hold_q_, hold_qd_;  // the safe stop's held reference, braking to rest (position loop)
+  Eigen::VectorXd speed_gain_;        // |q̈| of the latest good samples (peak, fading) [rad/s^2]
   Eigen::VectorXd brake_q_, brake_qd_, brake_tau_;
   Eigen::VectorXd stop_entry_tau_;  // the last torque command before the safe stop
   Eigen::VectorXd guarded_tau_;

@@ -166,6 +166,10 @@ SafetyFault StateSupervisor::check_kinematics(const RobotState& s, int& joint) c
       if (std::abs(mean_qd - (q - q_ref[i]) / dt) > c.velocity_consistency_rad_s + 2.0 * c.encoder_quantum_rad / dt) {
         return SafetyFault::kVelocityMismatch;
       }
+      // A position that did not change by a single bit while q̇ says the joint moved more than two
+      // encoder quanta: the reading is stuck (within the tolerance above, it would pass for
+      // frozen_s while the arm moves on).
+      if (q == q_ref[i] && std::abs(mean_qd) * dt > 2.0 * c.encoder_quantum_rad) return SafetyFault::kFrozenValues;
     }
   }
   joint = -1;

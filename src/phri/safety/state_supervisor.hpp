@@ -60,7 +60,8 @@ enum class SafetyFault : std::uint8_t {
   kTorqueCurrentMismatch,  ///< τ_s disagrees with the motor torque K_T G_r i beyond friction and rotor inertia
   kRobotStopRequest,///< the robot asks for a safe stop while its samples are good (a degraded link)
   kHoldRefused,     ///< during the safe stop the robot refused its hold for several cycles in a row
-  kLast = kHoldRefused,
+  kMissedAtSpeed,   ///< a sample missing while a joint ran where the velocity guard brakes (torque loops)
+  kLast = kMissedAtSpeed,
 };
 
 constexpr std::string_view to_string(SupervisorState s) {
@@ -88,6 +89,7 @@ constexpr std::string_view to_string(SafetyFault f) {
     case SafetyFault::kTorqueCurrentMismatch: return "torque_current_mismatch";
     case SafetyFault::kRobotStopRequest: return "robot_stop_request";
     case SafetyFault::kHoldRefused: return "hold_refused";
+    case SafetyFault::kMissedAtSpeed: return "missed_at_speed";
     case SafetyFault::kTorqueRange: return "torque_out_of_range";
     case SafetyFault::kCurrentRange: return "current_out_of_range";
     case SafetyFault::kFrozenValues: return "frozen_values";
