@@ -446,8 +446,11 @@ void Controller::brake_state() {
   if (!supervisor_.has_kinematics()) return;
   const double rate = settings_.safety.brake_rate;
   // Cycles since the data, or the robot's time since it when longer (a stalled control thread runs
-  // no cycles); a jumped stamp can only lengthen it, and the prediction is bounded by q̇ / r.
-  const double by_clock = std::clamp(stop_stamp_s_ - supervisor_.kinematic_stamp(), 0.0, 1.0);
+  // no cycles): by the stamps and by the sequence, whichever says less (one of them may have jumped;
+  // an age too long would put the hold's reference ahead of the arm).
+  const double by_sequence =
+      static_cast<double>(static_cast<std::uint32_t>(stop_sequence_ - supervisor_.kinematic_sequence())) * settings_.period_s;
+  const double by_clock = std::clamp(std::min(stop_stamp_s_ - supervisor_.kinematic_stamp(), by_sequence), 0.0, 1.0);
   const double age_s = std::max(static_cast<double>(cycles_since_good_) * settings_.period_s, by_clock);
   const double decay = std::exp(-rate * age_s);
   brake_q_ = (supervisor_.kinematic_q() + (1.0 - decay) / rate * supervisor_.kinematic_qd())
@@ -649,6 +652,7 @@ void Controller::shape_tasks() {
 CycleStatus Controller::step(const RobotState& state, const ControllerTargets& targets, RobotCommand& command) {
   ++steps_;
   if (std::isfinite(state.joints.stamp_s)) stop_stamp_s_ = state.joints.stamp_s;
+  stop_sequence_ = state.joints.sequence;
   const bool targets_accepted = apply(targets);
   const bool had_good = supervisor_.has_good();
   const double previous_good_stamp = supervisor_.last_good_time();

@@ -180,7 +180,8 @@ private:
   long cycles_since_good_ = 0;
   long safe_stop_cycles_ = 0;
   long steps_ = 0;                    // step() calls
-  double stop_stamp_s_ = 0.0;         // the latest finite joint stamp (the brake's prediction age)
+  double stop_stamp_s_ = 0.0;         // the latest finite joint stamp and sequence (the brake's prediction age)
+  std::uint32_t stop_sequence_ = 0;
   long refused_step_ = -2;            // the step of the latest refused write
   long refusals_in_row_ = 0;          // refused writes in consecutive steps
   bool holding_ = false;

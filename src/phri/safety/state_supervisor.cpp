@@ -326,6 +326,7 @@ bool StateSupervisor::check(const RobotState& s) {
     kinematic_q_ = s.q_rad;
     kinematic_qd_ = s.qd_rad_s;
     kinematic_stamp_ = s.joints.stamp_s;
+    kinematic_sequence_ = s.joints.sequence;
     has_kinematics_ = true;
   }
   if (fault == SafetyFault::kNone) {

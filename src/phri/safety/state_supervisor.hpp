@@ -213,6 +213,7 @@ public:
   const Eigen::VectorXd& kinematic_q() const { return kinematic_q_; }
   const Eigen::VectorXd& kinematic_qd() const { return kinematic_qd_; }
   double kinematic_stamp() const { return kinematic_stamp_; }
+  std::uint32_t kinematic_sequence() const { return kinematic_sequence_; }
   bool has_kinematics() const { return has_kinematics_; }
   bool kinematics_fresh() const { return kinematics_fresh_; }
   /// Samples re-synchronised after a gap or a jumped counter.
@@ -268,6 +269,7 @@ private:
   // The kinematics the safe stop brakes on (see kinematic_q()).
   Eigen::VectorXd kinematic_q_, kinematic_qd_;
   double kinematic_stamp_ = 0.0;
+  std::uint32_t kinematic_sequence_ = 0;
   bool has_kinematics_ = false;
   bool kinematics_fresh_ = false;
   bool kinematics_passed_ = false;   // classify(): the joint part of this sample passed
