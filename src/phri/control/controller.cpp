@@ -5,6 +5,7 @@
 #include <phri/model/algorithms.hpp>
 
 #include <algorithm>
+#include <cstdio>
 #include <cmath>
 #include <limits>
 
@@ -219,7 +220,8 @@ Controller::Controller(LoadedRobot robot, const ControllerSettings& settings)
       no_targets_(model_.nv()),
       hold_q_(Eigen::VectorXd::Zero(model_.nv())),
       hold_qd_(Eigen::VectorXd::Zero(model_.nv())),
-      speed_gain_(Eigen::VectorXd::Zero(model_.nv())),
+      acceleration_(Eigen::VectorXd::Zero(model_.nv())),
+      filtered_qd_(Eigen::VectorXd::Zero(model_.nv())),
       brake_q_(Eigen::VectorXd::Zero(model_.nv())),
       brake_qd_(Eigen::VectorXd::Zero(model_.nv())),
       brake_tau_(Eigen::VectorXd::Zero(model_.nv())),
@@ -497,6 +499,34 @@ bool Controller::answer_refused_write(const RobotState& state, RobotCommand& com
   return true;
 }
 
+// A sample the supervisor did not pass. Near the velocity limit the torque loops' command is a
+// brake the velocity guard shaped from the measured speed; repeated blind it is not one (a hand
+// pulling at the tool took the arm from 0.9x to 1.2x its limit within the 20 ms budget). A missing
+// sample stops at once where the last velocity, carried on at the recent acceleration over the
+// budget, reaches the limit; elsewhere the previous command stands in (hold_previous()).
+void Controller::missing_sample(const RobotState& state, RobotCommand& command) {
+  if (settings_.safety.stop_missed_at_speed && have_command_ && low_level_.loop() != LowLevelMode::kPosition &&
+      supervisor_.has_kinematics() &&
+      ((supervisor_.kinematic_qd() + supervisor_.settings().max_degraded_s * acceleration_).cwiseAbs().array() >
+       drive_velocity_limit_.array()).any()) {
+    supervisor_.report(SafetyFault::kMissedAtSpeed, state.time_s);
+    safe_stop(false, command);
+    return;
+  }
+  hold_previous(state, command);
+}
+
+// The joints' recent acceleration for missing_sample(): the rate of the velocity low-passed over
+// 10 ms (a raw difference of 1 kHz velocities is mostly noise).
+void Controller::track_acceleration(const Eigen::VectorXd& qd, double dt) {
+  const double alpha = dt / (0.01 + dt);
+  for (int i = 0; i < model_.nv(); ++i) {
+    const double previous = filtered_qd_[i];
+    filtered_qd_[i] += alpha * (qd[i] - filtered_qd_[i]);
+    acceleration_[i] = (filtered_qd_[i] - previous) / dt;
+  }
+}
+
 // The held reference's velocity decays at brake_rate (as the torque loops' brake), the reference
 // staying within the URDF limits; from rest (the other safe stops) it stays where it is.
 void Controller::brake_reference() {
@@ -681,26 +711,11 @@ CycleStatus Controller::step(const RobotState& state, const ControllerTargets& t
     return status_;
   }
   if (!good) {
-    // Near the velocity limit the torque loops' command is a brake the velocity guard shaped from
-    // the measured speed; repeated blind it is not one (a hand pulling at the tool took the arm
-    // from 0.9x to 1.2x its limit within the 20 ms budget). A missing sample stops at once where
-    // the last speed, plus what the recent acceleration adds over the budget, reaches the limit.
-    if (have_command_ && low_level_.loop() != LowLevelMode::kPosition && supervisor_.has_kinematics() &&
-        (supervisor_.kinematic_qd().cwiseAbs().array() + supervisor_.settings().max_degraded_s * speed_gain_.array() >
-         drive_velocity_limit_.array()).any()) {
-      supervisor_.report(SafetyFault::kMissedAtSpeed, state.time_s);
-      safe_stop(false, command);
-      return status_;
-    }
-    hold_previous(state, command);
+    missing_sample(state, command);
     return status_;
   }
   cycles_since_good_ = 0;
-  // The joints' recent acceleration (peak, fading over 20 ms) for the prediction above.
-  const double fade = std::exp(-dt / 0.02);
-  for (int i = 0; i < model_.nv(); ++i) {
-    speed_gain_[i] = std::max(std::abs(state.qd_rad_s[i] - qd_[i]) / dt, fade * speed_gain_[i]);
-  }
+  track_acceleration(state.qd_rad_s, dt);
   q_ = state.q_rad;
   qd_ = state.qd_rad_s;
   estimate(state, dt);

@@ -131,6 +131,8 @@ private:
   void hold_previous(const RobotState& state, RobotCommand& command);
   void safe_stop(bool sample_good, RobotCommand& command);
   void brake_state();
+  void missing_sample(const RobotState& state, RobotCommand& command);
+  void track_acceleration(const Eigen::VectorXd& qd, double dt);
   void keep_hold_acceptable();
   // Model terms, observer, wrench from the measured state; then, in the open-loop position mode,
   // the model terms of the integrated state the cycle runs on.
@@ -187,7 +189,8 @@ private:
   bool holding_ = false;
   bool brake_against_push_ = false;  // the safe stop's brake resists tau_ext (after a QP failure)
   Eigen::VectorXd hold_q_, hold_qd_;  // the safe stop's held reference, braking to rest (position loop)
-  Eigen::VectorXd speed_gain_;        // |q̈| of the latest good samples (peak, fading) [rad/s^2]
+  Eigen::VectorXd acceleration_;      // q̈ of the latest good samples, low-passed [rad/s^2]
+  Eigen::VectorXd filtered_qd_;       // q̇ low-passed for acceleration_
   Eigen::VectorXd brake_q_, brake_qd_, brake_tau_;
   Eigen::VectorXd stop_entry_tau_;  // the last torque command before the safe stop
   Eigen::VectorXd guarded_tau_;

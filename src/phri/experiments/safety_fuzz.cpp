@@ -649,30 +649,76 @@ long motion_horizon_cycles(const Shared& s, const MotionScenario& sc) {
 // One run of a motion scenario: the reference (fault null) records the path and is judged as a
 // push (back at the pose held before it, dual compliance: or at rest); a faulted run is judged from
 // its fault on against the reference's path.
-void motion_run(const Shared& s, const std::string& id, MotionScenario& sc, const FaultCase* fault, TaskOutput& out) {
-  const SafetyFuzzThresholds& th = s.o.thresholds;
+// The record of a motion window and, for a faulted one, its fault placed in the push.
+FuzzRecord motion_record(const Shared& s, const std::string& id, const MotionScenario& sc, const FaultCase* fault,
+                         FaultSpec& spec, long& fault_cycles) {
   const bool reference = fault == nullptr;
-  const bool dual = sc.mode == ComplianceMode::kDual;
   FuzzRecord r = base_record(id, 0, reference ? FuzzCaseKind::kReference : FuzzCaseKind::kFault, sc.mode, sc.loop, sc.plant_seed);
   r.context = sc.context();
   r.push_link = sc.push.plant_link();
   r.force_N = sc.push.magnitude_N;
   r.profile = std::string(to_string(sc.push.profile));
   r.duration_s = sc.push.duration_s;
-  FaultSpec spec;
-  long fault_cycles = 0, offset = 0;
+  fault_cycles = 0;
   if (reference) {
     r.target = "none";
-  } else {
-    if (!sc.ready) throw ExperimentError("safety fuzz", "no reference path for " + id);
-    fault_cycles = fault->cycles_in_motion();
-    offset = motion_fault_offset(s, sc, *fault);
-    describe_fault(r, *fault, fault_cycles);
-    r.fault_offset_s = static_cast<double>(offset) * s.dt;
-    spec = fault->spec;
-    spec.start_cycle = sc.push_cycle + (sc.with_switch ? sc.switch_offset : 0) + offset;
-    spec.cycles = fault_cycles;
+    return r;
   }
+  if (!sc.ready) throw ExperimentError("safety fuzz", "no reference path for " + id);
+  fault_cycles = fault->cycles_in_motion();
+  const long offset = motion_fault_offset(s, sc, *fault);
+  describe_fault(r, *fault, fault_cycles);
+  r.fault_offset_s = static_cast<double>(offset) * s.dt;
+  spec = fault->spec;
+  spec.start_cycle = sc.push_cycle + (sc.with_switch ? sc.switch_offset : 0) + offset;
+  spec.cycles = fault_cycles;
+  return r;
+}
+
+// The scenario's push on the rig's plant, from now.
+ExternalForce start_motion_push(Rig& rig, const Shared& s, const MotionScenario& sc) {
+  const ExternalForce force = sc.push.disturbance(rig.time());
+  const int plant_body = rig.robot().body_id(sc.push.plant_link());
+  if (plant_body < 0) {
+    throw ConfigError(s.o.plant_config_path, "bodies", "the plant has no body '" + sc.push.plant_link() + "' to push");
+  }
+  rig.robot().set_live_disturbance(plant_body, force);
+  return force;
+}
+
+// One judged cycle of a motion window: the deviation from the reference (a reference run: from the
+// pose held before the push) into m and the recovery tracker.
+void judge_motion_cycle(Rig& rig, const Shared& s, const MotionScenario& sc, bool reference, const Eigen::VectorXd& q_held,
+                        double push_end, WindowMetrics& m, RecoveryTracker& tracker) {
+  const SafetyFuzzThresholds& th = s.o.thresholds;
+  const double t = rig.time();
+  int joint = -1;
+  const double from_reference = rig.monitor().deviation(
+      rig.q(), reference ? Eigen::Ref<const Eigen::VectorXd>(q_held)
+                         : Eigen::Ref<const Eigen::VectorXd>(sc.q.col(std::min<long>(rig.plant_cycles(), sc.q.cols()) - 1)),
+      joint);
+  // Dual compliance keeps the pose the hand left it in: at rest after the push, it is back.
+  const bool rests_where_left = sc.mode == ComplianceMode::kDual && t >= push_end && rig.speed() < th.rest_speed_rad_s;
+  const double deviation = rests_where_left ? 0.0 : from_reference;
+  if (!reference || t >= push_end) m.max_deviation_rad = std::max(m.max_deviation_rad, deviation);
+  m.final_deviation_rad = deviation;
+  m.final_deviation_joint = rests_where_left ? -1 : joint;
+  m.final_speed_rad_s = rig.speed();
+  tracker.sample(t, deviation, rig.speed(), rig.safe_stop_time());
+}
+
+// The reference run's path, cut to the plant cycles it ran, is ready for the faulted runs.
+void keep_reference_path(MotionScenario& sc, long plant_cycles) {
+  sc.q.conservativeResize(Eigen::NoChange, std::min<long>(sc.q.cols(), plant_cycles));
+  sc.ready = true;
+}
+
+void motion_run(const Shared& s, const std::string& id, MotionScenario& sc, const FaultCase* fault, TaskOutput& out) {
+  const SafetyFuzzThresholds& th = s.o.thresholds;
+  const bool reference = fault == nullptr;
+  FaultSpec spec;
+  long fault_cycles = 0;
+  FuzzRecord r = motion_record(s, id, sc, fault, spec, fault_cycles);
   WindowMetrics& m = r.metrics;
   try {
     Rig rig(s, sc.mode, sc.loop, sc.plant_seed, spec);
@@ -697,12 +743,7 @@ void motion_run(const Shared& s, const std::string& id, MotionScenario& sc, cons
     }
     const Eigen::VectorXd q_held = rig.q();
     const double push_start = rig.time();
-    const ExternalForce force = sc.push.disturbance(push_start);
-    const int plant_body = rig.robot().body_id(sc.push.plant_link());
-    if (plant_body < 0) {
-      throw ConfigError(s.o.plant_config_path, "bodies", "the plant has no body '" + sc.push.plant_link() + "' to push");
-    }
-    rig.robot().set_live_disturbance(plant_body, force);
+    const ExternalForce force = start_motion_push(rig, s, sc);
     const double push_end = push_start + sc.push.duration_s;
     // The window's end in plant time (the reference's: the push's).
     const double fault_end = reference ? push_end
@@ -736,19 +777,7 @@ void motion_run(const Shared& s, const std::string& id, MotionScenario& sc, cons
         fault_seen = true;
         r.start_s = t;
       }
-      int joint = -1;
-      const double from_reference = rig.monitor().deviation(
-          rig.q(), reference ? Eigen::Ref<const Eigen::VectorXd>(q_held)
-                             : Eigen::Ref<const Eigen::VectorXd>(sc.q.col(std::min<long>(rig.plant_cycles(), sc.q.cols()) - 1)),
-          joint);
-      // Dual compliance keeps the pose the hand left it in: at rest after the push, it is back.
-      const bool rests_where_left = dual && t >= push_end && rig.speed() < th.rest_speed_rad_s;
-      const double deviation = rests_where_left ? 0.0 : from_reference;
-      if (!reference || t >= push_end) m.max_deviation_rad = std::max(m.max_deviation_rad, deviation);
-      m.final_deviation_rad = deviation;
-      m.final_deviation_joint = rests_where_left ? -1 : joint;
-      m.final_speed_rad_s = rig.speed();
-      tracker.sample(t, deviation, rig.speed(), rig.safe_stop_time());
+      judge_motion_cycle(rig, s, sc, reference, q_held, push_end, m, tracker);
     }
     rig.robot().set_live_disturbance(-1, force);
     if (reference) r.start_s = push_start;
@@ -756,10 +785,7 @@ void motion_run(const Shared& s, const std::string& id, MotionScenario& sc, cons
     r.safe_stop_reason = rig.safe_stop_reason();
     if (m.crashed) r.error = "the simulated plant diverged";
     out.simulated_s += rig.time();
-    if (reference) {
-      sc.q.conservativeResize(Eigen::NoChange, std::min<long>(sc.q.cols(), rig.plant_cycles()));
-      sc.ready = true;
-    }
+    if (reference) keep_reference_path(sc, rig.plant_cycles());
   } catch (const ConfigError&) {
     throw;
   } catch (const std::exception& e) {
