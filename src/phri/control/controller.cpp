@@ -373,10 +373,12 @@ void Controller::hold_previous(const RobotState& state, RobotCommand& command) {
   }
 }
 
-// The latched safe stop. Position loop (or no command yet): the robot's position hold at once,
-// its reference braking from where it was. Torque and current loops: gravity compensation with
-// joint damping on the brake's state (brake_state()), after a QP failure also -tau_ext while the
-// samples stay good, then, at rest or after max_brake_s, the hand-over to the position hold there.
+// The latched safe stop, designed for a moving arm. The robot's position hold at once, its
+// reference braking from where the arm is and how it moves (brake_state()), kept within the
+// following bound of it. After a QP failure under a push, or a stop the robot asked for, in the
+// torque and current loops: gravity compensation with joint damping on the brake's state (after a
+// QP failure also -tau_ext while the samples stay good; a requested stop blended in from the last
+// command), then, at rest or after max_brake_s, the hand-over to the hold there.
 void Controller::safe_stop(bool sample_good, RobotCommand& command) {
   status_ = CycleStatus::kSafeStop;
   const SafetySettings& s = settings_.safety;

@@ -13,10 +13,11 @@
 // (safety/) first. An implausible or missing sample is never estimated from: the previous command
 // is kept for at most SupervisorSettings::max_degraded_s (status kInvalidState / kStaleState).
 // Beyond that, or on a fault found elsewhere (the QP failing for max_qp_fallback_s, a refused
-// write reported by the loop through report_fault(), a robot fault), a latched safe stop: in the
-// torque and current loops a joint-damping brake on gravity compensation from the last good
-// state (after a QP failure, with the samples good, also resisting the push the observer sees),
-// then the robot's position hold at the measured pose; in the position loop, the hold at once. Behind the QP: tau_ext bounded (and a hard stop's reaction never read as a push), a
+// write answered through answer_refused_write(), a robot fault), a latched safe stop: the robot's
+// position hold, its reference braking from the arm's measured state (a bounded prediction while
+// no plausible sample comes); after a QP failure under a push or a stop the robot asked for, in the
+// torque loops, a joint-damping brake on gravity compensation first (after a QP failure also
+// resisting the push the observer sees), then the hold at rest. Behind the QP: tau_ext bounded (and a hard stop's reaction never read as a push), a
 // velocity guard, a limit guard and a collision guard on the torque (torque_guards.hpp).
 // Everything that changes the controller at run time arrives in ControllerTargets: the FSM, the
 // gamepad, a dashboard or a script never reach into its stages.
