@@ -1,14 +1,19 @@
 // ctest-labels: unit
 // phri::StateSupervisor alone, on synthetic samples of one joint moving at constant speed: the
 // re-synchronisation after a gap or a jumped counter, the kinematics kept for the brake when only
-// the torque is wrong, and the stop on a gap beyond the degraded budget.
+// the torque is wrong, and the stop on a gap beyond the degraded budget. Then every check and every
+// fault reason, each threshold at its edge: just inside it the sample passes, just beyond it the
+// sample is refused (or the stop taken) with that reason.
 #include <phri/safety/state_supervisor.hpp>
 
 #include <gtest/gtest.h>
 
+#include <phri/core/error.hpp>
+
+#include <cmath>
 #include <cstdint>
-#include <string>
 #include <limits>
+#include <string>
 
 namespace {
 
@@ -150,6 +155,439 @@ TEST(StateSupervisor, AFaultOfTheStopItselfIsKeptBesideTheStopsReason) {
   EXPECT_DOUBLE_EQ(supervisor.escalation().time_s, 0.007);
   supervisor.reset();
   EXPECT_EQ(supervisor.escalation().reason, SafetyFault::kNone);
+}
+
+// ---- Every check and every reason, thresholds at their edges (the defaults of SupervisorSettings:
+// a 1.4 rad/s, 50 N.m, 10 A joint within [-10, 10] rad).
+
+// The joint at rest at q, with the torque ripple of sample(k) (its readings are never frozen).
+phri::RobotState at_rest(long k, double q = 0.3) {
+  phri::RobotState s = sample(k);
+  s.q_rad[0] = q;
+  s.qd_rad_s[0] = 0.0;
+  return s;
+}
+
+phri::RobotState with_current(phri::RobotState s, double current_A) {
+  s.current.valid = true;
+  s.current.sequence = s.joints.sequence;
+  s.current.stamp_s = s.joints.stamp_s;
+  s.current_A[0] = current_A;
+  return s;
+}
+
+// The supervisor's verdict on one sample: kNone when accepted, else the sample's fault.
+SafetyFault verdict(phri::StateSupervisor& supervisor, const phri::RobotState& s) {
+  return supervisor.check(s) ? SafetyFault::kNone : supervisor.sample_fault();
+}
+
+// Its verdict on one sample after `good` accepted samples of the moving joint (sample(1..good)).
+SafetyFault verdict_after(long good, const phri::RobotState& s, const phri::SupervisorSettings& settings = {}) {
+  phri::StateSupervisor supervisor(one_joint(), settings);
+  for (long k = 1; k <= good; ++k) EXPECT_TRUE(supervisor.check(sample(k))) << k;
+  return verdict(supervisor, s);
+}
+
+constexpr double kEdge = 1e-6;  // how far inside / beyond a threshold the edge cases sit
+
+TEST(StateSupervisorEdges, RangesOfTheFirstSample) {
+  // The first sample has no motion to compare with: only its ranges are checked.
+  struct Case {
+    const char* name;
+    double limit;  // the threshold, from the defaults
+    SafetyFault fault;
+    void (*set)(phri::RobotState&, double);
+  };
+  const Case cases[] = {
+      {"q above", 10.0 + 0.2, SafetyFault::kPositionRange, [](phri::RobotState& s, double v) { s.q_rad[0] = v; }},
+      {"q below", 10.0 + 0.2, SafetyFault::kPositionRange, [](phri::RobotState& s, double v) { s.q_rad[0] = -v; }},
+      {"qd", 2.5 * 1.4, SafetyFault::kVelocityRange, [](phri::RobotState& s, double v) { s.qd_rad_s[0] = v; }},
+      {"-qd", 2.5 * 1.4, SafetyFault::kVelocityRange, [](phri::RobotState& s, double v) { s.qd_rad_s[0] = -v; }},
+      {"tau", 2.0 * 50.0, SafetyFault::kTorqueRange, [](phri::RobotState& s, double v) { s.tau_sensor_Nm[0] = v; }},
+      {"-tau", 2.0 * 50.0, SafetyFault::kTorqueRange, [](phri::RobotState& s, double v) { s.tau_sensor_Nm[0] = -v; }},
+      {"current", 1.5 * 10.0, SafetyFault::kCurrentRange, [](phri::RobotState& s, double v) { s = with_current(s, v); }},
+      {"-current", 1.5 * 10.0, SafetyFault::kCurrentRange, [](phri::RobotState& s, double v) { s = with_current(s, -v); }},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    phri::StateSupervisor inside(one_joint(), phri::SupervisorSettings{});
+    phri::RobotState s = at_rest(1);
+    c.set(s, c.limit - kEdge);
+    EXPECT_EQ(verdict(inside, s), SafetyFault::kNone);
+    EXPECT_EQ(inside.state(), SupervisorState::kNormal);
+
+    phri::StateSupervisor beyond(one_joint(), phri::SupervisorSettings{});
+    s = at_rest(1);
+    c.set(s, c.limit + kEdge);
+    EXPECT_EQ(verdict(beyond, s), c.fault);
+    EXPECT_EQ(beyond.sample_fault_joint(), 0);
+    EXPECT_EQ(beyond.state(), SupervisorState::kDegraded);
+    EXPECT_EQ(beyond.last_transition().reason, c.fault);
+    EXPECT_FALSE(beyond.has_good());
+  }
+}
+
+TEST(StateSupervisorEdges, ACurrentMarkedInvalidIsNotChecked) {
+  phri::StateSupervisor supervisor(one_joint(), phri::SupervisorSettings{});
+  phri::RobotState s = with_current(at_rest(1), 1e6);
+  s.current.valid = false;
+  EXPECT_EQ(verdict(supervisor, s), SafetyFault::kNone);
+}
+
+TEST(StateSupervisorEdges, TheFaultNamesItsJoint) {
+  phri::SensorRanges r;
+  r.q_lower = Eigen::Vector2d(-1.0, -2.0);
+  r.q_upper = Eigen::Vector2d(1.0, 2.0);
+  r.velocity_limit = Eigen::Vector2d(1.0, 1.0);
+  r.torque_range = Eigen::Vector2d(10.0, 10.0);
+  r.current_range = Eigen::Vector2d(5.0, 5.0);
+  phri::StateSupervisor supervisor(r, phri::SupervisorSettings{});
+  phri::RobotState s(2);
+  s.joints.valid = s.torque.valid = true;
+  s.joints.sequence = 1;
+  s.time_s = s.joints.stamp_s = 1e-3;
+  s.q_rad = Eigen::Vector2d(1.1, 2.3);  // joint 0 within its margin, joint 1 beyond it
+  EXPECT_EQ(verdict(supervisor, s), SafetyFault::kPositionRange);
+  EXPECT_EQ(supervisor.sample_fault_joint(), 1);
+  EXPECT_EQ(supervisor.last_transition().joint, 1);
+  EXPECT_DOUBLE_EQ(supervisor.last_transition().time_s, 1e-3);
+}
+
+TEST(StateSupervisorEdges, PositionStepAgainstTheVelocityLimit) {
+  // |Δq| over one period beyond 3 x 1.4 rad/s x 1 ms + 1 mrad is a jump; the velocity
+  // consistency check is widened so that only the step is judged.
+  phri::SupervisorSettings settings;
+  settings.velocity_consistency_rad_s = 100.0;
+  const double bound = 3.0 * 1.4 * 1e-3 + 1e-3;
+  for (const double sign : {1.0, -1.0}) {
+    phri::RobotState s = sample(101);
+    s.q_rad[0] = sample(100).q_rad[0] + sign * (bound - kEdge);
+    EXPECT_EQ(verdict_after(100, s, settings), SafetyFault::kNone) << sign;
+    s.q_rad[0] = sample(100).q_rad[0] + sign * (bound + kEdge);
+    EXPECT_EQ(verdict_after(100, s, settings), SafetyFault::kPositionJump) << sign;
+  }
+}
+
+TEST(StateSupervisorEdges, VelocityAgainstTheRateOfThePosition) {
+  // The mean of q̇ and the reference's q̇ may differ from Δq/Δt by 0.5 rad/s plus two encoder
+  // quanta over Δt (0.2 rad/s at 1 ms): a q̇ offset of 2 x 0.7 rad/s is the edge.
+  for (const double sign : {1.0, -1.0}) {
+    phri::RobotState s = sample(101);
+    s.qd_rad_s[0] = kSpeed + sign * (1.4 - kEdge);
+    EXPECT_EQ(verdict_after(100, s), SafetyFault::kNone) << sign;
+    s.qd_rad_s[0] = kSpeed + sign * (1.4 + kEdge);
+    EXPECT_EQ(verdict_after(100, s), SafetyFault::kVelocityMismatch) << sign;
+  }
+}
+
+TEST(StateSupervisorEdges, APositionStuckWhileTheVelocitySaysItMoved) {
+  // q bit-identical to the last sample's while the mean q̇ over the period covers more than two
+  // encoder quanta (2e-4 rad in 1 ms: 0.2 rad/s).
+  for (const double qd : {0.2 - kEdge, 0.2 + kEdge}) {
+    phri::StateSupervisor supervisor(one_joint(), phri::SupervisorSettings{});
+    phri::RobotState first = at_rest(1);
+    first.qd_rad_s[0] = qd;
+    ASSERT_TRUE(supervisor.check(first));
+    phri::RobotState stuck = at_rest(2);
+    stuck.qd_rad_s[0] = qd;
+    const bool beyond = qd > 0.2;
+    EXPECT_EQ(verdict(supervisor, stuck), beyond ? SafetyFault::kFrozenValues : SafetyFault::kNone) << qd;
+    EXPECT_EQ(supervisor.kinematics_fresh(), !beyond) << "a stuck position is no kinematics for the brake";
+  }
+}
+
+TEST(StateSupervisorEdges, ReadingsFrozenForFrozenS) {
+  // q̇ and τ_s bit-identical from sample 2 on (its stamp 2 ms) while the sequence advances: refused
+  // once they have been for frozen_s (50 ms), at the sample of stamp 52 ms (53 at the latest for
+  // the rounding of the stamps), never before.
+  phri::StateSupervisor supervisor(one_joint(), phri::SupervisorSettings{});
+  auto frozen = [](long k) {
+    phri::RobotState s = at_rest(k);
+    s.tau_sensor_Nm[0] = 5.0;
+    return s;
+  };
+  for (long k = 1; k <= 51; ++k) ASSERT_TRUE(supervisor.check(frozen(k))) << k;
+  supervisor.check(frozen(52));
+  EXPECT_EQ(verdict(supervisor, frozen(53)), SafetyFault::kFrozenValues);
+  EXPECT_EQ(supervisor.state(), SupervisorState::kDegraded);
+  // One changed bit of noise and the readings are live again.
+  phri::RobotState live = frozen(54);
+  live.tau_sensor_Nm[0] = std::nextafter(5.0, 6.0);
+  EXPECT_EQ(verdict(supervisor, live), SafetyFault::kNone);
+
+  phri::SupervisorSettings unchecked;
+  unchecked.frozen_s = 0.0;  // noise-free fakes
+  phri::StateSupervisor fake(one_joint(), unchecked);
+  for (long k = 1; k <= 200; ++k) ASSERT_TRUE(fake.check(frozen(k))) << k;
+}
+
+TEST(StateSupervisorEdges, SequenceAndStampFreshness) {
+  auto after_warmup = [](const phri::RobotState& s) {
+    phri::StateSupervisor supervisor(one_joint(), phri::SupervisorSettings{});
+    for (long k = 1; k <= 100; ++k) EXPECT_TRUE(supervisor.check(at_rest(k))) << k;
+    return verdict(supervisor, s);
+  };
+  phri::RobotState s = at_rest(101);
+  s.joints.sequence = 99;  // went back
+  EXPECT_EQ(after_warmup(s), SafetyFault::kStale);
+  s = at_rest(101);
+  s.joints.stamp_s = at_rest(100).joints.stamp_s;  // the sequence advanced, the stamp did not
+  EXPECT_EQ(after_warmup(s), SafetyFault::kStampFrozen);
+  s = at_rest(101);
+  s.joints.stamp_s = 0.05;  // went back
+  EXPECT_EQ(after_warmup(s), SafetyFault::kStampJump);
+  s = at_rest(101);
+  s.joints.stamp_s = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(after_warmup(s), SafetyFault::kStampJump);
+  // The sequence may advance by ceil(max_degraded_s / period_s) + 1 = 21 in one sample.
+  s = at_rest(101);
+  s.joints.sequence = 100 + 21;
+  EXPECT_EQ(after_warmup(s), SafetyFault::kNone);
+  s.joints.sequence = 100 + 22;
+  EXPECT_EQ(after_warmup(s), SafetyFault::kStampJump);
+  // The stamp by max_degraded_s + the sequence's advance x period_s (21 ms for one sample).
+  s = at_rest(101);
+  s.joints.stamp_s = at_rest(100).joints.stamp_s + 0.021 - kEdge;
+  EXPECT_EQ(after_warmup(s), SafetyFault::kNone);
+  s.joints.stamp_s = at_rest(100).joints.stamp_s + 0.021 + kEdge;
+  EXPECT_EQ(after_warmup(s), SafetyFault::kStampJump);
+}
+
+TEST(StateSupervisorEdges, AGapInBothCountersAtTheBudgetsEdge) {
+  // 19 missing periods: a 20 ms gap, within max_degraded_s; 20 missing: 21 ms, a safe stop.
+  for (const long missing : {19L, 20L}) {
+    phri::StateSupervisor supervisor(one_joint(), phri::SupervisorSettings{});
+    for (long k = 1; k <= 100; ++k) ASSERT_TRUE(supervisor.check(sample(k)));
+    EXPECT_TRUE(supervisor.check(sample(101 + missing))) << "the sample after the gap is good";
+    EXPECT_EQ(supervisor.safe_stop(), missing == 20) << missing;
+    if (missing == 20) {
+      EXPECT_EQ(supervisor.safe_stop_transition().reason, SafetyFault::kDegradedTooLong);
+      EXPECT_DOUBLE_EQ(supervisor.safe_stop_transition().time_s, sample(121).time_s);
+    }
+  }
+}
+
+phri::RobotState torque_spike(long k) {
+  phri::RobotState s = sample(k);
+  s.tau_sensor_Nm[0] = 1e6;
+  return s;
+}
+
+TEST(StateSupervisorEdges, BadSamplesInARowUpToTheDegradedBudget) {
+  // 20 implausible samples in a row are 20 ms of held state (max_degraded_s): still degraded;
+  // the 21st is a safe stop with that sample's reason.
+  phri::StateSupervisor supervisor(one_joint(), phri::SupervisorSettings{});
+  for (long k = 1; k <= 100; ++k) ASSERT_TRUE(supervisor.check(sample(k)));
+  for (long k = 101; k <= 120; ++k) EXPECT_FALSE(supervisor.check(torque_spike(k)));
+  EXPECT_EQ(supervisor.state(), SupervisorState::kDegraded);
+  EXPECT_EQ(supervisor.last_transition().reason, SafetyFault::kTorqueRange);
+  EXPECT_FALSE(supervisor.check(torque_spike(121)));
+  EXPECT_EQ(supervisor.state(), SupervisorState::kSafeStop);
+  EXPECT_EQ(supervisor.safe_stop_transition().reason, SafetyFault::kTorqueRange);
+  EXPECT_EQ(supervisor.safe_stop_transition().from, SupervisorState::kDegraded);
+  EXPECT_EQ(supervisor.implausible_samples(), 21);
+  // Latched: good samples pass the check (the brake uses them) but the state stays.
+  for (long k = 122; k <= 130; ++k) EXPECT_TRUE(supervisor.check(sample(k)));
+  EXPECT_TRUE(supervisor.safe_stop());
+}
+
+TEST(StateSupervisorEdges, RecoveryAfterRecoverySamplesGoodOnes) {
+  phri::StateSupervisor supervisor(one_joint(), phri::SupervisorSettings{});
+  for (long k = 1; k <= 100; ++k) ASSERT_TRUE(supervisor.check(sample(k)));
+  EXPECT_FALSE(supervisor.check(torque_spike(101)));
+  EXPECT_EQ(supervisor.state(), SupervisorState::kDegraded);
+  EXPECT_DOUBLE_EQ(supervisor.last_good().tau_sensor_Nm[0], sample(100).tau_sensor_Nm[0]) << "held";
+  EXPECT_TRUE(supervisor.check(sample(102)));
+  EXPECT_TRUE(supervisor.check(sample(103)));
+  EXPECT_EQ(supervisor.state(), SupervisorState::kDegraded) << "2 of recovery_samples = 3";
+  EXPECT_TRUE(supervisor.check(sample(104)));
+  EXPECT_EQ(supervisor.state(), SupervisorState::kNormal);
+  EXPECT_EQ(supervisor.last_transition().from, SupervisorState::kDegraded);
+  EXPECT_EQ(supervisor.transition_count(), 2u);
+}
+
+TEST(StateSupervisorEdges, IntermittentFaultsUpToTheFaultBudget) {
+  // Without decay each implausible sample adds 1 to the budget for good: 20 (max_fault_budget)
+  // spread among good samples leave the arm degraded at worst, the 21st is too many.
+  phri::SupervisorSettings settings;
+  settings.fault_budget_decay_per_good = 0.0;
+  phri::StateSupervisor supervisor(one_joint(), settings);
+  long k = 1;
+  for (; k <= 10; ++k) ASSERT_TRUE(supervisor.check(sample(k)));
+  for (int spike = 1; spike <= 20; ++spike) {
+    EXPECT_FALSE(supervisor.check(torque_spike(k++)));
+    for (int good = 0; good < 4; ++good) EXPECT_TRUE(supervisor.check(sample(k++)));
+  }
+  EXPECT_EQ(supervisor.state(), SupervisorState::kNormal);
+  EXPECT_FALSE(supervisor.check(torque_spike(k)));
+  EXPECT_EQ(supervisor.state(), SupervisorState::kSafeStop);
+  EXPECT_EQ(supervisor.safe_stop_transition().reason, SafetyFault::kTooManyFaults);
+
+  // With the default decay (0.05 per good sample) one spike in every 21 samples never adds up.
+  phri::StateSupervisor decaying(one_joint(), phri::SupervisorSettings{});
+  k = 1;
+  for (int spike = 0; spike < 200; ++spike) {
+    decaying.check(torque_spike(k++));
+    for (int good = 0; good < 20; ++good) ASSERT_TRUE(decaying.check(sample(k++)));
+  }
+  EXPECT_EQ(decaying.state(), SupervisorState::kNormal);
+  EXPECT_EQ(decaying.implausible_samples(), 200);
+}
+
+TEST(StateSupervisorEdges, SignalsMarkedInvalidOrNotFinite) {
+  struct Case {
+    const char* name;
+    SafetyFault fault;
+    bool kinematics;  // whether the joint part still reached the brake
+    void (*spoil)(phri::RobotState&);
+  };
+  const Case cases[] = {
+      {"joints invalid", SafetyFault::kInvalid, false, [](phri::RobotState& s) { s.joints.valid = false; }},
+      {"torque invalid", SafetyFault::kInvalid, true, [](phri::RobotState& s) { s.torque.valid = false; }},
+      {"q NaN", SafetyFault::kNotFinite, false,
+       [](phri::RobotState& s) { s.q_rad[0] = std::numeric_limits<double>::quiet_NaN(); }},
+      {"qd inf", SafetyFault::kNotFinite, false,
+       [](phri::RobotState& s) { s.qd_rad_s[0] = std::numeric_limits<double>::infinity(); }},
+      {"tau NaN", SafetyFault::kNotFinite, true,
+       [](phri::RobotState& s) { s.tau_sensor_Nm[0] = std::numeric_limits<double>::quiet_NaN(); }},
+      {"current NaN", SafetyFault::kNotFinite, true,
+       [](phri::RobotState& s) { s = with_current(s, std::numeric_limits<double>::quiet_NaN()); }},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    phri::StateSupervisor supervisor(one_joint(), phri::SupervisorSettings{});
+    for (long k = 1; k <= 100; ++k) ASSERT_TRUE(supervisor.check(sample(k)));
+    phri::RobotState s = sample(101);
+    c.spoil(s);
+    EXPECT_EQ(verdict(supervisor, s), c.fault);
+    EXPECT_EQ(supervisor.state(), SupervisorState::kDegraded);
+    EXPECT_EQ(supervisor.kinematics_fresh(), c.kinematics);
+    EXPECT_TRUE(supervisor.check(sample(102))) << "one bad sample, then good again";
+  }
+}
+
+TEST(StateSupervisorEdges, WrongSizes) {
+  phri::StateSupervisor supervisor(one_joint(), phri::SupervisorSettings{});
+  ASSERT_TRUE(supervisor.check(sample(1)));
+  phri::RobotState two(2);
+  two.joints = two.torque = sample(2).joints;
+  two.joints.valid = two.torque.valid = true;
+  EXPECT_EQ(verdict(supervisor, two), SafetyFault::kSize);
+  phri::RobotState current = sample(3);
+  current.current.valid = true;
+  current.current_A = Eigen::VectorXd::Zero(3);
+  EXPECT_EQ(verdict(supervisor, current), SafetyFault::kSize);
+  EXPECT_EQ(verdict(supervisor, sample(4)), SafetyFault::kNone);
+}
+
+TEST(StateSupervisorEdges, TheRobotsOwnFaultAndStopRequest) {
+  // A fault the robot reports is a safe stop at once, not a degraded spell.
+  phri::StateSupervisor faulted(one_joint(), phri::SupervisorSettings{});
+  ASSERT_TRUE(faulted.check(sample(1)));
+  phri::RobotState s = sample(2);
+  s.fault = true;
+  EXPECT_EQ(verdict(faulted, s), SafetyFault::kRobotFault);
+  EXPECT_EQ(faulted.state(), SupervisorState::kSafeStop);
+  EXPECT_EQ(faulted.safe_stop_transition().from, SupervisorState::kNormal);
+  EXPECT_EQ(faulted.safe_stop_transition().reason, SafetyFault::kRobotFault);
+  // A stop request on a good sample: the sample is used (the brake needs it) and the stop taken.
+  phri::StateSupervisor asked(one_joint(), phri::SupervisorSettings{});
+  ASSERT_TRUE(asked.check(sample(1)));
+  s = sample(2);
+  s.stop_requested = true;
+  EXPECT_TRUE(asked.check(s));
+  EXPECT_EQ(asked.state(), SupervisorState::kSafeStop);
+  EXPECT_EQ(asked.safe_stop_transition().reason, SafetyFault::kRobotStopRequest);
+  EXPECT_DOUBLE_EQ(asked.last_good().q_rad[0], s.q_rad[0]);
+}
+
+TEST(StateSupervisorEdges, FaultsReportedFromOutsideLatchASafeStop) {
+  for (const SafetyFault fault : {SafetyFault::kWriteRefused, SafetyFault::kQpFailure, SafetyFault::kFollowingError,
+                                  SafetyFault::kMissedAtSpeed, SafetyFault::kHoldRefused}) {
+    SCOPED_TRACE(std::string(phri::to_string(fault)));
+    phri::StateSupervisor supervisor(one_joint(), phri::SupervisorSettings{});
+    for (long k = 1; k <= 10; ++k) ASSERT_TRUE(supervisor.check(sample(k)));
+    supervisor.report(fault, 0.0105, 0);
+    EXPECT_EQ(supervisor.state(), SupervisorState::kSafeStop);
+    EXPECT_EQ(supervisor.safe_stop_transition().reason, fault);
+    EXPECT_EQ(supervisor.safe_stop_transition().joint, 0);
+    EXPECT_DOUBLE_EQ(supervisor.safe_stop_transition().time_s, 0.0105);
+    // A later report does not replace the reason; good samples do not end the stop.
+    supervisor.report(SafetyFault::kQpFailure, 0.02);
+    for (long k = 11; k <= 20; ++k) EXPECT_TRUE(supervisor.check(sample(k)));
+    EXPECT_EQ(supervisor.safe_stop_transition().reason, fault);
+    EXPECT_TRUE(supervisor.safe_stop());
+    supervisor.reset();
+    EXPECT_EQ(supervisor.state(), SupervisorState::kNormal);
+    EXPECT_FALSE(supervisor.has_good());
+  }
+}
+
+// τ_s against the motor current K_T G_r i (10 N.m/A here): the residual, low-passed over 10 ms,
+// may reach static + 0.5 |τ_f| + 0.15 min(|τ_s|, |K_T G_r i|) + 4 N.m (no rotor inertia here).
+TEST(StateSupervisorEdges, TorqueAgainstTheMotorCurrent) {
+  struct Case {
+    const char* name;
+    double speed, tau, friction_static, friction_coulomb;
+    double tolerance;
+  };
+  const Case cases[] = {
+      {"at rest, no load", 0.0, 0.0, 0.0, 0.0, 4.0},
+      {"at rest, 20 N.m", 0.0, 20.0, 0.0, 0.0, 4.0 + 0.15 * 20.0},
+      {"stiction", 0.0, 0.0, 1.5, 0.0, 4.0 + 1.5},
+      {"moving, Coulomb friction", kSpeed, 0.0, 0.0, 2.0, 4.0 + 0.5 * 2.0},
+  };
+  for (const Case& c : cases) {
+    for (const double excess : {-0.01, 0.01}) {
+      SCOPED_TRACE(std::string(c.name) + (excess > 0 ? ", beyond" : ", inside"));
+      phri::SensorRanges ranges = one_joint();
+      auto one = [](double v) { return Eigen::VectorXd::Constant(1, v); };
+      ranges.torque_per_amp = one(10.0);
+      ranges.reflected_inertia = ranges.friction_viscous = ranges.transmission_compliance = one(0.0);
+      ranges.friction_static = one(c.friction_static);
+      ranges.friction_coulomb = one(c.friction_coulomb);
+      phri::SupervisorSettings settings;
+      settings.frozen_s = 0.0;  // constant readings here
+      phri::StateSupervisor supervisor(ranges, settings);
+      // Motor torque = τ_s + the modelled kinetic friction + the residual.
+      const double kinetic = c.speed > 0.05 ? c.friction_coulomb : 0.0;
+      const double motor = c.tau + kinetic + c.tolerance + excess;
+      long refused_at = -1;
+      for (long k = 1; k <= 300 && refused_at < 0; ++k) {
+        phri::RobotState s = c.speed > 0.0 ? sample(k) : at_rest(k);
+        s.tau_sensor_Nm[0] = c.tau;
+        if (!supervisor.check(with_current(s, motor / 10.0))) refused_at = k;
+      }
+      if (excess < 0) {
+        EXPECT_EQ(refused_at, -1);
+        EXPECT_EQ(supervisor.state(), SupervisorState::kNormal);
+      } else {
+        EXPECT_GT(refused_at, 2) << "the filter starts from zero: not at the first samples";
+        EXPECT_EQ(supervisor.sample_fault(), SafetyFault::kTorqueCurrentMismatch);
+        EXPECT_EQ(supervisor.state(), SupervisorState::kSafeStop) << "at once, no degraded spell";
+        EXPECT_EQ(supervisor.safe_stop_transition().reason, SafetyFault::kTorqueCurrentMismatch);
+        EXPECT_EQ(supervisor.safe_stop_transition().joint, 0);
+      }
+    }
+  }
+}
+
+TEST(StateSupervisorEdges, InconsistentRangesOrSettingsAreConfigErrors) {
+  phri::SensorRanges sizes = one_joint();
+  sizes.torque_range = Eigen::VectorXd::Constant(2, 50.0);
+  EXPECT_THROW(phri::StateSupervisor(sizes, phri::SupervisorSettings{}), phri::ConfigError);
+  phri::SensorRanges order = one_joint();
+  order.q_lower[0] = order.q_upper[0];
+  EXPECT_THROW(phri::StateSupervisor(order, phri::SupervisorSettings{}), phri::ConfigError);
+  phri::SensorRanges compared = one_joint();
+  compared.torque_per_amp = Eigen::VectorXd::Constant(1, 10.0);  // the other terms left out
+  EXPECT_THROW(phri::StateSupervisor(compared, phri::SupervisorSettings{}), phri::ConfigError);
+  phri::SupervisorSettings budget;
+  budget.max_degraded_s = 0.5e-3;  // shorter than a period
+  EXPECT_THROW(phri::StateSupervisor(one_joint(), budget), phri::ConfigError);
+  phri::SupervisorSettings recovery;
+  recovery.recovery_samples = 0;
+  EXPECT_THROW(phri::StateSupervisor(one_joint(), recovery), phri::ConfigError);
 }
 
 }  // namespace
