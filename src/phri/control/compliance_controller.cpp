@@ -21,6 +21,10 @@ ComplianceController::ComplianceController(const ComplianceSettings& settings)
                    settings.ee_integral.linear_zone, settings.ee_integral.angular_zone}) {
     if (!(v >= 0) || !std::isfinite(v)) fail("gains", "stiffness, damping and weights must be finite and >= 0");
   }
+  if (settings.ee_axis_stiffness &&
+      (!settings.ee_axis_stiffness->allFinite() || (settings.ee_axis_stiffness->array() < 0.0).any())) {
+    fail("ee_axis_stiffness", "must be finite and >= 0 on every axis");
+  }
   if (!(settings.posture_weight > 0)) fail("posture_weight", "must be > 0 (it keeps the QP strictly convex)");
 }
 
@@ -35,6 +39,8 @@ void ComplianceController::apply(WholeBodyQp& qp) {
   Vector6d stiffness;
   if (ee_free) {
     stiffness.setZero();
+  } else if (settings_.ee_axis_stiffness) {
+    stiffness = *settings_.ee_axis_stiffness * stiffness_scale_;
   } else if (mode_ == ComplianceMode::kFullBody) {
     stiffness.setConstant(settings_.full_body_ee_stiffness * stiffness_scale_);
   } else {
@@ -44,15 +50,23 @@ void ComplianceController::apply(WholeBodyQp& qp) {
   ee.set_stiffness(stiffness);
   if (ee_free) {
     ee.set_damping(Vector6d::Constant(settings_.touched_ee_damping));
-  } else {
+  } else if ((stiffness.array() > 0.0).all()) {
     ee.set_critical_damping();
+  } else {
+    // An axis without a spring (per-axis compliance): the hand-guiding damping along it.
+    const Vector6d damping =
+        (stiffness.array() > 0.0).select(2.0 * stiffness.cwiseSqrt(), Vector6d::Constant(settings_.touched_ee_damping));
+    ee.set_damping(damping);
   }
   ee.set_weight(settings_.ee_weight);
-  ee.set_gamma(Vector6d::Constant(gamma_ee));
   posture.set_stiffness(posture_stiffness_);
   posture.set_damping(ee_free ? settings_.touched_posture_damping : settings_.posture_damping);
   posture.set_weight(settings_.posture_weight);
-  posture.set_gamma(gamma_posture);
+  // Gamma per role: every task with the main role or the null-space role, not only these two.
+  for (const auto& task : qp.tasks()) {
+    if (task->role() == ComplianceRole::kMain) task->set_role_gamma(gamma_ee);
+    if (task->role() == ComplianceRole::kNullSpace) task->set_role_gamma(gamma_posture);
+  }
 }
 
 void ComplianceController::initialise(ComplianceMode mode, WholeBodyQp& qp, const Data& data) {
@@ -61,7 +75,7 @@ void ComplianceController::initialise(ComplianceMode mode, WholeBodyQp& qp, cons
   apply(qp);
   // Start at the set values rather than filtering from zero.
   EndEffectorTask& ee = qp.end_effector();
-  ee.reset_gains(ee.stiffness_target(), 2.0 * ee.stiffness_target().cwiseSqrt(), settings_.ee_weight,
+  ee.reset_gains(ee.stiffness_target(), ee.damping_target(), settings_.ee_weight,
                  Vector6d::Constant(mode == ComplianceMode::kFullBody ? 1.0 : 0.0));
   qp.posture().reset_gains(settings_.posture_stiffness, settings_.posture_damping, settings_.posture_weight,
                            mode == ComplianceMode::kStiff ? 0.0 : 1.0);

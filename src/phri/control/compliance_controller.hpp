@@ -1,5 +1,6 @@
 #pragma once
-// Applies a compliance mode to the QP's tasks (gammas, gains) and runs dual compliance: a Schmitt
+// Applies a compliance mode to the QP's tasks (gamma per task role: task.hpp's ComplianceRole;
+// gains of the main task and the posture) and runs dual compliance: a Schmitt
 // trigger on the end-effector wrench norm (paper: "touched" above the high threshold, released
 // below the low one). While touched the end-effector task has zero stiffness, low damping and
 // gamma 1, so the hand drags it; on release the pose at release becomes the target and the mode is
@@ -10,6 +11,7 @@
 #include <phri/control/compliance_mode.hpp>
 #include <phri/control/return_leash.hpp>
 #include <phri/control/whole_body_qp.hpp>
+#include <phri/model/spatial.hpp>
 
 #include <algorithm>
 #include <optional>
@@ -43,6 +45,10 @@ struct ComplianceSettings {
   double release_threshold = 4.0;
   double touched_ee_damping = 15.0;
   double touched_posture_damping = 2.0;
+  /// The main task's stiffness per axis of its rows (EndEffectorTask::axes()), in place of the
+  /// mode's (ee_*_stiffness, full_body_ee_stiffness; 0 while touched in dual compliance); empty:
+  /// the mode's. An axis with no stiffness gets touched_ee_damping, the others 2 sqrt(K).
+  std::optional<Vector6d> ee_axis_stiffness;
 };
 
 class ComplianceController {

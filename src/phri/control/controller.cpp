@@ -1,5 +1,7 @@
 #include <phri/control/controller.hpp>
 
+#include <phri/control/task_registry.hpp>
+
 #include <phri/control/torque_guards.hpp>
 #include <phri/core/error.hpp>
 #include <phri/model/algorithms.hpp>
@@ -201,7 +203,7 @@ Controller::Controller(LoadedRobot robot, const ControllerSettings& settings)
       actuators_(checked(robot.actuators, model_, robot.actuators_source)),
       collision_(std::move(robot.collision)),
       qp_(model_, collision_ ? &*collision_ : nullptr, qp_settings(settings, actuators_)),
-      compliance_(settings.compliance),
+      compliance_(with_main_task_stiffness(settings.compliance, settings.tasks)),
       leash_(model_, model_.frame_id(settings.end_effector_frame), settings.compliance.return_leash),
       observer_(model_, settings.observer_gain),
       wrench_(wrench_settings(settings, model_)),
@@ -246,6 +248,30 @@ Controller::Controller(LoadedRobot robot, const ControllerSettings& settings)
     reflected_inertia_[i] = actuators_[i].reflected_inertia_kgm2;
     static_friction_[i] = std::max(actuators_[i].friction.static_Nm, actuators_[i].friction.coulomb_Nm);
   }
+  add_declared_tasks(settings.tasks);
+}
+
+// The run's declared tasks: the paper's two configured, the others built and added to the QP.
+void Controller::add_declared_tasks(const std::vector<TaskSpec>& specs) {
+  const TaskBuildContext context{model_, end_effector_frame_, settings_.qp.smoothing_time_constant};
+  for (const TaskSpec& spec : specs) {
+    if (spec.name == "end_effector") {
+      configure_main_task(spec, qp_.end_effector());
+    } else if (spec.name == "posture") {
+      configure_posture_task(spec, qp_.posture());
+    } else {
+      qp_.add_task(make_task(spec, context));
+    }
+  }
+}
+
+ComplianceSettings Controller::with_main_task_stiffness(ComplianceSettings compliance, const std::vector<TaskSpec>& specs) {
+  for (const TaskSpec& spec : specs) {
+    if (spec.name == "end_effector" && spec.has("stiffness")) {
+      compliance.ee_axis_stiffness = spec.six("stiffness", Vector6d::Zero(), 0.0, 1e4);
+    }
+  }
+  return compliance;
 }
 
 namespace {
@@ -632,6 +658,7 @@ void Controller::check_qp(WholeBodyQpStatus qp_status, double t) {
 void Controller::update_modes_and_targets() {
   if (!started_) {
     started_ = true;
+    qp_.start_tasks(model_, data_);
     qp_.posture().set_target(q_);
     compliance_.initialise(settings_.initial_compliance, qp_, data_);
     leash_.reset();
@@ -731,7 +758,10 @@ CycleStatus Controller::step(const RobotState& state, const ControllerTargets& t
   bound_external_torque();
   if (low_level_.requested() == LowLevelMode::kPosition) tau_ext_.setZero();
   shape_tasks();
-  const WholeBodyQpStatus qp_status = qp_.update(model_, data_, q_, qd_, tau_ext_, settings_.period_s);
+  // The F/T wrench for the tasks that read it (a force task), when it is plausible and in use.
+  const bool wrench_usable = wrench_supervisor_.fresh() && wrench_.calibrated();
+  const WholeBodyQpStatus qp_status =
+      qp_.update(model_, data_, q_, qd_, tau_ext_, settings_.period_s, wrench_usable ? &wrench_.wrench_world() : nullptr);
   check_qp(qp_status, state.time_s);
   if (supervisor_.safe_stop()) {
     safe_stop(true, command);

@@ -5,6 +5,7 @@
 // Tests and experiments may also build it in code.
 #include <phri/control/compliance_controller.hpp>
 #include <phri/control/compliance_mode.hpp>
+#include <phri/control/task_spec.hpp>
 #include <phri/control/whole_body_qp.hpp>
 #include <phri/control/wrench_estimator.hpp>
 #include <phri/core/enum_names.hpp>
@@ -180,6 +181,9 @@ struct ControllerSettings {
   double deadband_large_Nm = 1.0;
   double deadband_small_Nm = 0.4;
   ComplianceSettings compliance;
+  /// The run YAML's `controller.tasks:` (control/task_registry.hpp): "end_effector" and "posture"
+  /// configure the paper's two tasks, any other name adds a task. Empty: the paper's two as they are.
+  std::vector<TaskSpec> tasks;
   /// Time constant of the low-pass on the wrench norm that drives the dual-compliance trigger [s]
   /// (0: none). A hand's push builds up over tens of milliseconds; 10 ms rejects one-sample spikes.
   double wrench_trigger_filter_s = 0.01;

@@ -25,14 +25,30 @@ Eigen::Vector3d rotation_log(const Eigen::Matrix3d& r) {
 }
 
 EndEffectorTask::EndEffectorTask(const Model& model, int frame_id, double smoothing_time_constant,
-                                 const TargetLimits& limits)
-    : frame_id_(frame_id),
+                                 const TargetLimits& limits, double singular_value_threshold, std::string name,
+                                 ComplianceRole role)
+    : Task(std::move(name), role),
+      frame_id_(frame_id),
       limits_(limits),
       stiffness_(Eigen::VectorXd::Zero(6), smoothing_time_constant),
       damping_(Eigen::VectorXd::Zero(6), smoothing_time_constant),
       weight_(Eigen::VectorXd::Zero(1), smoothing_time_constant),
       gamma_(Eigen::VectorXd::Zero(6), smoothing_time_constant),
-      jacobian_(Eigen::MatrixXd::Zero(6, model.nv())) {}
+      jacobian_(Eigen::MatrixXd::Zero(6, model.nv())),
+      singular_weight_(singular_value_threshold),
+      frame_jacobian_(Eigen::MatrixXd::Zero(6, model.nv())),
+      weighted_rows_(Eigen::MatrixXd::Zero(6, model.nv())),
+      selected_rows_(Eigen::MatrixXd::Zero(6, model.nv())) {}
+
+void EndEffectorTask::set_fixed_gamma(const Vector6d& gamma) {
+  fixed_gamma_ = true;
+  gamma_.reset(gamma.cwiseMax(0.0).cwiseMin(1.0));
+}
+
+void EndEffectorTask::set_selection(const Vector6d& selection) {
+  selection_ = selection.cwiseMax(0.0).cwiseMin(1.0);
+  selecting_ = (selection_.array() < 1.0).any();
+}
 
 void EndEffectorTask::set_stiffness(const Vector6d& stiffness) { stiffness_.set_target(stiffness); }
 void EndEffectorTask::set_damping(const Vector6d& damping) { damping_.set_target(damping); }
@@ -51,7 +67,7 @@ void EndEffectorTask::reset_gains(const Vector6d& stiffness, const Vector6d& dam
   stiffness_.reset(stiffness);
   damping_.reset(damping);
   weight_.reset(Eigen::VectorXd::Constant(1, weight));
-  gamma_.reset(gamma.cwiseMax(0.0).cwiseMin(1.0));
+  if (!fixed_gamma_) gamma_.reset(gamma.cwiseMax(0.0).cwiseMin(1.0));
 }
 
 void EndEffectorTask::set_integral(const TaskIntegralSettings& settings) {
@@ -180,7 +196,7 @@ void EndEffectorTask::update_integral(double dt) {
                         velocity_.head<3>().norm() < kCreepLinear_m_s && velocity_.tail<3>().norm() < kCreepAngular_rad_s;
   for (Eigen::Index i = 0; i < 6; ++i) {
     const bool linear = i < 3;
-    const double e = error_[i];
+    const double e = task_error_[i];
     const double zone = linear ? integral_.linear_zone : integral_.angular_zone;
     const double limit = linear ? integral_.linear_limit : integral_.angular_limit;
     const bool active = creeping && std::abs(e) < zone && stiffness_.value()[i] > 0.0;
@@ -200,13 +216,65 @@ void EndEffectorTask::update(const Model& model, const Data& data, const Eigen::
   velocity_ = frame_velocity(model, data, frame_id_, ReferenceFrame::kLocalWorldAligned);
   error_.head<3>() = tracked_pose_.translation() - pose_.translation();
   error_.tail<3>() = rotation_log(tracked_pose_.linear() * pose_.linear().transpose());
+  task_error_ = in_task_axes(error_);
   update_integral(dt);
   const Vector6d bias = frame_jdot_qdot(model, data, frame_id_, ReferenceFrame::kLocalWorldAligned);
-  // ë* (paper's task reference) minus the drift J̇ qd, plus the compliant part gamma J M^-1 tau_ext.
-  reference_ = tracked_acceleration_ + stiffness_.value().cwiseProduct(error_) +
-               damping_.value().cwiseProduct(tracked_velocity_ - velocity_) + integral_term_ - bias;
+  // ë* (paper's task reference) minus the drift J̇ qd, plus the compliant part gamma J M^-1 tau_ext,
+  // each in the rows' axes (K, D and gamma diagonal there).
+  reference_ = in_task_axes(tracked_acceleration_) + stiffness_.value().cwiseProduct(task_error_) +
+               damping_.value().cwiseProduct(in_task_axes(tracked_velocity_ - velocity_)) + integral_term_ -
+               in_task_axes(bias);
   external_task_acceleration_.noalias() = jacobian_ * qdd_external;
-  reference_ += gamma_.value().cwiseProduct(external_task_acceleration_);
+  reference_ += gamma_.value().cwiseProduct(in_task_axes(external_task_acceleration_));
+  if (axes_ == TaskAxes::kFrame) {
+    const Eigen::Matrix3d rt = pose_.linear().transpose();
+    frame_jacobian_.topRows<3>().noalias() = rt * jacobian_.topRows<3>();
+    frame_jacobian_.bottomRows<3>().noalias() = rt * jacobian_.bottomRows<3>();
+  }
+  weigh_rows();
+}
+
+Vector6d EndEffectorTask::in_task_axes(const Vector6d& world) const {
+  if (axes_ == TaskAxes::kWorld) return world;
+  const Eigen::Matrix3d rt = pose_.linear().transpose();
+  Vector6d local;
+  local.head<3>().noalias() = rt * world.head<3>();
+  local.tail<3>().noalias() = rt * world.tail<3>();
+  return local;
+}
+
+// S^1/2 W S^1/2 A: the singular-direction weight W (identity when every singular value is above
+// its threshold, not formed) between the selection's square roots.
+void EndEffectorTask::weigh_rows() {
+  const Eigen::MatrixXd& a = rows();
+  const bool singular = singular_weight_.update(a);
+  weighted_ = singular || selecting_;
+  if (!weighted_) return;
+  if (!selecting_) {
+    weighted_rows_.noalias() = singular_weight_.weight() * a;
+    return;
+  }
+  const Vector6d root = selection_.cwiseSqrt();
+  selected_rows_.noalias() = root.asDiagonal() * a;
+  if (singular) {
+    weighted_rows_.noalias() = singular_weight_.weight() * selected_rows_;
+    weighted_rows_.array().colwise() *= root.array();
+  } else {
+    weighted_rows_.noalias() = root.asDiagonal() * selected_rows_;
+  }
+}
+
+void EndEffectorTask::add_objective(Eigen::MatrixXd& hessian, Eigen::VectorXd& gradient) const {
+  const double w = weight();
+  const Eigen::MatrixXd& a = rows();
+  if (weighted_) {
+    // w || (S^1/2 W S^1/2)^1/2 (A qdd - b) ||^2 (singular_direction_weight.hpp).
+    hessian.noalias() += w * a.transpose() * weighted_rows_;
+    gradient.noalias() -= w * weighted_rows_.transpose() * reference_;
+  } else {
+    hessian.noalias() += w * a.transpose() * a;
+    gradient.noalias() -= w * a.transpose() * reference_;
+  }
 }
 
 }  // namespace phri

@@ -25,8 +25,8 @@ JointLimitConstraint::JointLimitConstraint(const Model& model, const JointLimitS
   }
 }
 
-void JointLimitConstraint::tighten(const Eigen::VectorXd& q, const Eigen::VectorXd& qd, Eigen::VectorXd& lower,
-                                   Eigen::VectorXd& upper) const {
+void JointLimitConstraint::tighten(const Eigen::VectorXd& q, const Eigen::VectorXd& qd,
+                                   Eigen::Ref<Eigen::VectorXd> lower, Eigen::Ref<Eigen::VectorXd> upper) const {
   for (int i = 0; i < q.size(); ++i) {
     if (!limited_[static_cast<std::size_t>(i)]) continue;
     const VelocityDamper& damper = dampers_[static_cast<std::size_t>(i)];

@@ -4,6 +4,7 @@
 // as bounds on qdd. d_i and d_s are fractions of the joint's range (paper: 0.1 and 0.01); xi is
 // the joint's (scaled) velocity limit, so the damper lets it arrive at full speed at d_i.
 // Continuous joints have no bound here. Stiff: no gamma, so a push toward a limit is negated.
+#include <phri/control/constraint.hpp>
 #include <phri/control/velocity_damper.hpp>
 #include <phri/model/model.hpp>
 
@@ -18,14 +19,20 @@ struct JointLimitSettings {
   double amortization = 1.8;        ///< M
 };
 
-class JointLimitConstraint {
+class JointLimitConstraint final : public Constraint {
 public:
   /// velocity_limit: per joint, the xi of its damper.
   JointLimitConstraint(const Model& model, const JointLimitSettings& settings, const Eigen::VectorXd& velocity_limit);
 
   /// Tightens the acceleration bounds: lower = max(lower, damper on q - q_min), upper = min(upper,
   /// damper on q_max - q), for the joints that have limits.
-  void tighten(const Eigen::VectorXd& q, const Eigen::VectorXd& qd, Eigen::VectorXd& lower, Eigen::VectorXd& upper) const;
+  void tighten(const Eigen::VectorXd& q, const Eigen::VectorXd& qd, Eigen::Ref<Eigen::VectorXd> lower,
+               Eigen::Ref<Eigen::VectorXd> upper) const;
+  std::string_view type() const override { return "joint_limit"; }
+  void bound(const ConstraintContext& context, Eigen::Ref<Eigen::VectorXd> lower,
+             Eigen::Ref<Eigen::VectorXd> upper) override {
+    tighten(context.q, context.qd, lower, upper);
+  }
 
   bool limited(int joint) const { return limited_[static_cast<std::size_t>(joint)]; }
   /// The damper's gain lambda of a limited joint.

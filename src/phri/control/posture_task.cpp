@@ -8,8 +8,9 @@
 
 namespace phri {
 
-PostureTask::PostureTask(const Model& model, double smoothing_time_constant)
-    : nv_(model.nv()),
+PostureTask::PostureTask(const Model& model, double smoothing_time_constant, std::string name, ComplianceRole role)
+    : Task(std::move(name), role),
+      nv_(model.nv()),
       stiffness_(Eigen::VectorXd::Zero(model.nv()), smoothing_time_constant),
       damping_(Eigen::VectorXd::Zero(model.nv()), smoothing_time_constant),
       weight_(Eigen::VectorXd::Ones(1), smoothing_time_constant),
@@ -38,7 +39,18 @@ void PostureTask::reset_gains(double stiffness, double damping, double weight, d
   stiffness_.reset(Eigen::VectorXd::Constant(nv_, stiffness));
   damping_.reset(Eigen::VectorXd::Constant(nv_, damping));
   weight_.reset(Eigen::VectorXd::Constant(1, weight));
+  if (!fixed_gamma_) gamma_.reset(Eigen::VectorXd::Constant(1, std::clamp(gamma, 0.0, 1.0)));
+}
+
+void PostureTask::set_fixed_gamma(double gamma) {
+  fixed_gamma_ = true;
   gamma_.reset(Eigen::VectorXd::Constant(1, std::clamp(gamma, 0.0, 1.0)));
+}
+
+void PostureTask::add_objective(Eigen::MatrixXd& hessian, Eigen::VectorXd& gradient) const {
+  const double w = weight();
+  hessian.diagonal().array() += w;
+  gradient.noalias() -= w * reference_;
 }
 
 void PostureTask::set_target(const Eigen::VectorXd& q, const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd) {

@@ -14,14 +14,27 @@
 // constant 0.1 s), and it restarts from zero when the joint crosses its target, so it neither
 // winds up during a push or a motion nor drives an overshoot. The controller enables it in the
 // torque loops, not in dual compliance (see enable_integral); EndEffectorTask has the same term.
+#include <phri/control/task.hpp>
 #include <phri/core/smoothed_vector.hpp>
 #include <phri/model/model.hpp>
 
 namespace phri {
 
-class PostureTask {
+class PostureTask final : public Task {
 public:
-  PostureTask(const Model& model, double smoothing_time_constant = 0.1);
+  PostureTask(const Model& model, double smoothing_time_constant = 0.1, std::string name = "posture",
+              ComplianceRole role = ComplianceRole::kNullSpace);
+
+  // ---- task interface: rows A = I (nv rows)
+  std::string_view type() const override { return "posture"; }
+  void update(const TaskContext& context) override { update(context.q, context.qd, context.qdd_external, context.dt); }
+  void add_objective(Eigen::MatrixXd& hessian, Eigen::VectorXd& gradient) const override;
+  void set_role_gamma(double gamma) override {
+    if (!fixed_gamma_) set_gamma(gamma);
+  }
+  bool fixed_gamma() const override { return fixed_gamma_; }
+  /// A gamma of its own (the compliance modes leave it alone).
+  void set_fixed_gamma(double gamma);
 
   void set_stiffness(const Eigen::VectorXd& stiffness);
   void set_stiffness(double stiffness) { stiffness_.set_target_constant(stiffness); }
@@ -62,6 +75,7 @@ private:
   static constexpr double kIntegralBleed_s = 0.1;
 
   int nv_;
+  bool fixed_gamma_ = false;
   std::vector<bool> continuous_;
   SmoothedVector stiffness_;
   SmoothedVector damping_;

@@ -2,6 +2,7 @@
 // Self-collision avoidance of the QP (paper, "Safety Features"): the velocity damper
 // (velocity_damper.hpp) on the distance d of each capsule pair, d̈ = J_d qdd + J̇_d qd >= damper,
 // active inside the influence distance (paper: d_i 0.03 m, d_s 0.015 m, M 1.8).
+#include <phri/control/constraint.hpp>
 #include <phri/control/velocity_damper.hpp>
 #include <phri/model/collision_model.hpp>
 
@@ -35,7 +36,7 @@ inline double collision_braking_bound(double d, double d_dot, double safety_dist
   return -d_dot > 0.5 * allowed ? -b.gain * (d_dot + allowed) : -kInf;
 }
 
-class SelfCollisionConstraint {
+class SelfCollisionConstraint final : public Constraint {
 public:
   SelfCollisionConstraint(const Model& model, const CollisionModel& collision, const VelocityDamperSettings& damper,
                           const CollisionBrakingSettings& braking = {0.0, 50.0})
@@ -47,7 +48,21 @@ public:
         braking_(braking),
         damper_lower_(Eigen::VectorXd::Zero(collision.num_pairs())) {}
 
-  int num_rows() const { return collision_->num_pairs(); }
+  std::string_view type() const override { return "self_collision"; }
+  int num_rows() const override { return collision_->num_pairs(); }
+  void begin_cycle() override { relaxed_ = false; }
+  /// The rows, without the braking rows once relaxed in this cycle.
+  void fill_rows(const ConstraintContext& context, Eigen::Ref<Eigen::MatrixXd> a, Eigen::Ref<Eigen::VectorXd> l,
+                 Eigen::Ref<Eigen::VectorXd> u) override {
+    rows(context.model, context.data, a, l, u);
+    if (relaxed_) l = damper_lower_;
+  }
+  /// Drops the braking rows for this cycle where they bind (the damper alone rather than the fallback).
+  bool relax() override {
+    if (relaxed_ || !braking_binds_) return false;
+    relaxed_ = true;
+    return true;
+  }
 
   /// Distances at the current state (data: after the model terms), then one row per pair.
   template <class Rows, class Bound>
@@ -80,6 +95,7 @@ private:
   CollisionBrakingSettings braking_;
   Eigen::VectorXd damper_lower_;
   bool braking_binds_ = false;
+  bool relaxed_ = false;  // the braking rows dropped for this cycle
 };
 
 }  // namespace phri

@@ -15,6 +15,8 @@
 // lowered limit is asked no more deceleration than its reserve gives (reserve / (M_ii lambda) of
 // speed per cycle's bound), and with a negative reserve no less acceleration than the torque limit
 // forces, so the lowered limit never makes the QP infeasible by itself.
+#include <phri/control/constraint.hpp>
+
 #include <Eigen/Core>
 
 #include <algorithm>
@@ -31,14 +33,34 @@ struct BrakingReserveSettings {
   double return_gain = 200.0;
 };
 
-class VelocityLimitConstraint {
+class VelocityLimitConstraint final : public Constraint {
 public:
   VelocityLimitConstraint(const Eigen::VectorXd& velocity_limit, const Eigen::VectorXd& gain,
                           const BrakingReserveSettings& reserve = {0.0, 1.0, 0.0})
-      : velocity_limit_(velocity_limit), gain_(gain), reserve_(reserve) {}
+      : velocity_limit_(velocity_limit),
+        gain_(gain),
+        reserve_(reserve),
+        lower_(Eigen::VectorXd::Zero(velocity_limit.size())),
+        upper_(Eigen::VectorXd::Zero(velocity_limit.size())) {}
+
+  std::string_view type() const override { return "velocity_limit"; }
+  void begin_cycle() override { relaxed_ = false; }
+  /// Tightens the bounds by the reserve-lowered limits, with the return gain unless relaxed.
+  void bound(const ConstraintContext& context, Eigen::Ref<Eigen::VectorXd> lower,
+             Eigen::Ref<Eigen::VectorXd> upper) override {
+    bound(context.qd, context.hold_torque, context.torque_limit, context.inertia_diagonal, lower_, upper_, !relaxed_);
+    lower = lower.cwiseMax(lower_);
+    upper = upper.cwiseMin(upper_);
+  }
+  /// Drops the return gain for this cycle (the paper's bounds rather than the fallback brake).
+  bool relax() override {
+    if (relaxed_ || !returning_) return false;
+    relaxed_ = true;
+    return true;
+  }
 
   /// Sets the acceleration bounds from the velocity limits.
-  void bound(const Eigen::VectorXd& qd, Eigen::VectorXd& lower, Eigen::VectorXd& upper) const {
+  void bound(const Eigen::VectorXd& qd, Eigen::Ref<Eigen::VectorXd> lower, Eigen::Ref<Eigen::VectorXd> upper) const {
     for (int i = 0; i < qd.size(); ++i) {
       upper[i] = -gain_[i] * (qd[i] - velocity_limit_[i]);
       lower[i] = -gain_[i] * (qd[i] + velocity_limit_[i]);
@@ -50,7 +72,8 @@ public:
   /// with_return: the return gain beyond the limit (deceleration()); returning() then tells whether
   /// it asked more than the paper's gain on some joint.
   void bound(const Eigen::VectorXd& qd, const Eigen::VectorXd& hold, const Eigen::VectorXd& torque_limit,
-             const Eigen::VectorXd& inertia, Eigen::VectorXd& lower, Eigen::VectorXd& upper, bool with_return = true) {
+             const Eigen::VectorXd& inertia, Eigen::Ref<Eigen::VectorXd> lower, Eigen::Ref<Eigen::VectorXd> upper,
+             bool with_return = true) {
     returning_ = false;
     for (int i = 0; i < qd.size(); ++i) {
       const double up_reserve = torque_limit[i] + hold[i], down_reserve = torque_limit[i] - hold[i];
@@ -104,6 +127,8 @@ private:
   Eigen::VectorXd velocity_limit_, gain_;
   BrakingReserveSettings reserve_;
   bool returning_ = false;  // the last bound() asked more than the paper's gain somewhere
+  bool relaxed_ = false;    // the return gain dropped for this cycle
+  Eigen::VectorXd lower_, upper_;  // this cycle's bounds before tightening the QP's
 };
 
 }  // namespace phri

@@ -66,47 +66,117 @@ WholeBodyQp::WholeBodyQp(const Model& model, const CollisionModel* collision, co
 WholeBodyQp::WholeBodyQp(const Model& model, const CollisionModel* collision, const WholeBodyQpSettings& settings,
                          const Limits& limits)
     : settings_(settings),
-      end_effector_(model, model.frame_id(settings.end_effector_frame), settings.smoothing_time_constant),
-      posture_(model, settings.smoothing_time_constant),
       nv_(model.nv()),
-      num_pairs_(collision ? collision->num_pairs() : 0),
-      joint_limits_(model,
-                    {settings.joint_influence_fraction, settings.joint_safety_fraction, settings.joint_damper_amortization},
-                    limits.velocity),
-      velocity_limit_(limits.velocity, velocity_limit_gains(joint_limits_, settings.velocity_limit_gain, model.nv()),
-                      settings.braking_reserve),
-      torque_limit_(limits.torque),
       deadband_(settings.compliance_deadband.size() ? settings.compliance_deadband : Eigen::VectorXd::Zero(model.nv())),
       qdd_external_(Eigen::VectorXd::Zero(nv_)),
       qdd_desired_(Eigen::VectorXd::Zero(nv_)),
       tau_desired_(Eigen::VectorXd::Zero(nv_)),
       last_good_tau_(Eigen::VectorXd::Zero(nv_)),
       hold_torque_(Eigen::VectorXd::Zero(nv_)),
-      inertia_diagonal_(Eigen::VectorXd::Zero(nv_)),
-      singular_weight_(settings.singular_value_threshold),
-      weighted_jacobian_(Eigen::MatrixXd::Zero(6, nv_)) {
-  if (collision) self_collision_.emplace(model, *collision, settings.collision, settings.collision_braking);
-  // Rows: nv torque rows (A = M), then one row per collision pair. Bounds: qdd.
-  problem_.resize(nv_, 0, nv_ + num_pairs_);
-  solver_.resize(nv_, 0, nv_ + num_pairs_);
+      inertia_diagonal_(Eigen::VectorXd::Zero(nv_)) {
+  constexpr std::size_t kReserved = 16;  // more than any configuration declares: no reallocation later
+  tasks_.reserve(kReserved);
+  constraints_.reserve(kReserved);
+  auto ee = std::make_unique<EndEffectorTask>(model, model.frame_id(settings.end_effector_frame),
+                                              settings.smoothing_time_constant, TargetLimits{},
+                                              settings.singular_value_threshold);
+  end_effector_ = ee.get();
+  tasks_.push_back(std::move(ee));
+  auto posture = std::make_unique<PostureTask>(model, settings.smoothing_time_constant);
+  posture_ = posture.get();
+  tasks_.push_back(std::move(posture));
+
+  auto joint_limits = std::make_unique<JointLimitConstraint>(
+      model, JointLimitSettings{settings.joint_influence_fraction, settings.joint_safety_fraction,
+                                settings.joint_damper_amortization},
+      limits.velocity);
+  auto velocity_limit = std::make_unique<VelocityLimitConstraint>(
+      limits.velocity, velocity_limit_gains(*joint_limits, settings.velocity_limit_gain, model.nv()),
+      settings.braking_reserve);
+  velocity_limit_ = velocity_limit.get();
+  joint_limits_ = joint_limits.get();
+  // The velocity limit sets the bounds the joint-limit dampers then tighten (paper: qdd_d <=
+  // min(ë_p, ë_v) for an upper limit, >= max(...) for a lower one).
+  constraints_.push_back(std::move(velocity_limit));
+  constraints_.push_back(std::move(joint_limits));
+  auto torque = std::make_unique<TorqueLimitConstraint>(limits.torque);
+  torque_limit_ = torque.get();
+  constraints_.push_back(std::move(torque));
+  if (collision) {
+    auto pairs = std::make_unique<SelfCollisionConstraint>(model, *collision, settings.collision, settings.collision_braking);
+    self_collision_ = pairs.get();
+    constraints_.push_back(std::move(pairs));
+  }
+  resize_problem();
 }
 
-// Acceleration bounds from the velocity limits and the joint-limit dampers (paper: qdd_d <=
-// min(ë_p, ë_v) for an upper limit, >= max(...) for a lower one).
-void WholeBodyQp::joint_bounds(const Data& data, const Eigen::VectorXd& q, const Eigen::VectorXd& qd,
-                               const Eigen::VectorXd& tau_ext, bool with_return) {
-  hold_torque_ = data.nonlinear_effects - tau_ext;
-  inertia_diagonal_ = data.mass_matrix.diagonal();
-  velocity_limit_.bound(qd, hold_torque_, torque_limit(), inertia_diagonal_, problem_.lb, problem_.ub, with_return);
-  joint_limits_.tighten(q, qd, problem_.lb, problem_.ub);
+void WholeBodyQp::resize_problem() {
+  int rows = 0;
+  for (const auto& constraint : constraints_) rows += constraint->num_rows();
+  problem_.resize(nv_, 0, rows);
+  solver_.resize(nv_, 0, rows);
+  warm_ = false;
+}
+
+Task& WholeBodyQp::add_task(std::unique_ptr<Task> task) {
+  if (!task) throw ConfigError("WholeBodyQp", "tasks", "a null task");
+  if (find_task(task->name())) throw ConfigError("WholeBodyQp", "tasks", "two tasks named '" + task->name() + "'");
+  tasks_.push_back(std::move(task));
+  return *tasks_.back();
+}
+
+Constraint& WholeBodyQp::add_constraint(std::unique_ptr<Constraint> constraint) {
+  if (!constraint) throw ConfigError("WholeBodyQp", "constraints", "a null constraint");
+  constraints_.push_back(std::move(constraint));
+  resize_problem();
+  return *constraints_.back();
+}
+
+Task* WholeBodyQp::find_task(std::string_view name) {
+  for (const auto& task : tasks_) {
+    if (task->name() == name) return task.get();
+  }
+  return nullptr;
+}
+const Task* WholeBodyQp::find_task(std::string_view name) const { return const_cast<WholeBodyQp*>(this)->find_task(name); }
+
+// Objective: 1/2 qdd' H qdd + g' qdd, the sum of the tasks' weighted least squares (factor 2 dropped).
+void WholeBodyQp::assemble_objective() {
+  problem_.H.setZero();
+  problem_.g.setZero();
+  for (const auto& task : tasks_) task->add_objective(problem_.H, problem_.g);
+  problem_.H.diagonal().array() += settings_.regularization;
+}
+
+// Bounds from -inf/+inf tightened by each constraint in order, then each constraint's rows.
+void WholeBodyQp::fill_constraints(const ConstraintContext& context) {
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  problem_.lb.setConstant(-kInf);
+  problem_.ub.setConstant(kInf);
+  Eigen::Index row = 0;
+  for (const auto& constraint : constraints_) {
+    constraint->bound(context, problem_.lb, problem_.ub);
+    const int n = constraint->num_rows();
+    if (n == 0) continue;
+    constraint->fill_rows(context, problem_.A.middleRows(row, n), problem_.l.segment(row, n), problem_.u.segment(row, n));
+    row += n;
+  }
   for (int i = 0; i < nv_; ++i) {
     // Both limits bind (e.g. beyond one): split the difference.
     if (problem_.lb[i] > problem_.ub[i]) problem_.lb[i] = problem_.ub[i] = 0.5 * (problem_.lb[i] + problem_.ub[i]);
   }
 }
 
+bool WholeBodyQp::relax_a_constraint() {
+  for (const auto& constraint : constraints_) {
+    if (constraint->relax()) return true;
+  }
+  return false;
+}
+
 WholeBodyQpStatus WholeBodyQp::update(const Model& model, const Data& data, const Eigen::VectorXd& q,
-                                     const Eigen::VectorXd& qd, const Eigen::VectorXd& tau_ext, double dt) {
+                                     const Eigen::VectorXd& qd, const Eigen::VectorXd& tau_ext, double dt,
+                                     const Vector6d* ee_wrench_world) {
   if (!q.allFinite() || !qd.allFinite() || !tau_ext.allFinite() || !data.mass_matrix.allFinite()) {
     tau_desired_ = last_good_tau_;
     status_ = WholeBodyQpStatus::kInvalidInput;
@@ -116,42 +186,21 @@ WholeBodyQpStatus WholeBodyQp::update(const Model& model, const Data& data, cons
   soft_deadband(tau_ext, deadband_, qdd_external_);
   data.mass_matrix_llt.solveInPlace(qdd_external_);
 
-  end_effector_.update(model, data, qdd_external_, dt);
-  posture_.update(q, qd, qdd_external_, dt);
+  const TaskContext task_context{model, data, q, qd, tau_ext, qdd_external_, ee_wrench_world, dt};
+  for (const auto& task : tasks_) task->update(task_context);
+  assemble_objective();
 
-  // Objective: 1/2 qdd' H qdd + g' qdd from the weighted least squares (factor 2 dropped).
-  const double w_ee = end_effector_.weight();
-  const double w_0 = posture_.weight();
-  const Eigen::MatrixXd& jacobian = end_effector_.jacobian();
-  if (singular_weight_.update(jacobian)) {
-    // Near a singularity: w_ee || W^1/2 (J qdd - reference) ||^2 (singular_direction_weight.hpp).
-    weighted_jacobian_.noalias() = singular_weight_.weight() * jacobian;
-    problem_.H.noalias() = w_ee * jacobian.transpose() * weighted_jacobian_;
-    problem_.g.noalias() = -w_ee * weighted_jacobian_.transpose() * end_effector_.reference();
-  } else {
-    problem_.H.noalias() = w_ee * jacobian.transpose() * jacobian;
-    problem_.g.noalias() = -w_ee * jacobian.transpose() * end_effector_.reference();
-  }
-  problem_.H.diagonal().array() += w_0 + settings_.regularization;
-  problem_.g.noalias() -= w_0 * posture_.reference();
-
-  joint_bounds(data, q, qd, tau_ext);
-  torque_limit_.rows(data, tau_ext, problem_.A.topRows(nv_), problem_.l.head(nv_), problem_.u.head(nv_));
-  if (self_collision_) {
-    self_collision_->rows(model, data, problem_.A.middleRows(nv_, num_pairs_), problem_.l.segment(nv_, num_pairs_),
-                          problem_.u.segment(nv_, num_pairs_));
-  }
+  hold_torque_ = data.nonlinear_effects - tau_ext;
+  inertia_diagonal_ = data.mass_matrix.diagonal();
+  const ConstraintContext constraint_context{model, data, q, qd, tau_ext, hold_torque_, torque_limit(), inertia_diagonal_};
+  for (const auto& constraint : constraints_) constraint->begin_cycle();
+  fill_constraints(constraint_context);
 
   QpStatus qp = solver_.solve(problem_, {.warm_start = warm_, .reuse_hessian_factor = false});
-  if (qp == QpStatus::kInfeasible && velocity_limit_.returning()) {
-    // The return gain is a comfort beyond the paper's bound too (its reserve is M's diagonal's,
-    // the coupled joints may need more): the paper's bounds rather than the fallback.
-    joint_bounds(data, q, qd, tau_ext, false);
-    qp = solver_.solve(problem_, {.warm_start = false, .reuse_hessian_factor = false});
-  }
-  if (qp == QpStatus::kInfeasible && self_collision_ && self_collision_->braking_binds()) {
-    // The braking rows are a comfort ahead of the damper: without them rather than the fallback.
-    problem_.l.segment(nv_, num_pairs_) = self_collision_->damper_lower();
+  // A comfort beyond the paper's bounds (a faster return, a braking row) that makes the QP
+  // infeasible is dropped for this cycle: the paper's bounds rather than the fallback.
+  while (qp == QpStatus::kInfeasible && relax_a_constraint()) {
+    fill_constraints(constraint_context);
     qp = solver_.solve(problem_, {.warm_start = false, .reuse_hessian_factor = false});
   }
   if (qp == QpStatus::kOptimal && solver_.x().allFinite()) {

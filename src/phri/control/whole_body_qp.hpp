@@ -15,10 +15,14 @@
 // well, the arm accelerates at qdd_d: M qdd = tau_d + tau_ext - h. M and h here are link-side
 // (no rotor inertia); the low-level loop adds I_r qdd_d on the motor side.
 //
+// Tasks and constraints are objects in two lists (task.hpp, constraint.hpp), reserved at
+// start-up; H and g are assembled in one loop over the tasks, the bounds and rows in one loop over
+// the constraints. The paper's two tasks are always there: the main task (a pose task on the end
+// effector, role kMain) and the posture (role kNullSpace); more can be added (task_registry.hpp).
 // Constraints carry no gamma: they hold the *real* acceleration (push included) within bounds,
-// so a push toward a limit is negated. Each is its own object: JointLimitConstraint and
-// SelfCollisionConstraint (both the second-order velocity damper, velocity_damper.hpp),
-// VelocityLimitConstraint, TorqueLimitConstraint.
+// so a push toward a limit is negated. The built-in ones, in this order: VelocityLimitConstraint,
+// JointLimitConstraint (the second-order velocity damper, velocity_damper.hpp),
+// TorqueLimitConstraint, SelfCollisionConstraint (the same damper on capsule distances).
 #include <phri/control/end_effector_task.hpp>
 #include <phri/control/joint_limit_constraint.hpp>
 #include <phri/control/posture_task.hpp>
@@ -33,8 +37,9 @@
 #include <phri/qp/qp_problem.hpp>
 #include <phri/qp/qp_solver.hpp>
 
-#include <optional>
+#include <memory>
 #include <string_view>
+#include <vector>
 
 namespace phri {
 
@@ -96,15 +101,31 @@ public:
   /// collision may be null (no self-collision constraint). Throws ConfigError on bad settings.
   WholeBodyQp(const Model& model, const CollisionModel* collision, const WholeBodyQpSettings& settings);
 
-  EndEffectorTask& end_effector() { return end_effector_; }
-  PostureTask& posture() { return posture_; }
-  const EndEffectorTask& end_effector() const { return end_effector_; }
-  const PostureTask& posture() const { return posture_; }
+  /// The paper's main task (the end effector's pose) and its posture task.
+  EndEffectorTask& end_effector() { return *end_effector_; }
+  PostureTask& posture() { return *posture_; }
+  const EndEffectorTask& end_effector() const { return *end_effector_; }
+  const PostureTask& posture() const { return *posture_; }
+
+  /// Adds a task (at start-up, before the first update); its name must be new (ConfigError).
+  Task& add_task(std::unique_ptr<Task> task);
+  /// Adds a constraint after the built-in ones (at start-up); its rows are appended.
+  Constraint& add_constraint(std::unique_ptr<Constraint> constraint);
+  const std::vector<std::unique_ptr<Task>>& tasks() const { return tasks_; }
+  const std::vector<std::unique_ptr<Constraint>>& constraints() const { return constraints_; }
+  /// Every task holds where the arm is (Task::start), at the controller's start.
+  void start_tasks(const Model& model, const Data& data) {
+    for (const auto& task : tasks_) task->start(model, data);
+  }
+  /// The task of that name, or null.
+  Task* find_task(std::string_view name);
+  const Task* find_task(std::string_view name) const;
 
   /// One control cycle. `data`: after compute_all_terms(q, qd) on the controller's (link-side)
-  /// model; tau_ext: estimated external torque. Returns the status; results below.
+  /// model; tau_ext: estimated external torque; ee_wrench_world: the F/T wrench at the end effector
+  /// (TaskContext), or null. Returns the status; results below.
   WholeBodyQpStatus update(const Model& model, const Data& data, const Eigen::VectorXd& q, const Eigen::VectorXd& qd,
-                          const Eigen::VectorXd& tau_ext, double dt);
+                          const Eigen::VectorXd& tau_ext, double dt, const Vector6d* ee_wrench_world = nullptr);
 
   const Eigen::VectorXd& desired_acceleration() const { return qdd_desired_; }
   /// The soft dead band of tau_ext in the compliant terms, per joint [N.m].
@@ -115,12 +136,12 @@ public:
   QpStatus qp_status() const { return solver_.status(); }
   int qp_iterations() const { return solver_.iterations(); }
   const CollisionData* collision_data() const { return self_collision_ ? &self_collision_->data() : nullptr; }
-  const Eigen::VectorXd& torque_limit() const { return torque_limit_.torque_limit(); }
+  const Eigen::VectorXd& torque_limit() const { return torque_limit_->torque_limit(); }
   /// Per joint, after velocity_limit_fraction.
-  const Eigen::VectorXd& velocity_limit() const { return velocity_limit_.velocity_limit(); }
+  const Eigen::VectorXd& velocity_limit() const { return velocity_limit_->velocity_limit(); }
   /// Joint position bounds the dampers keep: limit -+ d_s (infinite for continuous joints).
-  const Eigen::VectorXd& safe_lower() const { return joint_limits_.safe_lower(); }
-  const Eigen::VectorXd& safe_upper() const { return joint_limits_.safe_upper(); }
+  const Eigen::VectorXd& safe_lower() const { return joint_limits_->safe_lower(); }
+  const Eigen::VectorXd& safe_upper() const { return joint_limits_->safe_upper(); }
   const WholeBodyQpSettings& settings() const { return settings_; }
 
 private:
@@ -130,26 +151,27 @@ private:
   static Limits checked_limits(const Model& model, const WholeBodyQpSettings& settings);
   WholeBodyQp(const Model& model, const CollisionModel* collision, const WholeBodyQpSettings& settings,
               const Limits& limits);
-  void joint_bounds(const Data& data, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, const Eigen::VectorXd& tau_ext,
-                    bool with_return = true);
+  void assemble_objective();
+  void fill_constraints(const ConstraintContext& context);
+  bool relax_a_constraint();
+  void resize_problem();
   void fallback_brake(const Data& data, const Eigen::VectorXd& qd, const Eigen::VectorXd& tau_ext);
 
   WholeBodyQpSettings settings_;
-  EndEffectorTask end_effector_;
-  PostureTask posture_;
   int nv_;
-  int num_pairs_;
-  JointLimitConstraint joint_limits_;
-  VelocityLimitConstraint velocity_limit_;
-  TorqueLimitConstraint torque_limit_;
-  std::optional<SelfCollisionConstraint> self_collision_;
+  std::vector<std::unique_ptr<Task>> tasks_;
+  std::vector<std::unique_ptr<Constraint>> constraints_;
+  EndEffectorTask* end_effector_ = nullptr;
+  PostureTask* posture_ = nullptr;
+  VelocityLimitConstraint* velocity_limit_ = nullptr;
+  JointLimitConstraint* joint_limits_ = nullptr;
+  TorqueLimitConstraint* torque_limit_ = nullptr;
+  SelfCollisionConstraint* self_collision_ = nullptr;
   QpProblem problem_;
   QpSolver solver_;
   Eigen::VectorXd deadband_;
   Eigen::VectorXd qdd_external_, qdd_desired_, tau_desired_, last_good_tau_;
-  Eigen::VectorXd hold_torque_, inertia_diagonal_;  // the braking reserve's scratch
-  SingularDirectionWeight singular_weight_;
-  Eigen::MatrixXd weighted_jacobian_;  // W J, 6 x nv scratch
+  Eigen::VectorXd hold_torque_, inertia_diagonal_;  // the constraints' context
   WholeBodyQpStatus status_ = WholeBodyQpStatus::kOk;
   bool warm_ = false;
 };

@@ -796,7 +796,7 @@ void motion_run(const Shared& s, const std::string& id, MotionScenario& sc, cons
 
 // ---- the task list: one task per run, each a deterministic function of the options
 
-struct Task {
+struct FuzzTask {
   std::string id;
   double cost = 1.0;  // simulated seconds, roughly: the longest go first
   std::function<void(TaskOutput&)> run;
@@ -811,7 +811,7 @@ std::uint64_t pair_key(ComplianceMode mode, LowLevelMode loop) {
 }
 
 // The random pushes of every pair, pushes_per_run per run.
-void add_push_tasks(const Shared& s, std::vector<Task>& tasks) {
+void add_push_tasks(const Shared& s, std::vector<FuzzTask>& tasks) {
   const SafetyFuzzOptions& o = s.o;
   const int pairs = static_cast<int>(o.modes.size() * o.loops.size());
   int pair = 0;
@@ -838,7 +838,7 @@ void add_push_tasks(const Shared& s, std::vector<Task>& tasks) {
   }
 }
 
-void add_targeted_tasks(const Shared& s, std::vector<Task>& tasks) {
+void add_targeted_tasks(const Shared& s, std::vector<FuzzTask>& tasks) {
   if (!s.o.targeted_pushes || s.targeted.empty()) return;
   for (ComplianceMode mode : s.o.modes) {
     for (LowLevelMode loop : s.o.loops) {
@@ -854,7 +854,7 @@ void add_targeted_tasks(const Shared& s, std::vector<Task>& tasks) {
 }
 
 // References first (their own phase), then one task per fault case and duration.
-void add_fault_tasks(const Shared& s, std::vector<Task>& references, std::vector<Task>& tasks,
+void add_fault_tasks(const Shared& s, std::vector<FuzzTask>& references, std::vector<FuzzTask>& tasks,
                      std::vector<std::unique_ptr<ReferencePath>>& paths) {
   if (s.faults.empty()) return;
   for (ComplianceMode mode : s.o.fault_modes) {
@@ -882,7 +882,7 @@ void add_fault_tasks(const Shared& s, std::vector<Task>& references, std::vector
 // The fault-in-motion and loop-switch windows: per context and pair a reference (its own phase)
 // and one task per fault. kAll: every fault on every modes x loops pair; kSubset: a few faults on
 // the fault_modes.
-void add_motion_tasks(const Shared& s, std::vector<Task>& references, std::vector<Task>& tasks,
+void add_motion_tasks(const Shared& s, std::vector<FuzzTask>& references, std::vector<FuzzTask>& tasks,
                       std::vector<std::unique_ptr<MotionScenario>>& scenarios) {
   if (s.faults.empty() || !s.o.motion_faults) return;
   static const char* const kSubsetMotionFaults[] = {"nan_q", "stall_50", "wrench_stuck"};
@@ -928,7 +928,7 @@ void add_motion_tasks(const Shared& s, std::vector<Task>& references, std::vecto
 // the result does not depend on the scheduling. The first error (a ConfigError, say) is rethrown.
 class TaskPool {
 public:
-  TaskPool(std::vector<Task>& tasks, std::vector<TaskOutput>& outputs, std::ostream* progress, const char* phase)
+  TaskPool(std::vector<FuzzTask>& tasks, std::vector<TaskOutput>& outputs, std::ostream* progress, const char* phase)
       : tasks_(tasks), outputs_(outputs), progress_(progress), phase_(phase) {}
 
   void run(int jobs) {
@@ -979,7 +979,7 @@ private:
                << std::endl;
   }
 
-  std::vector<Task>& tasks_;
+  std::vector<FuzzTask>& tasks_;
   std::vector<TaskOutput>& outputs_;
   std::ostream* progress_;
   const char* phase_;
@@ -995,14 +995,14 @@ private:
 };
 
 // Keeps the task `id` only (and the reference a fault run needs); ConfigError when none matches.
-void keep_replay(const std::string& id, std::vector<Task>& references, std::vector<Task>& tasks) {
-  auto named = [&](const Task& t) { return t.id == id; };
+void keep_replay(const std::string& id, std::vector<FuzzTask>& references, std::vector<FuzzTask>& tasks) {
+  auto named = [&](const FuzzTask& t) { return t.id == id; };
   const bool in_tasks = std::any_of(tasks.begin(), tasks.end(), named);
   const bool in_references = std::any_of(references.begin(), references.end(), named);
   if (!in_tasks && !in_references) {
     throw ConfigError("<safety fuzz options>", "replay", "no run '" + id + "' with these options (see report.md for the ids)");
   }
-  std::erase_if(tasks, [&](const Task& t) { return !named(t); });
+  std::erase_if(tasks, [&](const FuzzTask& t) { return !named(t); });
   // A fault run needs the reference of its (mode, loop): "fault/<mode>/<loop>/..." -> "reference/<mode>/<loop>",
   // "motion/..." -> "motion-reference/...", "switch/..." -> "switch-reference/...".
   std::string reference = id;
@@ -1012,7 +1012,7 @@ void keep_replay(const std::string& id, std::vector<Task>& references, std::vect
     const std::size_t p = prefix.size(), mode_end = id.find('/', p), loop_end = id.find('/', mode_end + 1);
     reference = reference_prefix + id.substr(p, loop_end - p);
   }
-  std::erase_if(references, [&](const Task& t) { return t.id != reference; });
+  std::erase_if(references, [&](const FuzzTask& t) { return t.id != reference; });
 }
 
 void collect(std::vector<TaskOutput>& outputs, SafetyFuzzResult& result) {
@@ -1048,7 +1048,7 @@ SafetyFuzzResult run_safety_fuzz(const SafetyFuzzOptions& o, std::ostream* progr
   const auto wall_start = std::chrono::steady_clock::now();
   const std::unique_ptr<Shared> shared = load_shared(o);
   if (!o.output_dir.empty()) ensure_output_directory(o.output_dir);
-  std::vector<Task> references, tasks;
+  std::vector<FuzzTask> references, tasks;
   std::vector<std::unique_ptr<ReferencePath>> paths;
   add_push_tasks(*shared, tasks);
   add_targeted_tasks(*shared, tasks);

@@ -1,0 +1,241 @@
+// ctest-labels: unit
+// Tasks as objects (control/task.hpp, task_registry.hpp): each type's rows against finite
+// differences of the model's forward kinematics, its reference against closed forms, the
+// registry's errors, per-axis gamma in the tool's axes, and the QP assembled from a list.
+#include <phri/control/task_registry.hpp>
+#include <phri/control/whole_body_qp.hpp>
+#include <phri/model/algorithms.hpp>
+
+#include "allocation_counter.hpp"
+
+#include <gtest/gtest.h>
+
+namespace {
+
+const std::string kGen3 = std::string(PHRI_SOURCE_DIR) + "/robots/kinova_gen3/";
+
+struct Arm {
+  phri::Model model = phri::Model::from_urdf_file(kGen3 + "gen3.urdf");
+  phri::Data data{model};
+  Eigen::VectorXd q = Eigen::VectorXd(7), qd = Eigen::VectorXd::Zero(7), tau_ext = Eigen::VectorXd::Zero(7),
+                  qdd_ext = Eigen::VectorXd::Zero(7);
+  int ee = model.frame_id("end_effector_link");
+  Arm() {
+    q << 0.1, 0.58, 3.0, -1.84, 0.2, 0.85, 1.57;
+    phri::compute_all_terms(model, data, q, qd);
+  }
+  phri::TaskBuildContext build() const { return {model, ee, 0.1}; }
+  phri::TaskContext context(const phri::Vector6d* wrench = nullptr) const {
+    return {model, data, q, qd, tau_ext, qdd_ext, wrench, 0.001};
+  }
+  // The position of a frame at q + h e_i (central differences give its Jacobian column).
+  Eigen::Vector3d position(int frame, const Eigen::VectorXd& at) const {
+    phri::Data d(model);
+    phri::forward_kinematics(model, d, at);
+    phri::update_frame_placements(model, d);
+    return d.frame_placements[static_cast<std::size_t>(frame)].translation();
+  }
+  Eigen::MatrixXd linear_jacobian_fd(int frame) const {
+    Eigen::MatrixXd j(3, 7);
+    for (int i = 0; i < 7; ++i) {
+      Eigen::VectorXd up = q, down = q;
+      up[i] += 1e-6;
+      down[i] -= 1e-6;
+      j.col(i) = (position(frame, up) - position(frame, down)) / 2e-6;
+    }
+    return j;
+  }
+};
+
+phri::TaskSpec spec(const std::string& type, const std::string& name) {
+  phri::TaskSpec s;
+  s.type = type;
+  s.name = name;
+  s.source = "test.yaml: controller.tasks[0]";
+  return s;
+}
+
+// H and g of one task alone.
+std::pair<Eigen::MatrixXd, Eigen::VectorXd> objective(const phri::Task& task) {
+  Eigen::MatrixXd h = Eigen::MatrixXd::Zero(7, 7);
+  Eigen::VectorXd g = Eigen::VectorXd::Zero(7);
+  task.add_objective(h, g);
+  return {h, g};
+}
+
+TEST(ForceTask, RowIsTheAxisAlongTheFiniteDifferenceJacobianAndReferenceTheAdmittance) {
+  Arm arm;
+  phri::TaskSpec s = spec("force", "press");
+  s.numbers["force_N"] = {10.0};
+  s.numbers["axis"] = {0.0, 0.0, -1.0};
+  s.numbers["weight"] = {2.0};
+  auto task = phri::make_task(s, arm.build());
+  // The environment pushes the robot up with 4 N: the robot applies 4 N down, 6 N short of 10.
+  phri::Vector6d wrench = phri::Vector6d::Zero();
+  wrench[2] = 4.0;
+  task->update(arm.context(&wrench));
+  const auto [h, g] = objective(*task);
+  const Eigen::RowVectorXd row = Eigen::Vector3d(0, 0, -1).transpose() * arm.linear_jacobian_fd(arm.ee);
+  EXPECT_LT((h - 2.0 * row.transpose() * row).norm(), 1e-6);
+  // At rest: b = D k_a (f* - f) = 50 * 1e-3 * 6 (defaults), g = -w b a.
+  EXPECT_LT((g + 2.0 * (50.0 * 1e-3 * 6.0) * row.transpose()).norm(), 1e-6);
+}
+
+TEST(ForceTask, WithoutAnFtSensorTheWrenchIsTheLeastSquaresOneThatExplainsTauExt) {
+  Arm arm;
+  phri::TaskSpec s = spec("force", "press");
+  s.numbers["force_N"] = {0.0};
+  s.numbers["admittance_m_per_s_N"] = {1.0 / 50.0};  // b = f* - f directly (D k_a = 1)
+  s.numbers["max_speed_m_s"] = {0.5};
+  auto task = phri::make_task(s, arm.build());
+  // A 7 N push down on the end effector: tau_ext = J^T F; along n = -z the robot applies
+  // f = -n.F = -7 N, so b = f* - f = 7.
+  Eigen::MatrixXd j(6, 7);
+  phri::frame_jacobian(arm.model, arm.data, arm.ee, phri::ReferenceFrame::kLocalWorldAligned, j);
+  phri::Vector6d push = phri::Vector6d::Zero();
+  push[2] = -7.0;
+  arm.tau_ext = j.transpose() * push;
+  task->update(arm.context());
+  const auto [h, g] = objective(*task);
+  const Eigen::RowVectorXd row = -j.row(2);
+  EXPECT_LT((h - 1e4 * row.transpose() * row).norm(), 1e-6);
+  EXPECT_LT((g + 1e4 * 7.0 * row.transpose()).norm() / 1e4, 1e-6);
+}
+
+TEST(FrameTask, RowsAreTheLinkPositionJacobianSelectedAndTheReferenceASpringToTheTarget) {
+  Arm arm;
+  const int elbow = arm.model.frame_id("forearm_link");
+  phri::TaskSpec s = spec("frame", "elbow_height");
+  s.words["frame"] = "forearm_link";
+  s.numbers["selection"] = {0.0, 0.0, 1.0};
+  s.numbers["stiffness"] = {40.0};
+  s.numbers["damping"] = {0.0};
+  s.numbers["weight"] = {3.0};
+  const Eigen::Vector3d p = arm.data.frame_placements[static_cast<std::size_t>(elbow)].translation();
+  s.numbers["target_m"] = {p.x(), p.y(), p.z() + 0.05};
+  auto task = phri::make_task(s, arm.build());
+  task->start(arm.model, arm.data);  // a given target is kept
+  task->update(arm.context());
+  const auto [h, g] = objective(*task);
+  const Eigen::RowVectorXd row = arm.linear_jacobian_fd(elbow).row(2);
+  EXPECT_LT((h - 3.0 * row.transpose() * row).norm(), 1e-6);
+  EXPECT_LT((g + 3.0 * (40.0 * 0.05) * row.transpose()).norm(), 1e-6);  // at rest: no drift
+}
+
+TEST(PoseTask, FrameAxesWithIsotropicGainsGiveTheWorldAxesObjective) {
+  // ||R^T r||^2 = ||r||^2: with the same gain on every axis the tool's axes change nothing.
+  Arm arm;
+  arm.qd << 0.2, -0.1, 0.3, 0.1, -0.2, 0.4, 0.1;
+  phri::compute_all_terms(arm.model, arm.data, arm.q, arm.qd);
+  arm.qdd_ext << 0.5, -1.0, 0.2, 0.3, 0.0, -0.4, 1.0;
+  std::pair<Eigen::MatrixXd, Eigen::VectorXd> results[2];
+  for (int frame_axes = 0; frame_axes < 2; ++frame_axes) {
+    phri::EndEffectorTask task(arm.model, arm.ee);
+    task.set_axes(frame_axes ? phri::TaskAxes::kFrame : phri::TaskAxes::kWorld);
+    task.reset_gains(phri::Vector6d::Constant(80.0), phri::Vector6d::Constant(9.0), 10.0, phri::Vector6d::Constant(0.5));
+    Eigen::Isometry3d target = arm.data.frame_placements[static_cast<std::size_t>(arm.ee)];
+    target.translation() += Eigen::Vector3d(0.02, -0.01, 0.03);
+    task.set_target(target);
+    task.update(arm.context());
+    results[frame_axes] = objective(task);
+  }
+  EXPECT_LT((results[0].first - results[1].first).norm(), 1e-9 * results[0].first.norm());
+  EXPECT_LT((results[0].second - results[1].second).norm(), 1e-9 * results[0].second.norm());
+}
+
+TEST(PoseTask, PerAxisGammaInTheToolAxesLetsThroughOnlyThePushAlongTheToolZ) {
+  Arm arm;
+  arm.qdd_ext << 0.5, -1.0, 0.2, 0.3, 0.0, -0.4, 1.0;
+  phri::EndEffectorTask task(arm.model, arm.ee);
+  task.set_axes(phri::TaskAxes::kFrame);
+  phri::Vector6d gamma = phri::Vector6d::Zero();
+  gamma[2] = 1.0;
+  task.reset_gains(phri::Vector6d::Zero(), phri::Vector6d::Zero(), 1.0, phri::Vector6d::Zero());
+  task.set_fixed_gamma(gamma);
+  task.set_role_gamma(0.0);  // a mode's gamma does not touch a declared one
+  task.hold_current_pose(arm.data);
+  task.update(arm.context());
+  // Rows R^T J; reference: the drift in tool axes plus gamma R^T J qdd_ext, only on the tool's z.
+  const Eigen::Matrix3d r = arm.data.frame_placements[static_cast<std::size_t>(arm.ee)].linear();
+  Eigen::MatrixXd j(6, 7);
+  phri::frame_jacobian(arm.model, arm.data, arm.ee, phri::ReferenceFrame::kLocalWorldAligned, j);
+  EXPECT_LT((task.rows().topRows<3>() - r.transpose() * j.topRows<3>()).norm(), 1e-12);
+  const Eigen::Vector3d push_tool = r.transpose() * (j.topRows<3>() * arm.qdd_ext);
+  phri::Vector6d drift = phri::frame_jdot_qdot(arm.model, arm.data, arm.ee, phri::ReferenceFrame::kLocalWorldAligned);
+  EXPECT_NEAR(task.reference()[2], push_tool.z() - (r.transpose() * drift.head<3>()).z(), 1e-12);
+  EXPECT_NEAR(task.reference()[0], -(r.transpose() * drift.head<3>()).x(), 1e-12);
+}
+
+TEST(PoseTask, ASelectionOfZeroLeavesTheAxisOutOfTheObjective) {
+  Arm arm;
+  phri::EndEffectorTask task(arm.model, arm.ee);
+  phri::Vector6d selection = phri::Vector6d::Ones();
+  selection[2] = 0.0;
+  task.set_selection(selection);
+  task.reset_gains(phri::Vector6d::Constant(50.0), phri::Vector6d::Constant(5.0), 2.0, phri::Vector6d::Zero());
+  task.hold_current_pose(arm.data);
+  task.update(arm.context());
+  Eigen::MatrixXd j(6, 7);
+  phri::frame_jacobian(arm.model, arm.data, arm.ee, phri::ReferenceFrame::kLocalWorldAligned, j);
+  const auto [h, g] = objective(task);
+  const Eigen::MatrixXd expected = 2.0 * j.transpose() * selection.asDiagonal() * j;
+  EXPECT_LT((h - expected).norm(), 1e-9 * expected.norm());
+}
+
+TEST(TaskRegistry, ErrorsNameTheKeyAndListWhatIsKnown) {
+  Arm arm;
+  auto message = [&](const phri::TaskSpec& s) {
+    try {
+      phri::make_task(s, arm.build());
+    } catch (const phri::ConfigError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(message(spec("polish", "p")).find("unknown task type 'polish' (known: pose, posture, force, frame)"),
+            std::string::npos);
+  phri::TaskSpec s = spec("force", "press");
+  s.numbers["forse_N"] = {10.0};
+  EXPECT_NE(message(s).find("controller.tasks[0]: forse_N: unknown key for a force task"), std::string::npos);
+  s = spec("force", "press");
+  s.numbers["force_N"] = {1e6};
+  EXPECT_NE(message(s).find("force_N: 1e+06 is outside [-200, 200]"), std::string::npos);
+  s = spec("force", "press");
+  s.numbers["axis"] = {0.0, 0.0, 0.0};
+  EXPECT_NE(message(s).find("axis: must not be zero"), std::string::npos);
+  s = spec("frame", "elbow");
+  EXPECT_NE(message(s).find("frame: name the frame"), std::string::npos);
+  s.words["frame"] = "no_such_link";
+  EXPECT_NE(message(s).find("no frame 'no_such_link'"), std::string::npos);
+  s = spec("pose", "tool");
+  s.words["frame"] = "end_effector";
+  s.words["axes"] = "tool";
+  EXPECT_NE(message(s).find("axes: 'tool' is not one of: world, frame"), std::string::npos);
+}
+
+TEST(WholeBodyQp, TasksAreAListNamesUniqueAndTheCycleAllocatesNothingWithTheNewTypes) {
+  Arm arm;
+  phri::WholeBodyQpSettings settings;
+  settings.end_effector_frame = "end_effector_link";
+  phri::WholeBodyQp qp(arm.model, nullptr, settings);
+  ASSERT_EQ(qp.tasks().size(), 2u);
+  EXPECT_EQ(qp.tasks()[0]->name(), "end_effector");
+  EXPECT_EQ(qp.tasks()[1]->type(), "posture");
+  phri::TaskSpec force = spec("force", "press");
+  phri::TaskSpec elbow = spec("frame", "elbow");
+  elbow.words["frame"] = "forearm_link";
+  qp.add_task(phri::make_task(force, arm.build()));
+  qp.add_task(phri::make_task(elbow, arm.build()));
+  EXPECT_THROW(qp.add_task(phri::make_task(force, arm.build())), phri::ConfigError);
+  EXPECT_EQ(qp.find_task("press")->type(), "force");
+  qp.start_tasks(arm.model, arm.data);
+  qp.posture().set_target(arm.q);
+  qp.update(arm.model, arm.data, arm.q, arm.qd, arm.tau_ext, 0.001);  // warm-up
+  phri::Vector6d wrench = phri::Vector6d::Zero();
+  phri::test::AllocationCounter counter;
+  for (int i = 0; i < 10; ++i) qp.update(arm.model, arm.data, arm.q, arm.qd, arm.tau_ext, 0.001, i % 2 ? &wrench : nullptr);
+  EXPECT_EQ(counter.allocations(), 0u);
+  EXPECT_EQ(qp.status(), phri::WholeBodyQpStatus::kOk);
+}
+
+}  // namespace
