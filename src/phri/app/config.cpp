@@ -1,6 +1,7 @@
 #include <phri/app/config.hpp>
 
 #include <phri/app/config_checks.hpp>
+#include <phri/app/task_config.hpp>
 #include <phri/app/robot_bundle.hpp>
 
 #include <phri/core/format.hpp>
@@ -301,7 +302,7 @@ void parse_wrench(const YamlReader& w, WrenchEstimatorSettings& s) {
 
 void parse_controller(const YamlReader& r, const ActuatorTable& drives, ControllerSettings& c) {
   r.allow_keys({"period_s", "observer_gain", "external_torque_source", "position_mode_open_loop", "compliance_deadband",
-                "compliance", "qp", "wrench"});
+                "compliance", "qp", "wrench", "tasks"});
   c.position_mode_open_loop = r.boolean_or("position_mode_open_loop", c.position_mode_open_loop);
   c.period_s = positive_or(r, "period_s", c.period_s, 0.1);
   if (r.has("external_torque_source")) {
@@ -320,6 +321,7 @@ void parse_controller(const YamlReader& r, const ActuatorTable& drives, Controll
   if (r.has("compliance")) parse_compliance(r.at("compliance"), c);
   if (r.has("qp")) parse_qp(r.at("qp"), drives, c.qp);
   if (r.has("wrench")) parse_wrench(r.at("wrench"), c.wrench);
+  if (r.has("tasks")) c.tasks = parse_task_specs(r.at("tasks"));
 }
 
 // ------------------------------------------------------------------------------------ low level

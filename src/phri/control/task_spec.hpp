@@ -16,13 +16,14 @@ namespace phri {
 struct TaskSpec {
   std::string type;    ///< a registered type: pose, posture, force, frame
   std::string name;    ///< unique in the run; "end_effector" and "posture" configure the paper's two
-  std::string source;  ///< where it was declared, for errors
+  std::string source;  ///< the file it was declared in, for errors
+  std::string path;    ///< its key path there, e.g. "controller.tasks[2]"
   std::map<std::string, std::vector<double>, std::less<>> numbers;
   std::map<std::string, std::string, std::less<>> words;
 
   bool has(std::string_view key) const { return numbers.count(key) || words.count(key); }
   [[noreturn]] void fail(const std::string& key, const std::string& reason) const {
-    throw ConfigError(source, key, reason);
+    throw ConfigError(source, path.empty() ? key : path + "." + key, reason);
   }
   /// A number in [low, high]; `fallback` when absent.
   double number(std::string_view key, double fallback, double low, double high) const;

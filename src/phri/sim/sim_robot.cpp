@@ -295,6 +295,7 @@ void SimRobot::find_ft_sensor() {
 void SimRobot::find_drop_test() {
   anchor_site_ = mj_name2id(m_.get(), mjOBJ_SITE, SimScene::kAnchorSite);
   drop_body_ = mj_name2id(m_.get(), mjOBJ_BODY, SimScene::kDropBody);
+  floor_geom_ = mj_name2id(m_.get(), mjOBJ_GEOM, SimScene::kFloorGeom);
   const int free = m_->body_jntadr[drop_body_];
   drop_qadr_ = m_->jnt_qposadr[free];
   drop_dadr_ = m_->jnt_dofadr[free];
@@ -864,6 +865,22 @@ void SimRobot::sample_state() {
     truth_.drop_mass_velocity_m_s = Eigen::Vector3d(d_->qvel[drop_dadr_], d_->qvel[drop_dadr_ + 1], d_->qvel[drop_dadr_ + 2]);
   }
   truth_.last_push = pushes_.latest();
+  truth_.floor_normal_force_N = floor_geom_ >= 0 ? floor_normal_force() : 0.0;
+}
+
+// The normal force of every contact between the floor and a geom of the arm or its tool.
+double SimRobot::floor_normal_force() const {
+  double total = 0.0;
+  for (int i = 0; i < d_->ncon; ++i) {
+    const mjContact& c = d_->contact[i];
+    if (c.geom1 != floor_geom_ && c.geom2 != floor_geom_) continue;
+    const int other = c.geom1 == floor_geom_ ? c.geom2 : c.geom1;
+    if (drop_body_ >= 0 && m_->geom_bodyid[other] == drop_body_) continue;
+    mjtNum force[6];
+    mj_contactForce(m_.get(), d_.get(), i, force);
+    total += force[0];
+  }
+  return total;
 }
 
 }  // namespace phri

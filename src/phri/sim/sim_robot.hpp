@@ -79,6 +79,8 @@ public:
     Eigen::Vector3d drop_mass_velocity_m_s = Eigen::Vector3d::Zero();
     double cable_length_m = 0.0;  ///< anchor to mass centre
     double cable_force_N = 0.0;   ///< cable tension (0 while slack)
+    // floor (a table when the tool touches it)
+    double floor_normal_force_N = 0.0;  ///< the floor's normal force on the robot's geoms, summed
     // random pushes
     RandomPushGenerator::Push last_push;  ///< latest push drawn (index 0: none yet)
   };
@@ -214,6 +216,8 @@ private:
   int force_adr_ = -1, torque_adr_ = -1;
   int anchor_site_ = -1;
   int drop_body_ = -1, drop_qadr_ = -1, drop_dadr_ = -1;
+  int floor_geom_ = -1;
+  double floor_normal_force() const;
   double latch_damping_ = 0.0;
   Eigen::Vector3d release_offset_ = Eigen::Vector3d::Zero();  // world axes, drawn at reset()
   Eigen::Vector3d hand_point_ = Eigen::Vector3d::Zero();      // held_by_hand: where the hand holds it

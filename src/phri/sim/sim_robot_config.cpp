@@ -235,9 +235,10 @@ void parse_drop_test(const YamlReader& d, SimRobotConfig::DropTest& s) {
 }
 
 void parse_floor(const YamlReader& f, SimRobotConfig::Floor& s) {
-  f.allow_keys({"enabled", "height_m"});
+  f.allow_keys({"enabled", "height_m", "tool_contact"});
   s.enabled = f.boolean_or("enabled", false);
   s.height_m = f.number_or("height_m", 0.0, -2.0, 2.0);  // within the arm's reach of its base
+  s.tool_contact = f.boolean_or("tool_contact", false);
 }
 
 // One entry of `disturbances:`.

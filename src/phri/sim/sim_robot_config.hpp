@@ -240,6 +240,8 @@ struct SimRobotConfig {
   struct Floor {
     bool enabled = false;
     double height_m = 0.0;
+    /// The tool touches it (a table to press on); otherwise only the drop mass does.
+    bool tool_contact = false;
   } floor;
 
   std::vector<ExternalForce> disturbances;  ///< scripted timeline

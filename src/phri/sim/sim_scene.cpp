@@ -88,6 +88,7 @@ void remove_keyframes(std::string& xml, const std::string& file) {
 
 // The tool alone on the flange (no F/T sensor): its origin is the flange site's frame.
 std::string bare_tool_mjcf(const SimRobotConfig& config, const FlangeMount& mount) {
+  const std::string tool_contact = config.floor.enabled && config.floor.tool_contact ? "1" : "0";
   const mjtNum* sp = mount.pos;
   const mjtNum* sq = mount.quat;
   const auto& tool = config.tool;
@@ -98,7 +99,8 @@ std::string bare_tool_mjcf(const SimRobotConfig& config, const FlangeMount& moun
   chain += "  <inertial pos=\"" + vec(tool.com_m) + "\" mass=\"" + num(tool.mass_kg) + "\" diaginertia=\"" +
            vec(tool.inertia_kgm2) + "\"/>\n";
   chain += "  <geom name=\"tool_geom\" type=\"box\" size=\"0.03 0.05 0.03\" pos=\"" + vec(tool.com_m) +
-           "\" contype=\"0\" conaffinity=\"0\" group=\"1\" rgba=\"0.2 0.2 0.8 0.6\"/>\n";
+           "\" contype=\"" + tool_contact + "\" conaffinity=\"" + tool_contact +
+           "\" group=\"1\" rgba=\"0.2 0.2 0.8 0.6\"/>\n";
   if (config.drop_test.enabled) {
     chain += "  <site name=\"" + std::string(SimScene::kAnchorSite) + "\" pos=\"" + vec(config.drop_test.anchor_m) +
              "\" size=\"0.005\"/>\n";
@@ -116,6 +118,7 @@ std::string mount_quat(const Eigen::Isometry3d& mount) {
 
 // The F/T adapter and the tool below it, as a body tree for the flange body.
 std::string tool_chain_mjcf(const SimRobotConfig& config, const FlangeMount& mount) {
+  const std::string tool_contact = config.floor.enabled && config.floor.tool_contact ? "1" : "0";
   const mjtNum* sp = mount.pos;
   const mjtNum* sq = mount.quat;
   const auto& ft = config.ft_sensor;
@@ -135,7 +138,8 @@ std::string tool_chain_mjcf(const SimRobotConfig& config, const FlangeMount& mou
   chain += "    <inertial pos=\"" + vec(tool.com_m) + "\" mass=\"" + num(tool.mass_kg) + "\" diaginertia=\"" +
            vec(tool.inertia_kgm2) + "\"/>\n";
   chain += "    <geom name=\"tool_geom\" type=\"box\" size=\"0.03 0.05 0.03\" pos=\"" + vec(tool.com_m) +
-           "\" contype=\"0\" conaffinity=\"0\" group=\"1\" rgba=\"0.2 0.2 0.8 0.6\"/>\n";
+           "\" contype=\"" + tool_contact + "\" conaffinity=\"" + tool_contact +
+           "\" group=\"1\" rgba=\"0.2 0.2 0.8 0.6\"/>\n";
   chain += "    <site name=\"" + std::string(SimScene::kSensorSite) + "\" size=\"0.01\"/>\n";
   if (config.drop_test.enabled) {
     chain += "    <site name=\"" + std::string(SimScene::kAnchorSite) + "\" pos=\"" + vec(config.drop_test.anchor_m) +
