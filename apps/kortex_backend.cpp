@@ -1,6 +1,7 @@
 #include "kortex_backend.hpp"
 
 #include <phri/app/loop_clock.hpp>
+#include <phri/app/plant_check.hpp>
 #include <phri/core/error.hpp>
 #include <phri/hardware/bota_sens_one.hpp>
 #include <phri/hardware/kortex_emulator.hpp>
@@ -20,18 +21,15 @@ namespace {
 
 volatile std::sig_atomic_t g_interrupted = 0;
 
+// The description's settings (actuators, home posture) with the controller's joint limits.
 phri::KortexRobotSettings robot_settings(const phri::Config& config, const phri::Model& model, bool dry_run) {
-  phri::KortexRobotSettings s;
-  s.dof = model.nq();
-  s.period_s = config.controller.period_s;
+  const phri::RobotDescription& description = config.plant;  // the robot's description (+ the plant's settings)
+  if (description.actuators.size() != model.nq()) {
+    throw phri::ConfigError(config.source, "robot.actuators", "one actuator per joint for the Kortex backend");
+  }
+  phri::KortexRobotSettings s = phri::kortex_robot_settings(description, config.controller.period_s);
   s.position_lower_rad = model.lower_limits();
   s.position_upper_rad = model.upper_limits();
-  const phri::ActuatorTable& actuators = config.plant.actuators;  // nominal actuators.yaml
-  if (actuators.size() != s.dof) throw phri::ConfigError(config.source, "robot.actuators", "one actuator per joint for the Kortex backend");
-  s.torque_per_amp_Nm_per_A.resize(s.dof);
-  for (int i = 0; i < s.dof; ++i) s.torque_per_amp_Nm_per_A[i] = actuators[i].torque_per_amp();
-  const std::vector<double>& home = config.plant.initial_q_rad;  // the run's home posture
-  if (static_cast<int>(home.size()) == s.dof) s.reference_q_rad = Eigen::Map<const Eigen::VectorXd>(home.data(), s.dof);
   s.dry_run = dry_run;
   return s;
 }
@@ -53,7 +51,7 @@ std::string health_line(const phri::KortexRobot& robot) {
 class EmulatedArm final : public KortexBackend {
 public:
   EmulatedArm(const phri::Config& config, const phri::Model& model, const KortexArguments& args)
-      : plant_(config.plant), arm_(plant_, plant_.state()) {
+      : plant_(checked_plant(config)), arm_(plant_, plant_.state()) {
     if (!args.emulate_fault.empty()) arm_.schedule(phri::ScheduledKortexFault::parse(args.emulate_fault, "--emulate-fault"));
     phri::KortexRobotSettings settings = robot_settings(config, model, args.dry_run);
     settings.wrench_source = [this](phri::RobotState& s) {
@@ -62,7 +60,8 @@ public:
     };
     robot_ = std::make_unique<phri::KortexRobot>(arm_, settings);
   }
-  phri::KortexRobot& robot() override { return *robot_; }
+  phri::KortexRobot& kortex_robot() override { return *robot_; }
+  phri::PushInput* pushes() override { return &plant_; }
   std::string report() const override {
     const phri::KortexEmulator::Counters& c = arm_.counters();
     return health_line(*robot_) + "; emulator: " + std::to_string(c.commands_applied) + " commands applied, " +
@@ -71,6 +70,11 @@ public:
   }
 
 private:
+  static const phri::SimRobotConfig& checked_plant(const phri::Config& config) {
+    phri::check_plant_matches_controller(config.controller, config.plant);
+    return config.plant;
+  }
+
   phri::SimRobot plant_;
   phri::KortexEmulator arm_;
   std::unique_ptr<phri::KortexRobot> robot_;
@@ -98,7 +102,7 @@ public:
     }
     robot_ = std::make_unique<phri::KortexRobot>(*client_, settings);
   }
-  phri::KortexRobot& robot() override { return *robot_; }
+  phri::KortexRobot& kortex_robot() override { return *robot_; }
   std::string report() const override { return health_line(*robot_); }
 
 private:
@@ -137,8 +141,19 @@ std::unique_ptr<KortexBackend> make_kortex_backend(const KortexArguments& args, 
   throw phri::ConfigError("--backend", args.backend, "not a Kortex backend");
 }
 
+void register_kortex_backends(phri::BackendRegistry& registry, const KortexArguments& args) {
+  registry.add("kortex-emulator", [&args](const phri::BackendRequest& request) -> std::unique_ptr<phri::Backend> {
+    return std::make_unique<EmulatedArm>(request.config, request.model, args);
+  });
+#ifdef PHRI_HAVE_KORTEX_SDK
+  registry.add("kortex", [&args](const phri::BackendRequest& request) -> std::unique_ptr<phri::Backend> {
+    return std::make_unique<RealArm>(args, request.config, request.model);
+  });
+#endif
+}
+
 int kortex_dry_run(KortexBackend& backend, double duration_s, bool real_time, std::ostream& out) {
-  phri::KortexRobot& robot = backend.robot();
+  phri::KortexRobot& robot = backend.kortex_robot();
   phri::LoopClock clock(robot.period_s(), real_time ? phri::LoopClock::Pacing::kRealTime : phri::LoopClock::Pacing::kLockstep);
   const long cycles = std::lround(duration_s / robot.period_s());
   double next_print = 0.0;

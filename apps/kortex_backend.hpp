@@ -3,7 +3,8 @@
 // backend (phri::KortexRobot), on the real arm (Kinova's SDK, only when built with
 // -DPHRI_KORTEX_API_DIR) or on the in-process emulator over the simulated plant; with
 // --ft-serial, the Bota SensONE's wrench; with --dry-run, only reading (no torque ever sent).
-#include <phri/app/config.hpp>
+#include <phri/config/config.hpp>
+#include <phri/app/backend_registry.hpp>
 #include <phri/app/live_channel.hpp>
 #include <phri/hardware/kortex_robot.hpp>
 #include <phri/model/model.hpp>
@@ -24,17 +25,19 @@ struct KortexArguments {
 };
 
 /// The arm of a run with its link and sensors, kept alive together; robot() is what the loop drives.
-class KortexBackend {
+class KortexBackend : public phri::Backend {
 public:
-  virtual ~KortexBackend() = default;
-  virtual phri::KortexRobot& robot() = 0;
-  /// One line on the link and the arm's report (after the run).
-  virtual std::string report() const = 0;
+  phri::RobotInterface& robot() override { return kortex_robot(); }
+  virtual phri::KortexRobot& kortex_robot() = 0;
+  bool brake_on_interrupt() const override { return true; }
 };
 
 /// Refuses a kortex option without a kortex backend, and --backend kortex without the SDK (one
 /// line saying how to build it).
 void check_kortex_arguments(const KortexArguments& args);
+/// Registers "kortex-emulator" and, when built with Kinova's SDK, "kortex"; `args` must outlive
+/// the registry (its factories read it).
+void register_kortex_backends(phri::BackendRegistry& registry, const KortexArguments& args);
 /// Connects and starts the arm (throws HardwareError with one line when it cannot).
 std::unique_ptr<KortexBackend> make_kortex_backend(const KortexArguments& args, const phri::Config& config,
                                                    const phri::Model& model);

@@ -24,16 +24,17 @@
 #include "ft_monitor.hpp"
 #include "kortex_backend.hpp"
 
-#include <phri/app/config.hpp>
-#include <phri/app/config_checks.hpp>
-#include <phri/app/robot_bundle.hpp>
+#include <phri/app/sim_backend.hpp>
+#include <phri/app/loop_clock.hpp>
+#include <phri/config/config.hpp>
+#include <phri/config/config_checks.hpp>
+#include <phri/config/robot_bundle.hpp>
 #include <phri/model/capsule_fit.hpp>
 #include <phri/app/run_session.hpp>
 #include <phri/core/error.hpp>
 #include <phri/core/format.hpp>
 #include <phri/core/process.hpp>
 #include <phri/sim/mujoco_handles.hpp>
-#include <phri/sim/sim_robot.hpp>
 #include <phri/sim/urdf_plant.hpp>
 #include <phri/core/version.hpp>
 #include <phri/experiments/drop_test.hpp>
@@ -231,6 +232,20 @@ std::vector<std::string> generated_plant_warnings(const phri::SimRobotConfig& pl
   return phri::UrdfPlant::generate(options).warnings;
 }
 
+// The robots `phri run --backend` drives: the simulation, the Kortex backends (kortex_backend.cpp).
+phri::BackendRegistry run_backends(const KortexArguments& kortex) {
+  phri::BackendRegistry registry;
+  phri::register_sim_backend(registry);
+  register_kortex_backends(registry, kortex);
+  return registry;
+}
+
+void print_run_line(const RunArguments& args, const phri::Config& config) {
+  std::printf("phri run: %s, %.1f s, %s%s%s\n", args.config_path.c_str(), config.run.duration_s,
+              config.run.pacing == phri::LoopClock::Pacing::kLockstep ? "lockstep" : "real time",
+              args.kortex.backend == "sim" ? "" : (", backend " + args.kortex.backend).c_str(), args.kortex.dry_run ? ", dry run" : "");
+}
+
 // `phri run`: loads the configuration, runs the session, writes the log, summary and figure.
 int run_command(const RunArguments& args) {
   phri::Config config = phri::Config::from_yaml_file(args.config_path, args.robot_folder);
@@ -243,11 +258,11 @@ int run_command(const RunArguments& args) {
 
   // Everything that can refuse the configuration is built before the first line of output.
   check_kortex_arguments(args.kortex);
+  const phri::BackendRegistry backends = run_backends(args.kortex);
+  backends.require(args.kortex.backend);
   const bool real_arm = args.kortex.backend == "kortex";
   if (real_arm && args.lockstep) throw phri::ConfigError("--lockstep", "", "the real arm runs in real time (--backend kortex)");
   if (real_arm) config.run.pacing = phri::LoopClock::Pacing::kRealTime;
-  std::unique_ptr<phri::SimRobot> sim;
-  if (args.kortex.backend == "sim") sim = std::make_unique<phri::SimRobot>(config.plant);
   phri::Controller cycle(config.controller);
   // What the URDF loader and the plant generator accepted but the user should know (one line each,
   // naming the link): odd inertias, a base inertial ignored, inertias MuJoCo balanced.
@@ -255,16 +270,15 @@ int run_command(const RunArguments& args) {
   for (const std::string& warning : generated_plant_warnings(config.plant)) std::fprintf(stderr, "phri: warning: %s\n", warning.c_str());
   for (const std::string& warning : phri::config_warnings(config)) std::fprintf(stderr, "phri: warning: %s\n", warning.c_str());
   phri::Fsm fsm(config.fsm, cycle);
-  // The Kortex backend connects and starts the arm last (a refusal is one line, the arm put back).
-  std::unique_ptr<KortexBackend> kortex;
-  if (!sim) kortex = make_kortex_backend(args.kortex, config, cycle.model());
-  phri::RobotInterface& robot = sim ? static_cast<phri::RobotInterface&>(*sim) : kortex->robot();
-  std::printf("phri run: %s, %.1f s, %s%s%s\n", args.config_path.c_str(), config.run.duration_s,
-              config.run.pacing == phri::LoopClock::Pacing::kLockstep ? "lockstep" : "real time",
-              sim ? "" : (", backend " + args.kortex.backend).c_str(), args.kortex.dry_run ? ", dry run" : "");
-  if (args.kortex.dry_run) {
+  if (args.kortex.dry_run) {  // a Kortex backend (check_kortex_arguments), only read
+    const std::unique_ptr<KortexBackend> kortex = make_kortex_backend(args.kortex, config, cycle.model());
+    print_run_line(args, config);
     return kortex_dry_run(*kortex, config.run.duration_s, config.run.pacing == phri::LoopClock::Pacing::kRealTime, std::cout);
   }
+  // The backend last: a real arm connects and starts then (a refusal is one line, the arm put back).
+  const std::unique_ptr<phri::Backend> backend = backends.make(args.kortex.backend, {config, cycle.model()});
+  phri::RobotInterface& robot = backend->robot();
+  print_run_line(args, config);
   std::unique_ptr<phri::Gamepad> gamepad;
   if (config.gamepad.enabled) {
     gamepad = std::make_unique<phri::Gamepad>(config.gamepad);
@@ -277,13 +291,14 @@ int run_command(const RunArguments& args) {
   if (args.dashboard.enabled) dashboard = start_dashboard(args.dashboard, config, cycle, live);
 
   phri::RunOptions options;
-  if (dashboard || kortex) options.live = &live;
+  if (dashboard || backend->brake_on_interrupt()) options.live = &live;
+  options.pushes = backend->pushes();
   // Until the files are written. On the arm, Ctrl-C brakes to rest first (InterruptToStop replaces
   // the SIGINT handler); SIGTERM ends the loop there too, then the backend's exit sequence.
   const StopOnSignals stop_on_signals;
   options.stop_requested = &g_stop_requested;
   std::optional<InterruptToStop> interrupt;
-  if (kortex) interrupt.emplace(live);
+  if (backend->brake_on_interrupt()) interrupt.emplace(live);
   options.duration_s = config.run.duration_s;
   options.real_time = config.run.pacing == phri::LoopClock::Pacing::kRealTime;
   options.phases.push_back({0.0, "startup"});
@@ -292,7 +307,7 @@ int run_command(const RunArguments& args) {
   if (gamepad) gamepad->stop();
   if (dashboard) dashboard->stop();
   std::printf("\n");
-  if (kortex) std::printf("%s\n", kortex->report().c_str());
+  if (const std::string report = backend->report(); !report.empty()) std::printf("%s\n", report.c_str());
   phri::print_run_summary(summary, std::cout);
   std::ostringstream md;
   md << "# phri run: " << args.config_path << "\n\n";
@@ -363,7 +378,7 @@ CLI::App* add_run_command(CLI::App& app, RunArguments& args) {
   run->add_option("--backend", args.kortex.backend,
                   "the arm: sim (the simulated Gen3), kortex (the real Gen3 through Kinova's Kortex API; needs a build with "
                   "-DPHRI_KORTEX_API_DIR) or kortex-emulator (the Kortex backend on an emulated arm over the simulation)")
-      ->check(CLI::IsMember({"sim", "kortex", "kortex-emulator"}))->capture_default_str();
+      ->capture_default_str();
   run->add_option("--ip", args.kortex.ip, "the arm's address (--backend kortex; TCP 10000, UDP 10001)")->capture_default_str();
   run->add_option("--ft-serial", args.kortex.ft_serial, "the Bota SensONE's serial device (--backend kortex)");
   run->add_option("--emulate-fault", args.kortex.emulate_fault,

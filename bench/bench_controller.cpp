@@ -7,7 +7,7 @@
 // the same states in the same run, the safety supervisor's plausibility check alone (a second
 // StateSupervisor built like the controller's: supervisor_median_us, the part of the cycle it adds):
 //   build/release/bench/phri_bench --benchmark_filter=ControllerCycle
-#include <phri/app/robot_bundle.hpp>
+#include <phri/config/robot_bundle.hpp>
 #include <phri/control/controller.hpp>
 #include <phri/control/singular_direction_weight.hpp>
 #include <phri/model/algorithms.hpp>

@@ -12,8 +12,8 @@
 //    turned as MuJoCo's own sensor reads it, the tool's weight removed at rest;
 //  * each new key's mistakes are one-line errors naming robot.yaml and the key.
 // The arm is robots/example_6dof, copied and its robot.yaml edited.
-#include <phri/app/config.hpp>
-#include <phri/app/robot_bundle.hpp>
+#include <phri/config/config.hpp>
+#include <phri/config/robot_bundle.hpp>
 #include <phri/control/controller.hpp>
 #include <phri/model/algorithms.hpp>
 #include <phri/sim/sim_robot.hpp>

@@ -9,8 +9,8 @@
 //  * robot.yaml's `payloads`: bodies on any link, carried alike by the controller's model and the
 //    generated plant (gravity torques against MuJoCo's bias force at rest), the arm holding its pose.
 // The arm is robots/example_6dof, copied and edited.
-#include <phri/app/config.hpp>
-#include <phri/app/robot_bundle.hpp>
+#include <phri/config/config.hpp>
+#include <phri/config/robot_bundle.hpp>
 #include <phri/control/controller.hpp>
 #include <phri/dashboard/state_encoder.hpp>
 #include <phri/model/algorithms.hpp>

@@ -2,7 +2,8 @@
 // phri::Config: configs/demo.yaml loads into the settings of every piece (paths resolved, plant
 // file merged with the overrides, the timeline sorted), and each class of mistake is a
 // phri::ConfigError naming the key path.
-#include <phri/app/config.hpp>
+#include <phri/app/loop_clock.hpp>
+#include <phri/config/config.hpp>
 #include <phri/core/error.hpp>
 
 #include "config_error.hpp"

@@ -8,7 +8,7 @@
 //     (LiveChannel -> Fsm::post -> ControllerTargets), and the stream shows the result;
 //   - 100 clients connecting and leaving while the loop runs in real time: all served, resident
 //     memory does not grow, the loop keeps its pace (every snapshot handed over or dropped, none waited for).
-#include <phri/app/config.hpp>
+#include <phri/config/config.hpp>
 #include <phri/app/fsm.hpp>
 #include <phri/app/live_channel.hpp>
 #include <phri/app/run_session.hpp>
@@ -239,6 +239,7 @@ struct LiveRun {
     options.real_time = real_time;
     options.status_line = false;
     options.live = &channel;
+    options.pushes = &robot;
     return phri::run_session(robot, controller, fsm, nullptr, nullptr, options, out);
   }
   phri::Config config;
@@ -361,6 +362,7 @@ TEST(DashboardLoop, TheLoopSideOfTheHandOffAllocatesNothingPerCycle) {
     options.duration_s = duration_s;
     options.status_line = false;
     options.live = &channel;
+    options.pushes = &robot;
     std::ostringstream out;
     const phri::test::AllocationCounter count;
     const phri::RunSummary summary = phri::run_session(robot, controller, fsm, nullptr, nullptr, options, out);

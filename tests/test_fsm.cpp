@@ -5,10 +5,10 @@
 // the static and dynamic scenarios, compliance modes, loops, stiffness and stops; the reference
 // never steps; the loop (plant + FSM + cycle) allocates nothing; the whole run logged through
 // phri::Logger and read back.
-#include <phri/app/config.hpp>
+#include <phri/config/config.hpp>
 #include <phri/control/controller.hpp>
 #include <phri/app/fsm.hpp>
-#include <phri/app/log_row.hpp>
+#include <phri/app/fill_log_row.hpp>
 #include <phri/app/logger.hpp>
 #include <phri/control/end_effector_task.hpp>
 #include <phri/core/error.hpp>

@@ -6,9 +6,9 @@
 // time) while the arm keeps running. The arm is robots/example_6dof, copied with `drive: generic`.
 // The hold has its own gains (drive.position_hold, or a default rule on the arm's inertia), and a
 // plant YAML says which drives it emulates (`drive:`), which must agree with the robot's.
-#include <phri/app/config.hpp>
+#include <phri/config/config.hpp>
 #include <phri/app/fsm.hpp>
-#include <phri/app/robot_bundle.hpp>
+#include <phri/config/robot_bundle.hpp>
 #include <phri/control/controller.hpp>
 #include <phri/model/algorithms.hpp>
 #include <phri/sim/sim_robot.hpp>

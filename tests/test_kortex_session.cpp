@@ -8,7 +8,7 @@
 // torque the plant applies and ends in a logged safe stop (the controller's safe hold, the
 // actuators in their position hold; after packet loss the controller's brake first, the link
 // still carrying it).
-#include <phri/app/config.hpp>
+#include <phri/config/config.hpp>
 #include <phri/app/fsm.hpp>
 #include <phri/app/run_session.hpp>
 #include <phri/control/controller.hpp>

@@ -3,7 +3,7 @@
 // writer thread drains concurrently; push never allocates; a full ring drops (and counts) instead
 // of blocking; the header is a list of unique, plain column names that pandas and PlotJuggler
 // accept, and every row has as many fields.
-#include <phri/app/log_row.hpp>
+#include <phri/config/log_row.hpp>
 #include <phri/app/logger.hpp>
 #include <phri/core/spsc_ring.hpp>
 #include <phri/core/error.hpp>

@@ -1,10 +1,10 @@
 // ctest-labels: unit integration
-// Robot bundles (robots/<robot>/robot.yaml, app/robot_bundle.hpp): the Gen3's bundle gives the run
+// Robot bundles (robots/<robot>/robot.yaml, config/robot_bundle.hpp): the Gen3's bundle gives the run
 // exactly the settings configs/demo.yaml spells out key by key (so the Gen3's figures do not move);
 // each class of mistake in a robot.yaml is a one-line ConfigError naming robot.yaml and the key path;
 // a generated arm's bundle with no plant section runs on the plant generated from its URDF.
-#include <phri/app/config.hpp>
-#include <phri/app/robot_bundle.hpp>
+#include <phri/config/config.hpp>
+#include <phri/config/robot_bundle.hpp>
 #include <phri/control/controller.hpp>
 #include <phri/lowlevel/custom_torque_controller.hpp>
 #include <phri/model/algorithms.hpp>

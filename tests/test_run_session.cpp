@@ -13,7 +13,7 @@
 #include <phri/app/fsm.hpp>
 #include <phri/app/logger.hpp>
 #include <phri/app/run_session.hpp>
-#include <phri/app/scenario.hpp>
+#include <phri/config/fsm_settings.hpp>
 #include <phri/control/controller.hpp>
 #include <phri/robot/actuator_table.hpp>
 #include <phri/robot/fake_robot.hpp>

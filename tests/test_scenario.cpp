@@ -1,9 +1,12 @@
 // ctest-labels: unit
-// The scenarios' reference generators (app/scenario.hpp) against their definitions: the quintic's
+// The scenarios' reference generators (config/fsm_settings.hpp) against their definitions: the quintic's
 // boundary conditions, the rounded triangle's bounds, speed and start, the dynamic trajectory's
 // parameters (paper_parameters.md section 5) and the consistency of every feed-forward velocity
 // and acceleration with the finite differences of the positions, the moves and brakes.
-#include <phri/app/scenario.hpp>
+#include <phri/config/fsm_settings.hpp>
+#include <phri/trajectory/joint_move.hpp>
+#include <phri/trajectory/pose_move.hpp>
+#include <phri/trajectory/quintic.hpp>
 #include <phri/control/end_effector_task.hpp>
 #include <phri/model/model.hpp>
 

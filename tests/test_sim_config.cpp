@@ -9,12 +9,12 @@
 #include <phri/core/random_generator.hpp>
 #include <phri/core/discrete_transfer_function.hpp>
 #include <phri/robot/actuator_table.hpp>
-#include <phri/sim/external_force.hpp>
+#include <phri/config/external_force.hpp>
 #include <phri/sim/link_inertial.hpp>
 #include <phri/sim/mujoco_handles.hpp>
 #include <phri/sim/random_push_generator.hpp>
 #include <phri/sim/sim_scene.hpp>
-#include <phri/sim/sim_robot_config.hpp>
+#include <phri/config/sim_robot_config.hpp>
 #include <phri/sim/stick_slip_friction.hpp>
 
 #include "config_error.hpp"

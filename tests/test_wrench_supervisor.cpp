@@ -5,7 +5,7 @@
 // stale, 100 samples of 1e6 N), the hand leaves. The F/T source must be dropped, the touch trigger
 // released and the arm held where it was when the fault began; the same run without a fault (and
 // with a push on the elbow the F/T does not see) must raise no alarm.
-#include <phri/app/log_row.hpp>
+#include <phri/app/fill_log_row.hpp>
 #include <phri/app/logger.hpp>
 #include <phri/control/controller.hpp>
 #include <phri/dashboard/state_encoder.hpp>

@@ -30,9 +30,10 @@ MODULE_DEPENDENCIES = {
     "safety": ["robot"],
     "control": ["model", "qp", "robot", "lowlevel", "safety"],
     "trajectory": ["control"],
-    "sim": ["robot"],
+    "config": ["control", "trajectory"],
+    "sim": ["robot", "config"],
     "hardware": ["robot"],
-    "app": ["control", "trajectory", "sim"],
+    "app": ["config", "control", "trajectory", "sim"],
     "experiments": ["app", "control", "sim"],
     "dashboard": ["app"],
 }
@@ -55,10 +56,10 @@ def reachable(module):
 
 def layering_findings(src):
     findings = []
-    for path in sorted(src.glob("phri/*/*")):
-        if path.suffix not in (".hpp", ".cpp"):
+    for path in sorted(src.glob("phri/**/*")):
+        if path.suffix not in (".hpp", ".cpp") or len(path.relative_to(src / "phri").parts) < 2:
             continue
-        module = path.parent.name
+        module = path.relative_to(src / "phri").parts[0]  # a file in a module's subfolder belongs to it
         if module not in MODULE_DEPENDENCIES:
             findings.append(f"{path}: module '{module}' is not in tools/check_structure.py's graph")
             continue

@@ -4,7 +4,7 @@
 // (hexadecimal floats), which the script compares with its own runs: the same loop, bit for bit.
 //
 //   phri_loop_reference [--seconds S] [--repetitions R]
-#include <phri/app/robot_bundle.hpp>
+#include <phri/config/robot_bundle.hpp>
 #include <phri/control/controller.hpp>
 #include <phri/sim/sim_robot.hpp>
 

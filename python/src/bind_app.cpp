@@ -4,7 +4,8 @@
 #include "bindings.hpp"
 #include "python_stream.hpp"
 
-#include <phri/app/config.hpp>
+#include <phri/app/loop_clock.hpp>
+#include <phri/config/config.hpp>
 #include <phri/app/run_session.hpp>
 
 #include <sstream>

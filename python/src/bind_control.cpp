@@ -6,7 +6,7 @@
 // Controller outputs (desired torque, external torque...) are read-only views updated every step.
 #include "bindings.hpp"
 
-#include <phri/app/robot_bundle.hpp>
+#include <phri/config/robot_bundle.hpp>
 #include <phri/control/controller.hpp>
 
 namespace phri::python {

@@ -8,7 +8,7 @@
 // the loop of apps/phri's run_session without its pacing, status line and statistics, so that a
 // script pays for nothing it does not ask for.
 #include <phri/app/fsm.hpp>
-#include <phri/app/log_row.hpp>
+#include <phri/app/fill_log_row.hpp>
 #include <phri/app/logger.hpp>
 #include <phri/control/controller.hpp>
 #include <phri/robot/robot_interface.hpp>

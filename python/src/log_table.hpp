@@ -1,9 +1,9 @@
 #pragma once
-// phri logs as tables of 8-byte cells: the columns of a LogRow (app/log_row.hpp, the one definition
+// phri logs as tables of 8-byte cells: the columns of a LogRow (config/log_row.hpp, the one definition
 // the CSV header and rows share), a LogRow written as one record of them, and a CSV log read back
 // into records. The Python side wraps the records in a numpy structured array (float64 for real
 // columns, int64 for integer ones), so a recorded run and a loaded log have the same dtype.
-#include <phri/app/log_row.hpp>
+#include <phri/config/log_row.hpp>
 
 #include <cstdint>
 #include <string>

@@ -46,6 +46,14 @@ findings = check.layering_findings(upward / "src")
 expect(len(findings) == 1 and "model" in findings[0] and "phri/control/" in findings[0], "an upward include is found")
 expect(check.main(["x", str(upward)]) == 1, "an upward include fails the check")
 
+nested = tree({"hardware/kortex_sdk/k.cpp": "#include <phri/control/controller.hpp>\nint s() { return 0; }\n"})
+findings = check.layering_findings(nested / "src")
+expect(len(findings) == 1 and "hardware" in findings[0] and "phri/control/" in findings[0],
+       "a file in a module's subfolder is read, as part of that module")
+
+config_on_sim = tree({"config/c.cpp": "#include <phri/sim/sim_robot.hpp>\nint c() { return 0; }\n"})
+expect(len(check.layering_findings(config_on_sim / "src")) == 1, "the configuration library may not include the simulator")
+
 unknown = tree({"gadgets/g.cpp": "int k() { return 0; }\n"})
 expect(len(check.layering_findings(unknown / "src")) == 1, "a module outside the graph is found")
 

@@ -2,7 +2,7 @@
 // The Gen3 controller the tests drive: the robot bundle robots/kinova_gen3 (files, frames, end of
 // arm, dead band, H(z)) with the library's defaults for the rest (the paper's demo values), one
 // home for the tests that build it.
-#include <phri/app/robot_bundle.hpp>
+#include <phri/config/robot_bundle.hpp>
 #include <phri/control/controller_settings.hpp>
 
 #include <string>

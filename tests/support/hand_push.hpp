@@ -1,7 +1,7 @@
 #pragma once
 // A push as a hand gives it, for the simulated plant's disturbance timeline: a force at a point of
 // a body (world axes) rising over 50 ms, held, then released.
-#include <phri/sim/external_force.hpp>
+#include <phri/config/external_force.hpp>
 
 #include <string>
 

@@ -30,16 +30,19 @@
 // brake: the reference decelerates to rest at a bounded rate (PoseBrake, JointBrake) before the
 // next state starts from it, so no transition steps the reference velocity.
 //
-// Events (app/event.hpp) come from post() (the gamepad) and from the timeline (handled when the
+// Events (config/event.hpp) come from post() (the gamepad) and from the timeline (handled when the
 // robot time reaches them), and act at once: compliance modes (ControllerTargets::compliance_mode),
 // stiffness up/down (x or / stiffness_step, ComplianceController clamps to [0.1, 4]), low-level
 // loops (during start-up: the loop to hand over to), scenarios, stops.
 //
 // update() allocates nothing and never throws; construction checks the settings (ConfigError).
 #include <phri/control/controller.hpp>
-#include <phri/app/event.hpp>
+#include <phri/config/event.hpp>
 #include <phri/app/live_gain.hpp>
-#include <phri/app/scenario.hpp>
+#include <phri/config/fsm_settings.hpp>
+#include <phri/trajectory/joint_move.hpp>
+#include <phri/trajectory/pose_move.hpp>
+#include <phri/trajectory/quintic.hpp>
 #include <phri/core/spsc_ring.hpp>
 #include <phri/model/data.hpp>
 
@@ -59,28 +62,6 @@ constexpr std::string_view to_string(FsmState s) {
   }
   return "unknown";
 }
-
-struct StartupSettings {
-  bool enabled = true;  ///< false: the first scenario starts at once, in the torque loop
-  std::vector<double> home_q_rad = paper_posture_target();  ///< one per joint
-  double max_joint_speed_rad_s = 0.3;  ///< peak joint speed of the move
-  double min_duration_s = 1.0;
-  double tolerance_rad = 0.05;  ///< posture error norm allowing the switch (paper: 0.05)
-  double timeout_s = 5.0;       ///< after the move: switch anyway (startup_timed_out())
-};
-
-struct FsmSettings {
-  StartupSettings startup;
-  StaticScenarioSettings static_scenario;
-  DynamicScenarioSettings dynamic_scenario;
-  BrakeSettings brake;
-  Scenario first_scenario = Scenario::kStatic;    ///< entered after start-up
-  LowLevelMode torque_loop = LowLevelMode::kCurrent;  ///< start-up hands over to it; toggle_loop's torque side
-  double stiffness_step = 1.25;  ///< factor of stiffness_up / stiffness_down
-  double rest_speed_rad_s = 0.01;  ///< |qd| below which the arm is at rest (finished())
-  std::vector<TimedEvent> timeline;  ///< scripted events (sorted here by time)
-  std::size_t queue_capacity = 64;   ///< posted events waiting for update()
-};
 
 class Fsm {
 public:

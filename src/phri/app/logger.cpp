@@ -1,7 +1,7 @@
 #include <phri/app/logger.hpp>
 
 #include <phri/control/controller.hpp>
-#include <phri/app/event.hpp>
+#include <phri/config/event.hpp>
 #include <phri/app/fsm.hpp>
 #include <phri/core/error.hpp>
 #include <phri/qp/qp_status.hpp>
@@ -75,7 +75,7 @@ std::string Logger::header(int dof) {
 std::string Logger::legend_yaml() {
   std::string out =
       "# Integer codes of the phri log's columns (phri::Logger). Units of the other columns: see\n"
-      "# src/phri/app/log_row.hpp (SI: s, rad, rad/s, N.m, A, m, N).\n";
+      "# src/phri/config/log_row.hpp (SI: s, rad, rad/s, N.m, A, m, N).\n";
   legend_entry(out, "compliance_mode", {ComplianceMode::kStiff, ComplianceMode::kNullSpace, ComplianceMode::kFullBody,
                                         ComplianceMode::kDual});
   out += "touched:\n  0: free\n  1: touched\n";

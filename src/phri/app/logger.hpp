@@ -1,5 +1,5 @@
 #pragma once
-// phri::Logger: one CSV row per control cycle (app/log_row.hpp), written to disk off the control
+// phri::Logger: one CSV row per control cycle (config/log_row.hpp), written to disk off the control
 // thread (DESIGN.md section 2, last stage).
 //
 //   phri::Logger logger({.path = "run.csv"});   // opens the file, writes header + legend, starts the writer
@@ -23,7 +23,8 @@
 //   * then one line per row, numbers only (integer codes for modes and statuses),
 // which pandas.read_csv and PlotJuggler's CSV loader open directly. The codes' legend goes to
 // a sidecar <path without .csv>.legend.yaml (legend_yaml()).
-#include <phri/app/log_row.hpp>
+#include <phri/config/log_row.hpp>
+#include <phri/config/logger_settings.hpp>
 #include <phri/core/spsc_ring.hpp>
 
 #include <atomic>
@@ -34,26 +35,6 @@
 #include <vector>
 
 namespace phri {
-
-/// Memory bound of the log ring: at most 100 MiB of rows waiting for the writer thread. The ring
-/// only absorbs the writer's stalls; 131072 rows of sizeof(LogRow) (~700 B) are 2 min at 1 kHz,
-/// and a larger ring only costs memory (4194304 rows took 2.9 GB).
-inline constexpr std::size_t kLogRingMaxBytes = std::size_t{100} << 20;
-
-/// Largest ring size within kLogRingMaxBytes (a power of two: the ring rounds its size up to one).
-constexpr std::size_t log_ring_max_rows() {
-  std::size_t rows = 2;
-  while (2 * rows * sizeof(LogRow) <= kLogRingMaxBytes) rows *= 2;
-  return rows;
-}
-
-struct LoggerSettings {
-  std::string path = "phri_log.csv";  ///< CSV file (truncated); its folder must exist
-  int dof = kLogMaxJoints;            ///< joints written per group (<= kLogMaxJoints)
-  std::size_t capacity_rows = 16384;  ///< ring size (rounded up to a power of two), <= log_ring_max_rows()
-  bool write_legend = true;           ///< write the <path>.legend.yaml sidecar
-  int writer_sleep_ms = 2;            ///< writer's pause when the ring is empty
-};
 
 struct LoggerStats {
   std::uint64_t pushed = 0;      ///< rows accepted by push()

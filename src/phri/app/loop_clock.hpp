@@ -7,6 +7,8 @@
 //              cycle is counted as an overrun and the schedule is not caught up (the next deadline
 //              is one period after now), so a stall does not cause a burst of fast cycles.
 // With the real arm, read() itself blocks on the robot's 1 kHz feedback; use kLockstep there.
+#include <phri/config/run_settings.hpp>
+
 #include <chrono>
 #include <cstdint>
 
@@ -14,7 +16,7 @@ namespace phri {
 
 class LoopClock {
 public:
-  enum class Pacing { kLockstep, kRealTime };
+  using Pacing = LoopPacing;
 
   LoopClock(double period_s, Pacing pacing);
 

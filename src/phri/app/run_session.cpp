@@ -1,9 +1,8 @@
 #include <phri/app/run_session.hpp>
 
-#include <phri/app/log_row.hpp>
+#include <phri/app/fill_log_row.hpp>
 #include <phri/app/loop_clock.hpp>
 #include <phri/core/statistics.hpp>
-#include <phri/sim/sim_robot.hpp>
 
 #include <algorithm>
 #include <chrono>
@@ -67,8 +66,10 @@ public:
         last_touches_(cycle.compliance().touch_count()),
         last_loop_switches_(cycle.low_level().switch_count()),
         live_(options.live),
-        sim_(dynamic_cast<SimRobot*>(&robot)) {
-    if (live_ && sim_) sim_bodies_ = simulated_bodies(cycle.model(), *sim_);
+        pushes_(options.pushes),
+        observers_(options.observers) {
+    if (live_) observers_.push_back(&live_->snapshots());
+    if (live_ && pushes_) push_targets_ = push_targets(cycle.model(), *pushes_);
   }
 
   RunSummary run() {
@@ -88,7 +89,7 @@ public:
       check_safety(status);
       check_overruns(clock_.wait_next(), t);
       print_status(t, pos, micros_[k]);
-      if (live_) publish_live(k);
+      if (!observers_.empty()) publish_to_observers(k);
       if (fsm_.finished()) {
         ++k;
         break;
@@ -137,7 +138,7 @@ private:
         ++summary_.refused_writes;
       }
     }
-    if (logger_ || live_) {
+    if (logger_ || !observers_.empty()) {
       fill_log_row(row_, state, cycle_, fsm_);
       row_.cycle_time_s = 1e-6 * us;
     }
@@ -145,13 +146,13 @@ private:
     return status;
   }
 
-  // The simulator's body of each model body (by link name), found before the loop.
-  static std::vector<int> simulated_bodies(const Model& model, const SimRobot& sim) {
+  // The push target of each model body (by link name), found before the loop.
+  static std::vector<int> push_targets(const Model& model, const PushInput& pushes) {
     std::vector<int> bodies(static_cast<std::size_t>(model.num_bodies()), -1);
     for (const Frame& f : model.frames()) {
       if (f.type == FrameType::kLink && f.body >= 0 && f.placement.isApprox(Eigen::Isometry3d::Identity()) &&
           bodies[static_cast<std::size_t>(f.body)] < 0) {
-        bodies[static_cast<std::size_t>(f.body)] = sim.body_id(f.name);
+        bodies[static_cast<std::size_t>(f.body)] = pushes.push_target(f.name);
       }
     }
     return bodies;
@@ -166,7 +167,7 @@ private:
     while (paused_ && steps_ == 0 && !stop_requested()) {
       // The page learns it is paused, and sees the last cycle (retried: the queue may be full
       // of the snapshots of a burst of steps).
-      if (!shown) shown = publish_snapshot();
+      if (!shown) shown = live_->publish(fill_snapshot());
       std::this_thread::sleep_for(std::chrono::milliseconds(1));
       for (LiveCommand c; live_->receive(c);) handle_live(c);
       waited = true;
@@ -187,34 +188,38 @@ private:
     }
   }
 
-  // A push on the simulated arm from the next read() on, for push_hold_s unless renewed.
+  // A push on the arm from the next read() on, for push_hold_s unless renewed.
   void start_push(const LivePush& push) {
-    if (!sim_ || push.body < 0 || push.body >= static_cast<int>(sim_bodies_.size()) ||
-        sim_bodies_[static_cast<std::size_t>(push.body)] < 0) {
+    if (!pushes_ || push.body < 0 || push.body >= static_cast<int>(push_targets_.size()) ||
+        push_targets_[static_cast<std::size_t>(push.body)] < 0) {
       return;
     }
-    push_force_.point_m = push.point_local;
-    push_force_.frame = ExternalForce::Frame::kWorld;
-    push_force_.force_N = push.force_world;
-    push_force_.profile = ExternalForce::Profile::kStep;
-    push_force_.start_s = sim_->state().time_s;
-    push_force_.duration_s = live_->settings().push_hold_s;
-    sim_->set_live_disturbance(sim_bodies_[static_cast<std::size_t>(push.body)], push_force_);
+    const double hold_s = live_->settings().push_hold_s;
+    pushes_->push(push_targets_[static_cast<std::size_t>(push.body)], push.point_local, push.force_world, hold_s);
+    push_start_s_ = row_.time_s;  // the latest state's time, where the push's hold starts
+    push_end_s_ = push_start_s_ + hold_s;
     push_ = push;
   }
 
   void end_push() {
-    if (sim_) sim_->set_live_disturbance(-1, push_force_);
+    if (pushes_) pushes_->push(-1, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), 0.0);
     push_.body = -1;
   }
 
-  void publish_live(std::size_t k) {
-    if (paused_ || live_->due(k)) publish_snapshot();
+  // Every observer whose cycle it is gets this cycle's snapshot (all of them while paused).
+  void publish_to_observers(std::size_t k) {
+    bool filled = false;
+    for (SnapshotChannel* observer : observers_) {
+      if (!paused_ && !observer->due(k)) continue;
+      if (!filled) fill_snapshot();
+      filled = true;
+      observer->publish(snapshot_);
+    }
   }
 
-  // The last cycle's row and what the loop knows beside it; false when the queue was full.
-  bool publish_snapshot() {
-    if (push_.body >= 0 && push_force_.scale_at(row_.time_s) == 0.0) push_.body = -1;  // ran out unrenewed
+  // The last cycle's row and what the loop knows beside it.
+  const LiveSnapshot& fill_snapshot() {
+    if (push_.body >= 0 && (row_.time_s < push_start_s_ || row_.time_s >= push_end_s_)) push_.body = -1;  // ran out unrenewed
     snapshot_.row = row_;
     snapshot_.dof = robot_.dof();
     snapshot_.push = push_;
@@ -224,7 +229,7 @@ private:
     snapshot_.posture_gamma_override = compliance.posture_gamma_override();
     snapshot_.posture_stiffness = compliance.posture_stiffness();
     snapshot_.overruns = clock_.overruns();
-    return live_->publish(snapshot_);
+    return snapshot_;
   }
 
   // Adds the cycle to its phase's sums; returns the end-effector position error [mm].
@@ -368,9 +373,10 @@ private:
   RunSummary summary_;
   // live front end
   LiveChannel* live_;
-  SimRobot* sim_;
-  std::vector<int> sim_bodies_;
-  ExternalForce push_force_;
+  PushInput* pushes_;
+  std::vector<SnapshotChannel*> observers_;  // options.observers and the live front end's; sized before the loop
+  std::vector<int> push_targets_;
+  double push_start_s_ = 0.0, push_end_s_ = 0.0;
   LivePush push_;
   LiveSnapshot snapshot_;
   bool paused_ = false;

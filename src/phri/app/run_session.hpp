@@ -14,7 +14,9 @@
 #include <phri/app/fsm.hpp>
 #include <phri/app/gamepad.hpp>
 #include <phri/app/live_channel.hpp>
+#include <phri/app/snapshot_channel.hpp>
 #include <phri/app/logger.hpp>
+#include <phri/robot/push_input.hpp>
 #include <phri/robot/robot_interface.hpp>
 
 #include <atomic>
@@ -35,10 +37,17 @@ struct RunOptions {
   bool status_line = true;          ///< a refreshed line on a terminal, progress lines otherwise
   std::vector<PhaseMark> phases;    ///< sorted by start; empty: one phase "run"
   /// A live front end (the dashboard), or null. Its commands are taken at the start of each
-  /// cycle (events and gains go to the FSM like the gamepad's; pushes to a simulated robot), its
-  /// snapshots published every `decimation` cycles. While paused the loop holds between two
-  /// cycles (the simulation and the controller stop together) and polls the channel every 1 ms.
+  /// cycle (events and gains go to the FSM like the gamepad's; pushes to `pushes`), and it is one
+  /// of the run's observers (its snapshots). While paused the loop holds between two cycles (the
+  /// simulation and the controller stop together) and polls the channel every 1 ms.
   LiveChannel* live = nullptr;
+  /// Where the live front end's pushes go (a simulated arm: the backend that built the robot hands
+  /// it over), or null: pushes are ignored.
+  PushInput* pushes = nullptr;
+  /// Observers of the run besides the live front end (a recorder, a bridge, a second monitor): each
+  /// gets every `decimation`-th cycle's snapshot through its own lock-free ring; a full ring drops
+  /// the snapshot, so none can block or slow the cycle. Each must outlive the run.
+  std::vector<SnapshotChannel*> observers;
   /// A stop asked from outside the loop (apps/phri.cpp: SIGINT, SIGTERM), or null. Loaded once a
   /// cycle (no wait, no allocation); once true, the run ends after that cycle as if its duration had
   /// run out, with RunSummary::interrupted set.

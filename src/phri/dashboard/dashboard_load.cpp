@@ -1,6 +1,6 @@
 #include <phri/dashboard/dashboard_load.hpp>
 
-#include <phri/app/config.hpp>
+#include <phri/config/config.hpp>
 #include <phri/app/run_session.hpp>
 #include <phri/core/statistics.hpp>
 #include <phri/dashboard/dashboard_server.hpp>
@@ -33,6 +33,7 @@ DashboardLoadSegment run_segment(const Config& config, const DashboardLoadOption
     settings.web_root = o.web_root;
     server = std::make_unique<DashboardServer>(live, cycle, settings);
     run.live = &live;
+    run.pushes = &robot;
     StreamClientsSettings crowd;
     crowd.port = server->port();
     crowd.token = server->token();

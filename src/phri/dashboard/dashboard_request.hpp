@@ -5,7 +5,7 @@
 // that are not finite or out of their range. A push's force is capped at `max_push_N` (the
 // reply says what was applied), not refused: dragging further only pushes as hard as allowed.
 //
-//   POST /api/event    {"event": "full_body_compliance"}          names: app/event.hpp
+//   POST /api/event    {"event": "full_body_compliance"}          names: config/event.hpp
 //   POST /api/gain     {"gain": "stiffness_scale", "value": 1.5}   names and ranges: app/live_gain.hpp
 //   POST /api/push     {"body": 6, "point": [x, y, z], "force": [fx, fy, fz]}
 //                      body: model body index; point: body frame [m], |point| <= 1; force: world [N]

@@ -1,6 +1,6 @@
 #include <phri/dashboard/state_encoder.hpp>
 
-#include <phri/app/event.hpp>
+#include <phri/config/event.hpp>
 #include <phri/app/fsm.hpp>
 #include <phri/app/live_gain.hpp>
 #include <phri/control/compliance_mode.hpp>

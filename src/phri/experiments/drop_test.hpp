@@ -19,7 +19,7 @@
 #include <phri/control/compliance_mode.hpp>
 #include <phri/control/controller_settings.hpp>
 #include <phri/robot/low_level_mode.hpp>
-#include <phri/sim/sim_robot_config.hpp>
+#include <phri/config/sim_robot_config.hpp>
 
 #include <cstdint>
 #include <iosfwd>

@@ -11,7 +11,7 @@
 // Coulomb level (the paper found them close enough to use one value; the plant may not).
 // Same seed, same plant (phri::RandomGenerator is platform independent).
 #include <phri/robot/actuator_table.hpp>
-#include <phri/sim/sim_robot_config.hpp>
+#include <phri/config/sim_robot_config.hpp>
 
 #include <cstdint>
 #include <vector>

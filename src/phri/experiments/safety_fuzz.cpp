@@ -1,6 +1,6 @@
 #include <phri/experiments/safety_fuzz.hpp>
 
-#include <phri/app/robot_bundle.hpp>
+#include <phri/config/robot_bundle.hpp>
 #include <phri/control/controller.hpp>
 #include <phri/core/error.hpp>
 #include <phri/core/format.hpp>

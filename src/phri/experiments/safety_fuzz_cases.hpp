@@ -7,7 +7,7 @@
 #include <phri/model/collision_model.hpp>
 #include <phri/model/data.hpp>
 #include <phri/model/model.hpp>
-#include <phri/sim/external_force.hpp>
+#include <phri/config/external_force.hpp>
 
 #include <Eigen/Core>
 

@@ -9,6 +9,17 @@
 #include <utility>
 
 namespace phri {
+
+KortexRobotSettings kortex_robot_settings(const RobotDescription& robot, double period_s) {
+  KortexRobotSettings s;
+  s.dof = robot.dof();
+  s.period_s = period_s;
+  s.torque_per_amp_Nm_per_A.resize(s.dof);
+  for (int i = 0; i < s.dof; ++i) s.torque_per_amp_Nm_per_A[i] = robot.actuators[i].torque_per_amp();
+  const std::vector<double>& home = robot.initial_q_rad;
+  if (static_cast<int>(home.size()) == s.dof) s.reference_q_rad = Eigen::Map<const Eigen::VectorXd>(home.data(), s.dof);
+  return s;
+}
 namespace {
 
 bool all_finite(const Eigen::VectorXd& v) { return v.allFinite(); }

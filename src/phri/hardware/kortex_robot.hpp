@@ -51,6 +51,7 @@
 // written (writes are accepted and ignored).
 #include <phri/hardware/hardware_error.hpp>
 #include <phri/hardware/kortex_client.hpp>
+#include <phri/robot/robot_description.hpp>
 #include <phri/robot/robot_interface.hpp>
 
 #include <Eigen/Core>
@@ -89,6 +90,11 @@ struct KortexRobotSettings {
   /// Fills the F/T fields of the state each read() (the Bota driver, the emulator's plant); may be empty.
   std::function<void(RobotState&)> wrench_source;
 };
+
+/// The settings a robot's description gives (robot/robot_description.hpp): joints, torque per amp
+/// from its actuators, its home posture as the continuous joints' reference; the period is the
+/// controller's. Joint limits are the caller's (the controller's model).
+KortexRobotSettings kortex_robot_settings(const RobotDescription& robot, double period_s);
 
 /// The arm's own report and the link's counters, refreshed by read().
 struct KortexHealth {

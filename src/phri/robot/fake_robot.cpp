@@ -7,6 +7,18 @@
 
 namespace phri {
 
+FakeRobotSettings fake_robot_settings(const RobotDescription& robot, double period_s) {
+  FakeRobotSettings s;
+  s.dof = robot.dof();
+  s.period_s = period_s;
+  if (static_cast<int>(robot.initial_q_rad.size()) == s.dof) {
+    s.initial_q_rad = Eigen::Map<const Eigen::VectorXd>(robot.initial_q_rad.data(), s.dof);
+  }
+  s.torque_per_amp_Nm_per_A.resize(s.dof);
+  for (int i = 0; i < s.dof; ++i) s.torque_per_amp_Nm_per_A[i] = robot.actuators[i].torque_per_amp();
+  return s;
+}
+
 FakeRobot::FakeRobot(const FakeRobotSettings& settings) : n_(settings.dof), period_(settings.period_s) {
   if (settings.dof < 1) throw ConfigError("FakeRobotSettings", "dof", "must be >= 1");
   if (!(settings.period_s > 0.0)) throw ConfigError("FakeRobotSettings", "period_s", "must be > 0");

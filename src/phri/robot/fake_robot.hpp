@@ -29,6 +29,7 @@
 // the arm executes; an optional observer sees every write() and its status.
 //
 // read() and write() never throw and, without an observer that allocates, never allocate.
+#include <phri/robot/robot_description.hpp>
 #include <phri/robot/robot_interface.hpp>
 
 #include <Eigen/Core>
@@ -44,6 +45,9 @@ struct FakeRobotSettings {
   Eigen::VectorXd initial_q_rad;            ///< empty: zeros
   Eigen::VectorXd torque_per_amp_Nm_per_A;  ///< K_T G_r per joint for kCurrent; empty: ones
 };
+
+/// A fake of the described robot: its joints, its home posture, its actuators' torque per amp.
+FakeRobotSettings fake_robot_settings(const RobotDescription& robot, double period_s);
 
 /// Read or write numbers first .. first + count - 1 (1-based); count 0: none.
 struct CycleWindow {

@@ -19,7 +19,7 @@
 #include <phri/robot/actuator_table.hpp>
 #include <phri/robot/drive_kind.hpp>
 #include <phri/sim/drive_loops.hpp>
-#include <phri/sim/sim_robot_config.hpp>
+#include <phri/config/sim_robot_config.hpp>
 
 #include <vector>
 

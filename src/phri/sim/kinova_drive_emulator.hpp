@@ -37,7 +37,7 @@
 #include <phri/robot/drive_kind.hpp>
 #include <phri/robot/robot_command.hpp>
 #include <phri/sim/drive_loops.hpp>
-#include <phri/sim/sim_robot_config.hpp>
+#include <phri/config/sim_robot_config.hpp>
 
 #include <Eigen/Core>
 

@@ -5,8 +5,8 @@
 // the push point is uniform along the segment, on the surface in a uniform radial direction;
 // the force direction is uniform on the half-sphere pointing into the surface.
 #include <phri/core/random_generator.hpp>
-#include <phri/sim/external_force.hpp>
-#include <phri/sim/random_push_settings.hpp>
+#include <phri/config/external_force.hpp>
+#include <phri/config/random_push_settings.hpp>
 
 #include <Eigen/Core>
 

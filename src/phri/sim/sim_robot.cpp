@@ -412,6 +412,17 @@ void SimRobot::set_live_disturbance(int body, const ExternalForce& force) {
   live_force_.rise_s = force.rise_s;
 }
 
+void SimRobot::push(int target, const Eigen::Vector3d& point_m, const Eigen::Vector3d& force_world_N, double hold_s) {
+  ExternalForce force;  // no body name: no allocation
+  force.point_m = point_m;
+  force.frame = ExternalForce::Frame::kWorld;
+  force.force_N = force_world_N;
+  force.profile = ExternalForce::Profile::kStep;
+  force.start_s = state_.time_s;
+  force.duration_s = hold_s;
+  set_live_disturbance(target, force);
+}
+
 void SimRobot::restart_noise_and_counters() {
   joint_noise_.reseed(config_.seed, kJointNoiseStream);
   ft_noise_.reseed(config_.seed, kFtNoiseStream);

@@ -45,8 +45,9 @@
 #include <phri/sim/elastic_transmission.hpp>
 #include <phri/sim/mujoco_handles.hpp>
 #include <phri/sim/random_push_generator.hpp>
+#include <phri/robot/push_input.hpp>
 #include <phri/robot/robot_interface.hpp>
-#include <phri/sim/sim_robot_config.hpp>
+#include <phri/config/sim_robot_config.hpp>
 #include <phri/sim/stick_slip_friction.hpp>
 
 #include <Eigen/Core>
@@ -57,7 +58,7 @@
 
 namespace phri {
 
-class SimRobot final : public RobotInterface {
+class SimRobot final : public RobotInterface, public PushInput {
 public:
   using Vector6d = Eigen::Matrix<double, 6, 1>;
 
@@ -116,6 +117,10 @@ public:
   /// its profile over its start_s and duration_s. Replaces the previous one; body -1 clears it.
   /// No allocation.
   void set_live_disturbance(int body, const ExternalForce& force);
+
+  // ---- PushInput: a step force as a live disturbance from the latest state's time on.
+  int push_target(const std::string& link) const override { return body_id(link); }
+  void push(int target, const Eigen::Vector3d& point_m, const Eigen::Vector3d& force_world_N, double hold_s) override;
 
   /// MuJoCo model and data, read-only (viewers, tests comparing with MuJoCo's own quantities).
   const mjModel_* mujoco_model() const { return m_.get(); }

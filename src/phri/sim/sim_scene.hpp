@@ -17,7 +17,7 @@
 //
 // The arm's keyframes are removed (their qpos would not match once the drop mass adds a free
 // joint); the initial state comes from the plant configuration.
-#include <phri/sim/sim_robot_config.hpp>
+#include <phri/config/sim_robot_config.hpp>
 
 #include <string>
 #include <vector>

@@ -1,4 +1,4 @@
-#include <phri/app/log_row.hpp>
+#include <phri/app/fill_log_row.hpp>
 
 #include <phri/control/controller.hpp>
 #include <phri/app/fsm.hpp>

@@ -1,6 +1,6 @@
 #pragma once
 // phri::Event: what an operator (DS4 gamepad, app/gamepad.hpp) or a scripted timeline (the
-// `events:` list of a run config, app/config.hpp) asks of the FSM (app/fsm.hpp). One flat
+// `events:` list of a run config, config/config.hpp) asks of the FSM (app/fsm.hpp). One flat
 // enumeration: an event is a plain value, copied through lock-free queues and logged as its
 // integer code (the enumerator's value, stable: append new events at the end).
 //

@@ -1,6 +1,6 @@
 #pragma once
-// Physical ranges shared by the run YAML (app/config.cpp) and the robot bundle
-// (app/robot_bundle.cpp): a value beyond them is a unit mistake or a typo, not a setting.
+// Physical ranges shared by the run YAML (config/config.cpp) and the robot bundle
+// (config/robot_bundle.cpp): a value beyond them is a unit mistake or a typo, not a setting.
 namespace phri::physical_range {
 
 // What an arm carries beyond its URDF: at most 20 kg, 5x the Gen3's rated 4 kg payload (above, a

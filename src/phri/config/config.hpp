@@ -22,7 +22,7 @@
 //
 // Schema (top-level sections; all but `robot` and `plant` optional, absent keys keep the defaults
 // of the settings structs, which follow the paper where it gives a value):
-//   robot:       either a robot bundle's folder (robots/<robot>, see app/robot_bundle.hpp), or
+//   robot:       either a robot bundle's folder (robots/<robot>, see config/robot_bundle.hpp), or
 //                urdf, actuators, collision ('' for none), end_effector_frame (required),
 //                ft_sensor_offset_m (default 0), payloads [{name, frame, mass_kg, com_m,
 //                inertia_kgm2}] (default none: the library knows no arm's end of arm) -> ControllerSettings
@@ -41,14 +41,14 @@
 //                rotor_inertia_compensation}                                 -> ControllerSettings
 //   fsm:         first_scenario, stiffness_step, rest_speed_rad_s, startup {...}, static {...},
 //                dynamic {...}, brake {...}                                 -> FsmSettings
-//   events:      [{at: seconds, event: name}] (names: app/event.hpp)          -> FsmSettings::timeline
+//   events:      [{at: seconds, event: name}] (names: config/event.hpp)          -> FsmSettings::timeline
 //   logging:     enabled, path, buffer_rows, legend                           -> LoggerSettings
 //   gamepad:     enabled, poll_interval_ms, trigger_press, trigger_release    -> GamepadSettings
 //   run:         duration_s, pacing (real_time | lockstep)                    -> RunSettings
 //
 // Validation at load: unknown keys, duplicate keys, explicit nulls, wrong types, values outside
 // their physical range and inconsistent pairs are a phri::ConfigError naming the file and the key
-// path (the checks against the robot, app/config_checks.hpp, too), e.g. "controller.qp.collision.safety_distance_m"
+// path (the checks against the robot, config/config_checks.hpp, too; the plant against the URDF when the simulator is built, app/plant_check.hpp), e.g. "controller.qp.collision.safety_distance_m"
 // (d_s must be < d_i), "controller.compliance.release_threshold" (must be < touch_threshold),
 // "events[3].event". Input files (urdf, actuators, collision, plant file) are relative to the
 // folder of the YAML that names them and must exist; the log path (an output) is relative to the
@@ -56,25 +56,16 @@
 //
 // The compliance modes fix the gammas (0 or 1 per task, control/compliance_controller.hpp), so the
 // file has no gamma keys.
+#include <phri/config/fsm_settings.hpp>
+#include <phri/config/gamepad_settings.hpp>
+#include <phri/config/logger_settings.hpp>
+#include <phri/config/run_settings.hpp>
+#include <phri/config/sim_robot_config.hpp>
 #include <phri/control/controller_settings.hpp>
-#include <phri/app/fsm.hpp>
-#include <phri/app/gamepad.hpp>
-#include <phri/app/logger.hpp>
-#include <phri/app/loop_clock.hpp>
-#include <phri/sim/sim_robot_config.hpp>
 
 #include <string>
 
 namespace phri {
-
-struct RunSettings {
-  /// Longest run: one hour of robot time. The run loop keeps one cycle time (a double) per period
-  /// for its statistics, sized before the loop: 3.6e6 cycles at 1 kHz are 29 MB (1e9 s ended in
-  /// std::bad_alloc); a longer session is several runs.
-  static constexpr double kMaxDuration_s = 3600.0;
-  double duration_s = 30.0;  ///< robot time after which the run ends (if `stop` has not ended it)
-  LoopClock::Pacing pacing = LoopClock::Pacing::kRealTime;
-};
 
 struct Config {
   static Config from_yaml_file(const std::string& path);

@@ -3,7 +3,7 @@
 // pushes at random times on random arm links, at a random point of the link's surface (its
 // collision capsule), in a random direction into the surface, with a random magnitude and
 // duration. One push at a time.
-#include <phri/sim/external_force.hpp>
+#include <phri/config/external_force.hpp>
 
 #include <string>
 #include <vector>

@@ -10,15 +10,15 @@
 // phri::ConfigError(file, key path, reason), e.g. key path "plant.noise.torque_sensor_std_Nm".
 // Relative file names in the YAML are relative to the YAML file's directory.
 //
+// The simulator's configuration is the robot's description (robot/robot_description.hpp: URDF,
+// actuators, base, home posture, end of arm, payloads, drive) plus the plant-only settings here.
 // `actuators` is the nominal table of actuators.yaml (what the controller believes);
 // `actuator_overrides` and `friction_scale` make the plant's drives differ from it, and `mismatch`
 // perturbs the plant's link inertials relative to the URDF (model mismatch).
 #include <phri/core/error.hpp>
-#include <phri/robot/actuator_table.hpp>
-#include <phri/robot/drive_kind.hpp>
-#include <phri/robot/end_of_arm.hpp>
-#include <phri/sim/external_force.hpp>
-#include <phri/sim/random_push_settings.hpp>
+#include <phri/robot/robot_description.hpp>
+#include <phri/config/external_force.hpp>
+#include <phri/config/random_push_settings.hpp>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -30,23 +30,7 @@
 
 namespace phri {
 
-class YamlReader;
-
-/// A generic drive's position hold (GenericDrive), per joint; a list left empty takes the default
-/// rule of GenericDrive::hold_gains (critically damped at 30 Hz on the joint's inertia).
-struct GenericHoldGains {
-  std::vector<double> kp_Nm_per_rad;
-  std::vector<double> kd_Nms_per_rad;
-};
-
-/// The `drive:` key of robot.yaml and of a plant YAML, one grammar for both:
-///   drive: kinova | generic
-///   drive: {kind: generic, position_hold: {kp_Nm_per_rad: [...], kd_Nms_per_rad: [...]}}
-/// `drive` is the key's node; `dof` the joints. Gains of a `kinova` drive are refused (its
-/// position servo is the plant's vendor.position). Throws ConfigError naming the key path.
-DriveKind parse_drive(const YamlReader& drive, int dof, GenericHoldGains& hold);
-
-struct SimRobotConfig {
+struct SimRobotConfig : RobotDescription {
   static SimRobotConfig from_yaml_file(const std::string& path);
   /// `base_dir` resolves relative file names; `source_name` stands for the file in errors.
   static SimRobotConfig from_yaml_string(const std::string& yaml, const std::string& source_name,
@@ -62,39 +46,20 @@ struct SimRobotConfig {
 
   /// Joint-side parameters of the plant's drives: `actuators` with the overrides applied.
   ActuatorTable plant_actuators() const;
-  int dof() const { return actuators.size(); }
   double physics_step_s() const { return 1.0 / physics_rate_Hz; }
   int substeps_per_cycle() const;
 
   std::string source = "<SimRobotConfig>";  ///< file the config came from (error messages)
 
-  // ---- robot description
-  std::string mjcf_path;       ///< MJCF of the arm alone (robots/kinova_gen3/gen3_plant.xml); or:
-  /// the URDF the arm's MJCF is generated from (sim/urdf_plant.hpp), when mjcf_path is empty.
-  std::string urdf_path;
-  std::vector<std::string> locked_joints;  ///< URDF joints welded at 0 in the generated plant
+  // ---- how the plant is made: a hand-written MJCF of the arm alone (robots/kinova_gen3/gen3_plant.xml),
+  // or, when mjcf_path is empty, generated from the description's urdf_path (sim/urdf_plant.hpp)
+  std::string mjcf_path;
   bool balance_inertia = false;  ///< generated plant: MuJoCo's balanceinertia (a warning per link it changes)
   /// The file the arm comes from, for messages: mjcf_path, else urdf_path.
   const std::string& arm_file() const { return mjcf_path.empty() ? urdf_path : mjcf_path; }
-  std::string actuators_path;  ///< actuators.yaml
-  ActuatorTable actuators;     ///< nominal drive models, loaded from actuators_path
-
-  // ---- where the arm stands: gravity in the world frame and the placement in the world of the
-  // base link (the body `base_link`; '' : the arm's root bodies, the URDF's root link or the
-  // MJCF's bodies under <worldbody>); a robot bundle's frames.base, gravity_m_s2 and
-  // base_placement, which the controller's model gets too. The arm's root bodies move as one so
-  // that the base lands at base_placement, whatever fixed links lie between them and the base
-  // (a body with a joint there is refused: the base is fixed in the world).
-  std::string base_link;
-  Eigen::Vector3d gravity_m_s2 = Eigen::Vector3d(0.0, 0.0, -9.81);
-  Eigen::Isometry3d base_placement = Eigen::Isometry3d::Identity();
-
   // ---- timing
   double physics_rate_Hz = 4000.0;  ///< MuJoCo step rate; multiple of 1 kHz (the Kortex filter rate)
   double control_period_s = 0.001;  ///< read()/write() period; multiple of the physics step
-
-  // ---- initial state: the arm starts at rest, holding initial_q in Position mode
-  std::vector<double> initial_q_rad;  ///< one per joint
 
   std::uint64_t seed = 1;  ///< sensor noise and random pushes
 
@@ -125,48 +90,6 @@ struct SimRobotConfig {
     double encoder_counts_per_rev = 262144.0;  ///< position quantum 2 pi / counts; 0: no quantisation
   } noise;
 
-  // ---- the end of arm: an F/T sensor at the flange and the tool below it, a tool alone on the
-  // flange, or neither (a bare flange). Without a sensor there is no F/T sample ever
-  // (RobotState::wrench never valid). A plant YAML has one when it gives the `ft_sensor` and
-  // `tool` sections, or `tool` alone (with its flange_site); no default describes a particular arm.
-  bool has_end_of_arm = false;
-  bool has_ft_sensor = true;  ///< with has_end_of_arm: false for a tool on the flange, no sensor
-  /// An F/T sensor is there to be read (external_torque_source ft or fused needs one).
-  bool ft_sensor_present() const { return has_end_of_arm && has_ft_sensor; }
-  struct FtSensor {
-    /// MJCF site of the tool flange (z out of the flange), where the end of arm mounts (the tool
-    /// itself when there is no sensor)
-    std::string flange_site;
-    /// The sensor's measuring frame in the flange site's frame (EndOfArm::sensor_mount): the
-    /// tool body's pose on the adapter, its origin the sensor site.
-    Eigen::Isometry3d sensor_mount = Eigen::Isometry3d::Identity();
-    double flange_side_mass_kg = 0.0;  ///< not measured by the sensor
-    Eigen::Vector3d flange_side_com_m = Eigen::Vector3d::Zero();  ///< flange frame
-    Eigen::Vector3d flange_side_inertia_kgm2 = Eigen::Vector3d::Zero();
-    double rate_Hz = 1000.0;
-    double force_std_N = 0.05;
-    double torque_std_Nm = 0.002;
-    Eigen::Vector3d force_bias_N = Eigen::Vector3d::Zero();
-    Eigen::Vector3d torque_bias_Nm = Eigen::Vector3d::Zero();
-  } ft_sensor;
-
-  // ---- the tool below the F/T sensor
-  struct Tool {
-    double mass_kg = 0.0;
-    Eigen::Vector3d com_m = Eigen::Vector3d::Zero();         ///< sensor frame
-    Eigen::Vector3d inertia_kgm2 = Eigen::Vector3d::Zero();  ///< principal, sensor axes
-  } tool;
-
-  /// The end of arm's bodies (nullopt: a bare flange), and the same the other way; the flange
-  /// site and the sensor's rate, noise and bias are left as they are.
-  std::optional<EndOfArm> end_of_arm() const;
-  void set_end_of_arm(const std::optional<EndOfArm>& end_of_arm);
-
-  /// Bodies welded into links of the arm (a robot bundle's `payloads`), each a child body of the
-  /// link's body with its inertial; none by default. A link that is no body of the arm's MJCF is
-  /// a ConfigError at "payloads[i].link".
-  std::vector<LinkPayload> payloads;
-
   // ---- link inertial and drive-gain mismatch relative to the URDF and actuators.yaml
   struct Mismatch {
     bool enabled = false;
@@ -179,14 +102,6 @@ struct SimRobotConfig {
     /// vendor's loops keep converting with the nominal value, as real firmware does.
     double torque_constant_fraction = 0.0;
   } mismatch;
-
-  // ---- whose drives: Kinova's loops, emulated (KinovaDriveEmulator, the `vendor` section), or a
-  // generic current/torque drive (GenericDrive: a PD position hold with generic_hold's gains, no
-  // integrator; plain torque; current). The plant YAML's `drive:` (default kinova) or a robot
-  // bundle's, which must agree when both say it (RobotBundle::apply_to).
-  DriveKind drive = DriveKind::kKinova;
-  bool drive_stated = false;  ///< the plant YAML has a `drive:` key
-  GenericHoldGains generic_hold;  ///< drive generic: the hold's gains (empty: GenericDrive::hold_gains' rule)
 
   // ---- the vendor's actuator loops, emulated inside the plant (see KinovaDriveEmulator)
   struct Vendor {

@@ -18,7 +18,7 @@
 // naming robot.yaml and the key path (e.g. "end_of_arm.tool.mass_kg").
 #include <phri/control/controller_settings.hpp>
 #include <phri/robot/drive_kind.hpp>
-#include <phri/sim/sim_robot_config.hpp>
+#include <phri/config/sim_robot_config.hpp>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>

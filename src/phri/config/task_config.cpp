@@ -1,4 +1,4 @@
-#include <phri/app/task_config.hpp>
+#include <phri/config/task_config.hpp>
 
 #include <phri/control/task_registry.hpp>
 

@@ -1,14 +1,14 @@
-#include <phri/app/config.hpp>
+#include <phri/config/config.hpp>
 
-#include <phri/app/config_checks.hpp>
-#include <phri/app/task_config.hpp>
-#include <phri/app/robot_bundle.hpp>
+#include <phri/config/config_checks.hpp>
+#include <phri/config/robot_bundle.hpp>
+#include <phri/config/task_config.hpp>
 
 #include <phri/core/format.hpp>
 #include <phri/core/yaml_reader.hpp>
 #include <phri/robot/actuator_table.hpp>
 
-#include <phri/app/physical_ranges.hpp>
+#include <phri/config/physical_ranges.hpp>
 
 #include <cmath>
 #include <filesystem>
@@ -485,8 +485,8 @@ void parse_run(const YamlReader& r, RunSettings& s) {
                                     format_general(s.duration_s, 10));
   }
   if (r.has("pacing")) {
-    s.pacing = r.choice("pacing", {"real_time", "lockstep"}) == "real_time" ? LoopClock::Pacing::kRealTime
-                                                                          : LoopClock::Pacing::kLockstep;
+    s.pacing = r.choice("pacing", {"real_time", "lockstep"}) == "real_time" ? LoopPacing::kRealTime
+                                                                 : LoopPacing::kLockstep;
   }
 }
 

@@ -1,5 +1,5 @@
-#include <phri/app/robot_bundle.hpp>
-#include <phri/app/physical_ranges.hpp>
+#include <phri/config/robot_bundle.hpp>
+#include <phri/config/physical_ranges.hpp>
 
 #include <phri/core/format.hpp>
 #include <phri/core/rpy.hpp>

@@ -2,14 +2,14 @@
 // The checks of a run configuration that need the robot it names, run by Config's loaders once
 // every section is parsed (each a phri::ConfigError naming the key path, or the robot file and
 // its element):
-//   * the controller's URDF against the simulated plant's MJCF: the same joints, hinges where the
-//     plant has hinges, no limit wider than the plant's, no 'continuous' joint the plant limits;
 //   * robot.end_effector_frame moved by every joint (a frame upstream of the last joint, or the
 //     base, cannot carry the end-effector task nor the F/T sensor);
 //   * the postures the run starts from or goes to (plant.initial.q_rad, fsm.startup.home_q_rad,
 //     fsm.static.posture_q_rad) within the URDF's joint limits and clear of self-collision: no
 //     capsule pair closer than controller.qp.collision.safety_distance_m.
-#include <phri/app/config.hpp>
+// The plant's MJCF against the URDF needs MuJoCo: the simulator's backend checks it
+// (app/plant_check.hpp) before the run.
+#include <phri/config/config.hpp>
 
 #include <string>
 #include <vector>

@@ -1,5 +1,5 @@
 #pragma once
-// phri::LogRow: one control cycle as the logger records it (app/logger.hpp): a fixed-size,
+// phri::LogRow: one control cycle as the logger records it (app/logger.hpp; filled by app/fill_log_row.hpp): a fixed-size,
 // trivially copyable record, so that the control thread copies it into a preallocated ring slot
 // with no allocation. Joint vectors hold up to kLogMaxJoints joints (the Gen3 has 7); the logger
 // writes the first `dof` of them.
@@ -29,10 +29,6 @@
 #include <cstdint>
 
 namespace phri {
-
-class Controller;
-class Fsm;
-struct RobotState;
 
 inline constexpr int kLogMaxJoints = 7;
 
@@ -114,11 +110,5 @@ void visit_log_columns(const LogRow& r, int dof, Visitor&& v) {
   v.number("stiffness_scale", r.stiffness_scale);
   v.number("cycle_time_s", r.cycle_time_s);
 }
-
-/// Fills every field the robot state and the control cycle give (after cycle.step()): all but
-/// fsm_state, event and cycle_time_s. No allocation.
-void fill_log_row(LogRow& row, const RobotState& state, const Controller& cycle);
-/// ... and fsm_state and event from the FSM (event: the last one its last update handled).
-void fill_log_row(LogRow& row, const RobotState& state, const Controller& cycle, const Fsm& fsm);
 
 }  // namespace phri

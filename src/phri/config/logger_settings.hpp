@@ -1,0 +1,31 @@
+#pragma once
+// The logger's settings (app/logger.hpp), read from a run YAML's `logging:`; the ring's bound
+// follows from the row's size (config/log_row.hpp).
+#include <phri/config/log_row.hpp>
+
+#include <cstddef>
+#include <string>
+
+namespace phri {
+
+/// Memory bound of the log ring: at most 100 MiB of rows waiting for the writer thread. The ring
+/// only absorbs the writer's stalls; 131072 rows of sizeof(LogRow) (~700 B) are 2 min at 1 kHz,
+/// and a larger ring only costs memory (4194304 rows took 2.9 GB).
+inline constexpr std::size_t kLogRingMaxBytes = std::size_t{100} << 20;
+
+/// Largest ring size within kLogRingMaxBytes (a power of two: the ring rounds its size up to one).
+constexpr std::size_t log_ring_max_rows() {
+  std::size_t rows = 2;
+  while (2 * rows * sizeof(LogRow) <= kLogRingMaxBytes) rows *= 2;
+  return rows;
+}
+
+struct LoggerSettings {
+  std::string path = "phri_log.csv";  ///< CSV file (truncated); its folder must exist
+  int dof = kLogMaxJoints;            ///< joints written per group (<= kLogMaxJoints)
+  std::size_t capacity_rows = 16384;  ///< ring size (rounded up to a power of two), <= log_ring_max_rows()
+  bool write_legend = true;           ///< write the <path>.legend.yaml sidecar
+  int writer_sleep_ms = 2;            ///< writer's pause when the ring is empty
+};
+
+}  // namespace phri
