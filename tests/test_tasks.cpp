@@ -55,6 +55,15 @@ phri::TaskSpec spec(const std::string& type, const std::string& name) {
   return s;
 }
 
+// The end effector's inertia along -z with its other axes held, n' (J M^-1 J')^-1 n.
+double inertia_along_minus_z(const Arm& arm) {
+  Eigen::MatrixXd j(6, 7);
+  phri::frame_jacobian(arm.model, arm.data, arm.ee, phri::ReferenceFrame::kLocalWorldAligned, j);
+  const Eigen::MatrixXd m_inverse = arm.data.mass_matrix.inverse();
+  const Eigen::MatrixXd lambda = (j * m_inverse * j.transpose()).inverse();
+  return lambda(2, 2);  // n = -z: the sign cancels
+}
+
 // H and g of one task alone.
 std::pair<Eigen::MatrixXd, Eigen::VectorXd> objective(const phri::Task& task) {
   Eigen::MatrixXd h = Eigen::MatrixXd::Zero(7, 7);
@@ -69,27 +78,34 @@ TEST(ForceTask, RowIsTheAxisAlongTheFiniteDifferenceJacobianAndReferenceTheAdmit
   s.numbers["force_N"] = {10.0};
   s.numbers["axis"] = {0.0, 0.0, -1.0};
   s.numbers["weight"] = {2.0};
+  s.numbers["max_speed_m_s"] = {0.5};
   auto task = phri::make_task(s, arm.build());
-  // The environment pushes the robot up with 4 N: the robot applies 4 N down, 6 N short of 10.
+  // The environment pushes the robot up with 6 N: the robot applies 6 N down, 4 N short of 10.
   phri::Vector6d wrench = phri::Vector6d::Zero();
-  wrench[2] = 4.0;
+  wrench[2] = 6.0;
   task->update(arm.context(&wrench));
   const auto [h, g] = objective(*task);
   const Eigen::RowVectorXd row = Eigen::Vector3d(0, 0, -1).transpose() * arm.linear_jacobian_fd(arm.ee);
   EXPECT_LT((h - 2.0 * row.transpose() * row).norm(), 1e-6);
-  // At rest: b = D k_a (f* - f) = 50 * 1e-3 * 6 (defaults), g = -w b a.
-  EXPECT_LT((g + 2.0 * (50.0 * 1e-3 * 6.0) * row.transpose()).norm(), 1e-6);
+  // At rest: b = D v* = g (f* - f) / Lambda_n, Lambda_n = n' (J M^-1 J')^-1 n (the default gain 1), g = -w b a.
+  const double lambda = inertia_along_minus_z(arm);
+  EXPECT_LT((g + 2.0 * (4.0 / lambda) * row.transpose()).norm(), 1e-6);
+  // A speed bound below v*: b = D v_max (default D 100).
+  s.numbers["max_speed_m_s"] = {0.001};
+  auto slow = phri::make_task(s, arm.build());
+  slow->update(arm.context(&wrench));
+  const auto [h2, g2] = objective(*slow);
+  EXPECT_LT((g2 + 2.0 * (100.0 * 0.001) * row.transpose()).norm(), 1e-6);
 }
 
 TEST(ForceTask, WithoutAnFtSensorTheWrenchIsTheLeastSquaresOneThatExplainsTauExt) {
   Arm arm;
   phri::TaskSpec s = spec("force", "press");
   s.numbers["force_N"] = {0.0};
-  s.numbers["admittance_m_per_s_N"] = {1.0 / 50.0};  // b = f* - f directly (D k_a = 1)
   s.numbers["max_speed_m_s"] = {0.5};
   auto task = phri::make_task(s, arm.build());
   // A 7 N push down on the end effector: tau_ext = J^T F; along n = -z the robot applies
-  // f = -n.F = -7 N, so b = f* - f = 7.
+  // f = -n.F = -7 N, so b = (f* - f) / Lambda_n = 7 / Lambda_n.
   Eigen::MatrixXd j(6, 7);
   phri::frame_jacobian(arm.model, arm.data, arm.ee, phri::ReferenceFrame::kLocalWorldAligned, j);
   phri::Vector6d push = phri::Vector6d::Zero();
@@ -99,7 +115,7 @@ TEST(ForceTask, WithoutAnFtSensorTheWrenchIsTheLeastSquaresOneThatExplainsTauExt
   const auto [h, g] = objective(*task);
   const Eigen::RowVectorXd row = -j.row(2);
   EXPECT_LT((h - 1e4 * row.transpose() * row).norm(), 1e-6);
-  EXPECT_LT((g + 1e4 * 7.0 * row.transpose()).norm() / 1e4, 1e-6);
+  EXPECT_LT((g + 1e4 * (7.0 / inertia_along_minus_z(arm)) * row.transpose()).norm() / 1e4, 1e-6);
 }
 
 TEST(FrameTask, RowsAreTheLinkPositionJacobianSelectedAndTheReferenceASpringToTheTarget) {

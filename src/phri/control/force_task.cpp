@@ -1,16 +1,18 @@
 // Cartesian force task (not in the paper; the classic polishing and insertion use): the end
-// effector presses with the force f* along an axis n while other tasks hold the other axes,
-// through an admittance along n:
+// effector presses with the force f* along an axis n while other tasks hold the other axes:
 //
-//   w || n^T (J qdd + J̇ qd) - D (v* - n^T v) - gamma n^T J M^-1 tau_ext ||^2,   v* = k_a (f* - f)
+//   w || n^T (J qdd + J̇ qd) - D (v* - n^T v) - gamma n^T J M^-1 tau_ext ||^2
+//   v* = clamp(g (f* - f) / (Lambda_n D), +-v_max)
 //
 // f = -n^T F is the force the end effector applies along n, F the environment's wrench on the
 // robot (world axes): the F/T sensor's when a plausible one is in use, else the least-squares
-// wrench that explains tau_ext, (J J^T)^-1 J tau_ext. Inverse dynamics already holds the contact
-// force the observer sees (tau_d = M qdd + h - tau_ext), so the admittance only corrects the
-// difference. Away from a surface the end effector approaches at k_a f* (at most max_speed); on a
-// surface of stiffness k the penetration x follows x'' + D x' + D k_a k x = D k_a f*: the force
-// settles at f* for any k, without overshoot up to k = D / (4 k_a) (12.5 kN/m with the defaults).
+// wrench that explains tau_ext, (J J^T)^-1 J tau_ext. Lambda_n = n^T (J M^-1 J^T)^-1 n is the end
+// effector's inertia along n with its other axes held. In contact (v = 0) the task asks the
+// acceleration g (f* - f) / Lambda_n, i.e. the extra force g (f* - f): a force loop of gain g
+// (dimensionless, default 1) whatever the arm's posture. Inverse dynamics holds the contact force
+// the observer has already seen (tau_d = M qdd + h - tau_ext), which makes the loop integral: the
+// force converges to f* at the observer's rate. In free space the same law approaches the surface
+// at g f* / (Lambda_n D), at most v_max.
 #include <phri/control/task_registry.hpp>
 
 #include <phri/model/algorithms.hpp>
@@ -30,14 +32,15 @@ public:
         frame_id_(frame_id),
         frame_axes_(spec.word("axes", "world", {"world", "frame"}) == "frame"),
         force_(spec.number("force_N", 10.0, -200.0, 200.0)),
-        admittance_(spec.number("admittance_m_per_s_N", 1e-3, 0.0, 0.1)),
-        damping_(spec.number("damping", 50.0, 0.0, 1e3)),
-        max_speed_(spec.number("max_speed_m_s", 0.05, 0.0, 0.5)),
+        gain_(spec.number("force_gain", 1.0, 0.0, 2.0)),
+        damping_(spec.number("damping", 100.0, 1.0, 1e3)),
+        max_speed_(spec.number("max_speed_m_s", 0.02, 0.0, 0.5)),
         weight_(spec.number("weight", 1e4, 0.0, 1e8)),
         gamma_(spec.number("gamma", 0.0, 0.0, 1.0)),
         fixed_gamma_(role() == ComplianceRole::kNone || spec.has("gamma")),
         jacobian_(Eigen::MatrixXd::Zero(6, model.nv())),
-        row_(Eigen::RowVectorXd::Zero(model.nv())) {
+        row_(Eigen::RowVectorXd::Zero(model.nv())),
+        mobility_(Eigen::MatrixXd::Zero(model.nv(), 6)) {
     const Eigen::Vector3d axis = spec.three("axis", Eigen::Vector3d(0.0, 0.0, -1.0), -1.0, 1.0);
     if (!(axis.norm() > 1e-6)) spec.fail("axis", "must not be zero");
     axis_ = axis.normalized();
@@ -56,7 +59,8 @@ public:
     row_.noalias() = n.transpose() * jacobian_.topRows<3>();
     const Vector6d wrench = c.ee_wrench_world ? *c.ee_wrench_world : estimated_wrench(c.tau_ext);
     force_measured_ = -n.dot(wrench.head<3>());
-    const double speed_target = std::clamp(admittance_ * (force_ - force_measured_), -max_speed_, max_speed_);
+    const double speed_target =
+        std::clamp(gain_ * (force_ - force_measured_) / (inertia_along(c.data, n) * damping_), -max_speed_, max_speed_);
     const double speed = n.dot(frame_velocity(c.model, c.data, frame_id_, ReferenceFrame::kLocalWorldAligned).head<3>());
     const double drift = n.dot(frame_jdot_qdot(c.model, c.data, frame_id_, ReferenceFrame::kLocalWorldAligned).head<3>());
     reference_ = damping_ * (speed_target - speed) - drift + gamma_ * row_.dot(c.qdd_external);
@@ -67,10 +71,20 @@ public:
     gradient.noalias() -= (weight_ * reference_) * row_.transpose();
   }
 
-  /// The force along the axis the end effector applies (last update) [N].
-  double force_measured() const { return force_measured_; }
-
 private:
+  // Lambda_n = n^T (J M^-1 J^T)^-1 n, the task-space inertia along n with the other axes held [kg].
+  double inertia_along(const Data& data, const Eigen::Vector3d& n) {
+    mobility_ = jacobian_.transpose();
+    data.mass_matrix_llt.solveInPlace(mobility_);  // M^-1 J^T
+    jjt_.noalias() = jacobian_ * mobility_;
+    jjt_.diagonal().array() += 1e-9;
+    llt_.compute(jjt_);
+    projected_.head<3>() = n;
+    projected_.tail<3>().setZero();
+    const double inverse = projected_.dot(llt_.solve(projected_));
+    return std::max(inverse, 1e-3);
+  }
+
   // The wrench that explains tau_ext at the end effector, least squares: J^T F = tau_ext.
   Vector6d estimated_wrench(const Eigen::VectorXd& tau_ext) {
     jjt_.noalias() = jacobian_ * jacobian_.transpose();
@@ -83,10 +97,11 @@ private:
   int frame_id_;
   bool frame_axes_;
   Eigen::Vector3d axis_;
-  double force_, admittance_, damping_, max_speed_, weight_, gamma_;
+  double force_, gain_, damping_, max_speed_, weight_, gamma_;
   bool fixed_gamma_;
   Eigen::MatrixXd jacobian_;
   Eigen::RowVectorXd row_;
+  Eigen::MatrixXd mobility_;  // M^-1 J^T, nv x 6
   double reference_ = 0.0;
   double force_measured_ = 0.0;
   Eigen::Matrix<double, 6, 6> jjt_;
@@ -104,7 +119,7 @@ std::unique_ptr<Task> make_force_task(const TaskSpec& spec, const TaskBuildConte
 const TaskType& force_task_type() {
   static const TaskType type{"force",
                              "a contact force along an axis at the end effector",
-                             {"axis", "axes", "force_N", "admittance_m_per_s_N", "damping", "max_speed_m_s",
+                             {"axis", "axes", "force_N", "force_gain", "damping", "max_speed_m_s",
                               "weight", "gamma", "role"},
                              &make_force_task};
   return type;

@@ -276,6 +276,7 @@ void SimRobot::perturb_link_inertials(const std::vector<int>& arm_bodies) {
 }
 
 void SimRobot::find_ft_sensor() {
+  floor_geom_ = mj_name2id(m_.get(), mjOBJ_GEOM, SimScene::kFloorGeom);  // the floor's contacts are truth too
   if (!config_.has_end_of_arm) return;  // a bare flange: no sensor, no tool
   tool_body_ = mj_name2id(m_.get(), mjOBJ_BODY, SimScene::kToolBody);
   if (!config_.has_ft_sensor) {  // a tool on the flange: no sensor to read
@@ -295,7 +296,6 @@ void SimRobot::find_ft_sensor() {
 void SimRobot::find_drop_test() {
   anchor_site_ = mj_name2id(m_.get(), mjOBJ_SITE, SimScene::kAnchorSite);
   drop_body_ = mj_name2id(m_.get(), mjOBJ_BODY, SimScene::kDropBody);
-  floor_geom_ = mj_name2id(m_.get(), mjOBJ_GEOM, SimScene::kFloorGeom);
   const int free = m_->body_jntadr[drop_body_];
   drop_qadr_ = m_->jnt_qposadr[free];
   drop_dadr_ = m_->jnt_dofadr[free];
