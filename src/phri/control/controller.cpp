@@ -16,11 +16,8 @@ namespace phri {
 namespace {
 // What the controller may ask of a drive beyond the QP's torque limit (the guards, the safe stop's
 // brake): this fraction of its peak torque. The rest is K_T's spread (5 % on the plant): the robot
-// refuses a torque beyond its own peak, and the refused command leaves the last accepted one
-// running (safety-fuzz seed 31337 with the guards at the full peak; seed 11111,
-// full_body/kinova_torque_high_velocity/0, with the brake at the full peak: 83 refused writes,
-// joint 1 at 1.115x). 0.9 was no reach at all on the Gen3's large joints (QP limit 95 N.m, peak
-// 105): a push taking 98.6 % of joint 2's QP limit left the brake 1.3 N.m (same window, 1.085x).
+// refuses a torque beyond its own peak and keeps the last accepted one; 0.9 left the brake no reach
+// on the Gen3's large joints (QP limit 95 N.m, peak 105) (replayed: SafetyFuzz.FormerFailuresReplayedPass, seed 31337).
 constexpr double kDriveReach = 0.94;
 
 void require_end_effector_frame(const ControllerSettings& settings) {
@@ -571,8 +568,8 @@ void Controller::brake_reference() {
 // and beyond a joint's safety distance d_s from its limit, the component of tau_ext pointing away
 // from the limit may be the hard stop's reaction, not a hand: fed back, it would make tau_d press
 // into the stop (the observer then reads the stop's answer as a push, and so on). It is dropped
-// there. Not in the whole damper band d_i: a hand pushing a joint out of it at speed would be
-// hidden from the velocity constraint (safety-fuzz seed 8642, 1.06x the limit on joint 4).
+// there. Not in the whole damper band d_i, where it could hide a hand pushing the joint out at speed
+// (replayed: SafetyFuzz.FormerFailuresReplayedPass, seed 8642).
 void Controller::bound_external_torque() {
   for (int i = 0; i < model_.nv(); ++i) {
     const double bound = settings_.safety.external_torque_bound_factor * torque_limit_[i];
@@ -586,16 +583,14 @@ void Controller::bound_external_torque() {
 // The last lines behind the QP, on the torque (torque_guards.hpp):
 // - velocity guard: damping rate x (M_ii + I_r) on the excess speed above velocity_guard_fraction
 //   of the drive's limit, scaled down where joints that share an axis would make it ring
-//   (guard_coupling_scale). It acts on the latest sample: a 189 N step on the Gen3's half_arm_2_link
-//   took joint 3 from rest to 1.09x in 8 ms, and the two-sample mean used before (against that
-//   ringing) acted one cycle late (safety-fuzz seed 31337, full_body/custom/22; now 0.99x);
+//   (guard_coupling_scale). It acts on the latest sample: a mean acts a cycle late on a step
+//   (replayed: SafetyFuzz.FormerFailuresReplayedPass, seed 31337 full_body/custom/22);
 // - limit guard: beyond a limit's safety distance d_s an outward torque of the joint's static
 //   friction plus a spring on the depth (the damper's acceleration alone is below stiction, so a
 //   joint could rest there);
 // - collision guard: capsule pairs inside d_s pushed apart through their distance Jacobian. The
-//   QP's damper asks the same through the acceleration, but under a strong push the torque loops'
-//   tracking error let a pair through d_s to contact (-1.65 mm, seed 4242, full_body/kinova_torque/21,
-//   the QP feasible throughout; now 10.7 mm at the closest).
+//   QP's damper asks the same through the acceleration, but the torque loops' tracking error can
+//   let a pair through d_s under a strong push (replayed: SafetyFuzz.FormerFailuresReplayedPass, seed 4242 full_body/kinova_torque/21).
 // A guard that acts may go beyond the QP's limit up to kDriveReach of the drive's peak torque.
 void Controller::guard_torque(Eigen::VectorXd& tau) {
   // g <= 1.5 in guard_coupling_scale (replays measured before the QP's return gain): 1.0 left
@@ -726,9 +721,8 @@ CycleStatus Controller::step(const RobotState& state, const ControllerTargets& t
                              : settings_.period_s;
   if (supervisor_.safe_stop()) {
     // After a QP failure (the samples good, a push beyond what the constraints could answer) the
-    // brake keeps resisting the push as the QP's fallback did: dropping it flung the arm (safety-
-    // fuzz seed 24680, full_body/custom/3: a 154 N step on bracelet_link, joint 6 from 0.76x to
-    // 2.66x its velocity limit within 60 ms of the safe stop). The estimate stays current.
+    // brake keeps resisting the push as the QP's fallback did (dropping it flings the arm). The
+    // estimate stays current.
     if (good && brake_against_push_ && !holding_) {
       q_ = state.q_rad;
       qd_ = state.qd_rad_s;

@@ -72,23 +72,18 @@ struct SafetySettings {
   /// acceleration over max_degraded_s, reaches the velocity limit: a safe stop at once
   /// (missed_at_speed) instead of the previous command for the degraded budget. Off by default:
   /// it stops a link that loses single frames while the arm moves fast (the Kortex link's loss
-  /// budget rides through 0.3 %), and its hold entry at speed is a torque step (107 N.m at 1.9 rad/s
-  /// through the Kortex emulator). `phri experiment safety-fuzz --seed 3 --pushes 48`: 14 controller
-  /// failures off, 9 on (dual compliance, a hand pulling the tool at 0.9x the limit).
+  /// budget rides through 0.3 %), and its hold entry at speed is a torque step (docs/safety.md).
   bool stop_missed_at_speed = false;
   /// Velocity guard of the torque loops, the last line behind the QP's velocity constraint: above
   /// guard_fraction x the drive's velocity limit, damping rate x (M_ii + I_r) x the excess, scaled
   /// down where coupled joints would ring (torque_guards.hpp).
   double velocity_guard_fraction = 0.9;
-  /// [1/s] Replaying the runs of safety-fuzz seeds 4242 and 2026 with controller failures (17
-  /// overspeed windows at 200): 5 left at 300; 400 (measured beside a check since removed) left 3;
-  /// at 600 and 800 the custom loop's torque chattered (refused writes, limits crossed). 300 keeps
-  /// a gain margin of 2 to that.
+  /// [1/s] A gain margin of 2 below where the custom loop's torque chatters (600).
   double velocity_guard_rate = 300.0;
   /// Limit guard: beyond the damper's safety distance d_s, an outward torque of the joint's static
   /// friction plus stiffness x the depth, so that a joint leaves the band against its stiction and
   /// a hand pressing it in meets a growing answer: ~50 N.m at the URDF limit (d_s 0.05 rad on the
-  /// Gen3). At 200 a 160 N push held joint 4 0.2 mrad past its limit (safety-fuzz seed 8642).
+  /// Gen3) (replayed: SafetyFuzz.FormerFailuresReplayedPass, seed 8642).
   double limit_guard_stiffness_Nm_per_rad = 1000.0;
   /// Collision guard: a capsule pair closer than the damper's safety distance d_s is pushed apart
   /// through its distance Jacobian, J_d^T (stiffness x depth + damping x approach speed)

@@ -13,8 +13,7 @@
 //
 // Release path: a push that ends leaves r behind for ~1/K_O, and a controller that cancels r
 // goes on pushing for the human who has let go: the arm gets the kick -M^-1 r. Where that kick
-// drives a fast joint along its motion, near its velocity limit it is an overspeed (safety-fuzz:
-// up to 1.28x, full-body compliance). A second observer of gain release_gain runs beside; while
+// drives a fast joint along its motion, near its velocity limit it is an overspeed. A second observer of gain release_gain runs beside; while
 // -M^-1 r points along the velocity of a joint faster than its release_speed (over 10 ms), each
 // r_i whose fast estimate is below |r_i| by more than release_threshold drops to it at once (only
 // toward zero). Otherwise r keeps its K_O low-pass: a bouncing load (the drop test) must be

@@ -13,9 +13,8 @@
 namespace phri {
 
 /// Braking distance ahead of the damper (ours, not the paper's). The damper allows xi (0.08 m/s) at
-/// d_i (3 cm) and nothing bounds the approach outside d_i: a push carried the Gen3's bracelet at
-/// ~1 m/s into d_i, where stopping within d_i - d_s asks ~30 m/s^2, beyond the torque limits (the
-/// QP fell back; 8.7 mm of penetration, safety-fuzz seed 5150, full_body/kinova_torque/1). So the
+/// d_i (3 cm) and nothing bounds the approach outside d_i, where a push can carry a link faster than
+/// the torque limits stop within d_i - d_s (replayed: SafetyFuzz.FormerFailuresReplayedPass, seed 5150 full_body/kinova_torque/1). So the
 /// approach speed is also bounded by what `deceleration` stops before d_s:
 /// -ḋ <= v(d) = min(sqrt(2 a (d - d_s)), gain / 5 (d - d_s)), as d̈ >= -gain (ḋ + v(d)) (the
 /// linear end keeps the lag of a first-order tracker from overshooting d_s where the square root's

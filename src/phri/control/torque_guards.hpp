@@ -14,9 +14,8 @@ namespace phri {
 /// torque, it changes the guarded joints' speeds by T (M^-1)_SS D e per cycle (T the period, M^-1
 /// the mobility, S the guarded set). A per-joint rate x M_ii is stable alone only where
 /// M_ii (M^-1)_ii is small: where another joint turns about nearly the same axis (the Gen3's joints
-/// 1 and 3 near q2 = 0) it reaches ~7.5, and the guard at 300/s, g = rate T M_ii (M^-1)_ii ~ 2.25,
-/// made joints 1 and 3 ring at 250 Hz, +-0.45 rad/s about 0.9 v_max, to 1.14x (safety-fuzz seed
-/// 60606, full_body/custom/0). Returns the scale in (0, 1] that keeps the largest eigenvalue of
+/// 1 and 3 near q2 = 0) it reaches ~7.5, and a per-joint guard rings (replayed: SafetyFuzz.FormerFailuresReplayedPass, seed 60606
+/// full_body/custom/0). Returns the scale in (0, 1] that keeps the largest eigenvalue of
 /// T D^1/2 (M^-1)_SS D^1/2 (bounded by Gershgorin's row sums) within max_step; 1 where nothing is
 /// guarded.
 inline double guard_coupling_scale(const Eigen::MatrixXd& mobility, const Eigen::VectorXd& damping,

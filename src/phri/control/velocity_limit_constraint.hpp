@@ -6,10 +6,8 @@
 // Braking reserve (ours, not the paper's). A limit the joint can reach is only as good as the
 // torque left to stop it there. Moving toward +, a joint brakes with tau >= -tau_max, which leaves
 // the reserve tau_max + hold, hold = h - tau_ext being the torque that holds it against gravity,
-// its motion and the push (toward -: tau_max - hold). A push that takes nearly all of a joint's
-// torque (a 160 N step on the Gen3's bracelet asks 96 % of joint 2's 95 N.m) left full-body
-// compliance carrying the joint to 0.9 v_max with ~2 N.m to stop it: the QP went infeasible and
-// the joint reached 1.10 x its limit (safety-fuzz seed 5150, full_body/custom/17). So below
+// its motion and the push (toward -: tau_max - hold); a push that takes nearly all of it leaves
+// too little to brake from v_max (replayed: SafetyFuzz.FormerFailuresReplayedPass, seed 5150 full_body/custom/17). So below
 // reserve_fraction x tau_max of reserve in a direction, that direction's limit falls linearly
 // with the reserve, down to min_speed_fraction x v_max at none. A joint already faster than the
 // lowered limit is asked no more deceleration than its reserve gives (reserve / (M_ii lambda) of
@@ -86,12 +84,9 @@ public:
 
   /// The deceleration asked of joint i, `over` faster than its limit in one direction (negative:
   /// below it, an acceleration allowed): gain x over, and beyond the limit up to return_gain x over
-  /// within what the direction's reserve decelerates the joint at (reserve / M_ii). At the paper's
-  /// 50/s alone a joint 0.3 rad/s beyond its limit was asked 15 rad/s^2, which the custom loop did
-  /// not realise where joints 3 and 5 share an axis (elbow straight): joint 3 coasted at 1.07x for
-  /// 30 ms (safety-fuzz seed 60606, full_body/custom/23). Unbounded by the reserve, the return gain
-  /// made the QP infeasible under a push that took 91 % of a joint's torque (1.29x after the safe
-  /// stop, same seed, full_body/custom/10).
+  /// within what the direction's reserve decelerates the joint at (reserve / M_ii): the paper's 50/s
+  /// alone is too slow where two joints share an axis, and unbounded by the reserve the return gain
+  /// makes the QP infeasible (replayed: SafetyFuzz.FormerFailuresReplayedPass, seed 60606 full_body/custom/23).
   double deceleration(int i, double over, double reserve, double inertia, bool with_return) {
     const double paper = gain_[i] * over;
     if (!with_return || !(over > 0.0) || !(reserve_.return_gain > gain_[i])) return paper;
@@ -113,10 +108,8 @@ public:
     const double lowered = fraction * v;
     if (fraction >= 1.0 || speed <= lowered) return lowered;
     // Faster than the lowered limit: the bound asks gain x slack of deceleration, what the reserve
-    // gives. With less than none (the push and the arm's own motion take more than the torque
-    // limit) it lets through the acceleration the torque cannot stop: asking for less made the QP
-    // infeasible, and its fallback brake, clipped on this joint, sped it up through the coupling
-    // (1.21x, safety-fuzz seed 5150, full_body/custom/17 with the collision braking row).
+    // gives. With less than none it lets through the acceleration the torque cannot stop: asking for
+    // less makes the QP infeasible (replayed: SafetyFuzz.FormerFailuresReplayedPass, seed 5150 full_body/custom/17).
     const double slack = reserve / (inertia * gain_[i]);
     return slack >= 0.0 ? std::max(lowered, std::min(speed, v) - slack) : std::min(speed, v) - slack;
   }

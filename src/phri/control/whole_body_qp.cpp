@@ -223,10 +223,8 @@ WholeBodyQpStatus WholeBodyQp::update(const Model& model, const Data& data, cons
 
 // Safe fallback: a joint damping brake qdd = -D qd, clipped to the joint bounds where they allow it,
 // negating the push like the constraints do, and torques clipped to their limits. The brake is
-// scaled down as a whole (its direction kept) to what the torque limits allow: with a joint
-// already at its limit (a push taking all of its torque), braking the others through the coupled
-// M asked that joint for more, the clip dropped it, and the joint sped up from 1.88 to 2.51 rad/s
-// within 20 ms of fallback (safety-fuzz seed 2718, full_body/custom/17). A joint beyond its limit
+// scaled down as a whole (its direction kept) to what the torque limits allow: clipping one joint
+// lets the coupled brake speed it up (replayed: SafetyFuzz.FormerFailuresReplayedPass, seed 2718 full_body/custom/17). A joint beyond its limit
 // with no brake at all only keeps the brake from pushing it further.
 void WholeBodyQp::fallback_brake(const Data& data, const Eigen::VectorXd& qd, const Eigen::VectorXd& tau_ext) {
   for (int i = 0; i < nv_; ++i) {

@@ -24,8 +24,7 @@
 // of that offset is torque spent between motor and sensor, up to the static friction level: at
 // rest, the friction the previous loop was pushing against (the entry hold). When the joint starts
 // to slide, the friction compensation supplies that torque, so the entry hold leaves the
-// integrator then; carried on, it added to the compensation and drove the joint on (1.25 rad/s on
-// a joint nobody touched, seed 20261127 of the safety fuzz).
+// integrator then; carried on, it would add to the compensation and drive the joint on.
 #include <phri/core/discrete_transfer_function.hpp>
 #include <phri/lowlevel/friction_compensation.hpp>
 #include <phri/robot/actuator_table.hpp>

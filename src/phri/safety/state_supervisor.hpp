@@ -150,8 +150,7 @@ struct SupervisorSettings {
   /// both for a rigid transmission (a_r = q̈) and for the catalogue's stiffness K, with one sign
   /// (the true compliance lies in between and the residual is linear in it), means a sensor is
   /// wrong (an offset or spike within range): an observer fed with it reports a push nobody
-  /// makes, and the controller drives the joint to cancel it (safety-fuzz seed 55555, +50 N.m on
-  /// joint 6 for 100 ms: 1.45x the velocity limit). Kinova's actuators make the same
+  /// makes, and the controller drives the joint to cancel it. Kinova's actuators make the same
   /// check (MOTOR_CURRENT_MISMATCH fault, kinova_gen3_actuators.md). I_r is known within a factor
   /// of two at best (the paper authors' tuned values differ 13x); a_r is clamped so that one bad
   /// sample cannot poison the filter. The margin (4 N.m, the size of a sensor offset the controller
