@@ -126,7 +126,7 @@ void check_kortex_arguments(const KortexArguments& args) {
   if (args.backend == "kortex") {
     throw phri::ConfigError("--backend kortex", "",
                             "this phri was built without Kinova's Kortex API: rebuild with cmake -DPHRI_KORTEX_API_DIR=<the "
-                            "unpacked SDK folder> (README, On the real arm), or run --backend kortex-emulator");
+                            "unpacked SDK folder> (docs/hardware.md), or run --backend kortex-emulator");
   }
 #endif
 }

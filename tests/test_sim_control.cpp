@@ -158,7 +158,7 @@ TEST(SimControl, FullBodyComplianceCarriedFarWalksBackInJointSpace) {
   // A hand (40 N on the bracelet for 1 s) carries the arm about 2 rad away. With the return leash:
   // back within 0.05 rad of the held posture within 3 s plus the walk back (the largest deviation
   // / the leash's return speed), on the plant's true joints. (A harder carry that flips the elbow, 80 N for 1.5 s,
-  // still ends in the flipped branch: the leash walks back without the arm; see the README.)
+  // still ends in the flipped branch: the leash walks back without the arm; see docs/architecture.md.)
   Rig rig(phri::ComplianceMode::kFullBody,
           {push("bracelet_link", Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(0, 40, 0), 1.0, 1.0)});
   rig.run(0.9);
