@@ -86,6 +86,9 @@ TEST(DashboardRequest, RefusesMalformedOversizedAndOutOfRangeWithAReason) {
       {"push", R"({"body": 2, "point": [0, 0, 5], "force": [1, 0, 0]})", 400, "within 1 m"},
       {"step", R"({"cycles": 0})", 400, "cycles must be an integer in [1, 10000]"},
       {"launch", "{}", 404, "no action 'launch'"},
+      {"gain", R"({"gain": "ee_gamma", "value": 0.3, "value": 1})", 400, "key 'value' given twice"},
+      {"push", R"({"body": 2, "point": [0, 0, 0], "force": [1, 0, 0], "force": [2, 0, 0]})", 400, "given twice"},
+      {"event", R"({"event": "stop"} trailing)", 400, "malformed JSON"},
   };
   for (const Case& c : cases) {
     const auto r = phri::parse_dashboard_request(c.action, c.body, limits);
@@ -104,6 +107,12 @@ TEST(DashboardRequest, CapsAPushAtTheMaximumAndKeepsItsDirection) {
   EXPECT_NEAR(r.command->push.force_world.x(), 60.0, 1e-9);
   EXPECT_NEAR(r.command->push.force_world.y(), 80.0, 1e-9);
   EXPECT_EQ(r.command->push.body, 6);
+  // A force whose norm overflows a double is capped along its direction, not zeroed.
+  const auto huge = phri::parse_dashboard_request("push", R"({"body": 6, "point": [0, 0, 0], "force": [3e200, 0, -4e200]})", limits);
+  ASSERT_TRUE(huge.command) << huge.error;
+  EXPECT_NEAR(huge.push_applied_N, 100.0, 1e-9);
+  EXPECT_NEAR(huge.command->push.force_world.x(), 60.0, 1e-9);
+  EXPECT_NEAR(huge.command->push.force_world.z(), -80.0, 1e-9);
   const auto gain = phri::parse_dashboard_request("gain", R"({"gain": "ee_gamma", "value": -1})", limits);
   ASSERT_TRUE(gain.command);
   EXPECT_EQ(gain.command->gain.value, -1.0);  // back to the compliance mode's gamma

@@ -39,7 +39,7 @@ const EVENT_GROUPS = {
 const MODE_OF_EVENT = { stiff_compliance: 'stiff', null_space_compliance: 'null_space', full_body_compliance: 'full_body',
                         dual_compliance: 'dual' };
 const LOOP_OF_EVENT = { position_loop: 'position', kinova_torque_loop: 'kinova_torque',
-                        kinova_torque_high_velocity_loop: 'kinova_torque_high_velocity', custom_loop: 'current' };
+                        kinova_torque_high_velocity_loop: 'kinova_torque_high_velocity', custom_loop: 'custom' };
 
 function buildButtons(model) {
   for (const [group, names] of Object.entries(EVENT_GROUPS)) {

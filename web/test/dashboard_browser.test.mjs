@@ -104,6 +104,11 @@ try {
   check(after.x > before.x + 1.5, `plots advance with robot time (${before.x?.toFixed(2)} s -> ${after.x?.toFixed(2)} s)`);
   check(rate >= 30, `plots redrawn at ${rate.toFixed(1)} Hz (>= 30)`);
   await waitFor(page, () => window.phri.last.fsm === 'static', 'start-up ends (static scenario)', 30000);
+  // The loop's button is highlighted under the name the stream gives the loop (custom, position, ...).
+  await waitFor(page, () => {
+    const on = [...document.querySelectorAll('#events-loop button.active')].map((b) => b.id);
+    return on.length === 1 && on[0] === `event-${window.phri.last.loop}_loop`;
+  }, 'the running loop\'s button, and only it, is highlighted');
   await page.screenshot({ path: path.join(out, 'dashboard_start.png') });
 
   // 2. Full-body compliance from its button, found in the log.

@@ -4,7 +4,9 @@
 
 #include <cmath>
 #include <initializer_list>
+#include <set>
 #include <string>
+#include <vector>
 
 namespace phri {
 namespace {
@@ -93,8 +95,14 @@ LiveCommand push_command(const json& j, const DashboardRequestLimits& limits, do
   c.push.point_local = vector3(member(j, "point"), "point");
   if (c.push.point_local.norm() > 1.0) throw Refusal{400, "point must lie within 1 m of the body's origin"};
   c.push.force_world = vector3(member(j, "force"), "force");
-  const double magnitude = c.push.force_world.norm();
-  if (magnitude > limits.max_push_N) c.push.force_world *= limits.max_push_N / magnitude;
+  // Capped along its direction; the direction from the largest component first, so that a force
+  // whose norm overflows (1e200 N) is capped, not zeroed.
+  const double largest = c.push.force_world.cwiseAbs().maxCoeff();
+  if (largest > 0.0) {
+    const Eigen::Vector3d direction = (c.push.force_world / largest).normalized();
+    const double magnitude = largest * (c.push.force_world / largest).norm();
+    if (!(magnitude <= limits.max_push_N)) c.push.force_world = limits.max_push_N * direction;
+  }
   applied = c.push.force_world.norm();
   return c;
 }
@@ -130,6 +138,21 @@ LiveCommand command_for(std::string_view action, const json& j, const DashboardR
   throw Refusal{404, "no action '" + std::string(action) + "'"};
 }
 
+// JSON with each object's keys given once: {"value": 3, "value": 1.5} is refused (nlohmann keeps the
+// last one silently).
+json parse_strict(std::string_view body) {
+  std::vector<std::set<std::string>> keys;
+  const json::parser_callback_t no_duplicates = [&keys](int, json::parse_event_t event, json& parsed) {
+    if (event == json::parse_event_t::object_start) keys.emplace_back();
+    if (event == json::parse_event_t::object_end && !keys.empty()) keys.pop_back();
+    if (event == json::parse_event_t::key && !keys.empty() && !keys.back().insert(parsed.get<std::string>()).second) {
+      throw Refusal{400, "key '" + parsed.get<std::string>() + "' given twice"};
+    }
+    return true;
+  };
+  return json::parse(body.begin(), body.end(), no_duplicates);
+}
+
 }  // namespace
 
 DashboardRequest parse_dashboard_request(std::string_view action, std::string_view body,
@@ -141,7 +164,7 @@ DashboardRequest parse_dashboard_request(std::string_view action, std::string_vi
                              std::to_string(limits.max_body_bytes)};
     }
     // An empty body stands for {} (the bare actions).
-    const json j = body.empty() ? json::object() : json::parse(body.begin(), body.end());
+    const json j = body.empty() ? json::object() : parse_strict(body);
     if (!j.is_object()) throw Refusal{400, "the body must be a JSON object"};
     out.command = command_for(action, j, limits, out.push_applied_N);
   } catch (const Refusal& r) {

@@ -55,8 +55,9 @@ private:
 struct StaticFile {
   std::string_view url, file, mime;
 };
-constexpr std::array<StaticFile, 7> kStaticFiles = {{
+constexpr std::array<StaticFile, 8> kStaticFiles = {{
     {"/", "index.html", "text/html; charset=utf-8"},
+    {"/favicon.svg", "favicon.svg", "image/svg+xml"},
     {"/app.js", "app.js", "text/javascript"},
     {"/style.css", "style.css", "text/css"},
     {"/vendor/three.module.js", "node_modules/three/build/three.module.js", "text/javascript"},
