@@ -57,8 +57,10 @@ void print_summary(const phri::BotaSensOne& sensor) {
 
 CLI::App* add_ft_monitor_command(CLI::App& app, FtMonitorArguments& args) {
   auto* monitor = app.add_subcommand("ft-monitor", "Print the Bota SensONE's wrench and the driver's counters");
-  monitor->add_option("--device", args.device, "serial device (better /dev/serial/by-id/...)")->capture_default_str();
-  monitor->add_flag("--emulate", args.emulate, "monitor a fake sensor on a pseudo-terminal (no hardware)");
+  auto* emulate = monitor->add_flag("--emulate", args.emulate, "monitor a fake sensor on a pseudo-terminal (no hardware)");
+  monitor->add_option("--device", args.device, "serial device (better /dev/serial/by-id/...)")
+      ->capture_default_str()
+      ->excludes(emulate);  // the emulator makes its own device
   monitor->add_option("--duration", args.duration_s, "seconds, 0: until Ctrl-C")->check(CLI::Range(0.0, 86400.0))
       ->capture_default_str();
   monitor->add_option("--print-hz", args.print_hz, "lines per second")->check(CLI::Range(0.1, 100.0))->capture_default_str();
@@ -95,5 +97,10 @@ int ft_monitor_command(const FtMonitorArguments& args) {
   }
   sensor.stop();
   print_summary(sensor);
+  // A monitor that never heard the sensor has not monitored it: say so in the exit status too.
+  if (sensor.counters().decoder.frames_ok == 0) {
+    std::printf("phri ft-monitor: no valid frame from %s\n", settings.device.c_str());
+    return 1;
+  }
   return 0;
 }
