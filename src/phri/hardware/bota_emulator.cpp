@@ -62,8 +62,10 @@ void sleep_unless(const std::atomic<bool>& stopping, int ms) {
 
 BotaFrame BotaEmulator::expected_frame(std::uint64_t k) {
   BotaFrame frame;
-  const float m = static_cast<float>(k % 4096);
-  frame.wrench = {0.25f * m - 100.0f, -0.5f * m, 3.0f + 0.125f * m, 0.001953125f * m, -1.5f, 0.0078125f * m - 2.0f};
+  // A bounded, slowly varying wrench a hand could give (a triangle over 4096 frames, within +-5 N and
+  // +-0.1 N.m); tests compare a decoded frame with expected_frame(k) bit for bit.
+  const float m = static_cast<float>(k % 4096 < 2048 ? k % 4096 : 4096 - k % 4096) / 2048.0f;  // 0 .. 1 .. 0
+  frame.wrench = {10.0f * m - 5.0f, -4.0f * m, 3.0f + 2.0f * m, 0.125f * m - 0.0625f, -0.05f, 0.2f * m - 0.1f};
   frame.timestamp = timestamp_of(k);
   frame.temperature = 25.0f;
   encode_clean(frame);

@@ -36,7 +36,9 @@ enum class BotaFault {
 };
 
 struct BotaEmulatorSettings {
-  double rate_hz = 500.0;        ///< frames per second while streaming
+  /// Frames per second while streaming: 100, the rate of the sinc filter 512 the driver sets
+  /// (`f,512,0,0,1`, docs/hardware.md); tests stream faster to count more frames.
+  double rate_hz = 100.0;
   bool streaming_at_start = true;  ///< true: already in run mode (left by an earlier session); false: booting
   BotaSensorConfig expected;     ///< the 'c' and 'f' commands it acknowledges (others get no answer)
   std::uint32_t seed = 1;        ///< garbage bytes
