@@ -34,7 +34,6 @@ std::string safety_bits_to_string(std::uint32_t bank_a) {
   return text.empty() ? "none" : text;
 }
 
-namespace {
 std::string_view sub_error_name(std::uint32_t sub_code) {
   switch (sub_code) {
     case sub_error::kMethodFailed: return "method_failed";
@@ -49,7 +48,6 @@ std::string_view sub_error_name(std::uint32_t sub_code) {
   }
   return "error";
 }
-}  // namespace
 
 std::string to_string(CallStatus status) {
   if (status.ok()) return "ok";

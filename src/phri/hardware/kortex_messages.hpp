@@ -103,6 +103,8 @@ struct CallStatus {
 
 /// "ok", "wrong_servoing_mode (75)", ...
 std::string to_string(CallStatus status);
+/// The name of a Kortex sub-error code ("method_timeout" for 131), "error" for one it does not know.
+std::string_view sub_error_name(std::uint32_t sub_code);
 std::string_view to_string(ControlMode mode);
 std::string_view to_string(ServoingMode mode);
 std::string_view to_string(ArmState state);

@@ -284,12 +284,14 @@ void KortexRobot::note_failure(kortex::CallStatus status) noexcept {
   if (health_.link_lost) return;
   const double silence = client_.clock_s() - last_good_s_;
   if (health_.consecutive_failures >= settings_.max_failed_refreshes) {
-    std::snprintf(reason_, sizeof reason_, "%d failed Refresh in a row, last: sub-code %u", health_.consecutive_failures,
-                  health_.last_failure.sub_code);
+    const std::string_view name = kortex::sub_error_name(health_.last_failure.sub_code);
+    std::snprintf(reason_, sizeof reason_, "%d failed Refresh in a row, last: %.*s (sub-code %u)",
+                  health_.consecutive_failures, static_cast<int>(name.size()), name.data(), health_.last_failure.sub_code);
     enter_link_loss(reason_);
   } else if (silence >= settings_.max_silence_s - 1e-9) {
-    std::snprintf(reason_, sizeof reason_, "no good feedback for %.1f ms, last: sub-code %u", 1e3 * silence,
-                  health_.last_failure.sub_code);
+    const std::string_view name = kortex::sub_error_name(health_.last_failure.sub_code);
+    std::snprintf(reason_, sizeof reason_, "no good feedback for %.1f ms, last: %.*s (sub-code %u)", 1e3 * silence,
+                  static_cast<int>(name.size()), name.data(), health_.last_failure.sub_code);
     enter_link_loss(reason_);
   }
 }
