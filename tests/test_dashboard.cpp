@@ -312,6 +312,14 @@ TEST(DashboardLoop, EventsGainsAndPushesReachTheControllerThroughTheLoopsOnePath
   EXPECT_NEAR(after_steps, 0.003, 1e-9) << "three single steps, then paused again";
   EXPECT_TRUE(stream_shows(run.server, "\"paused\":true", 3));
   EXPECT_EQ(run.robot.state().time_s, after_steps) << "paused: the simulation does not advance";
+  const auto paused_step = client.Post("/api/step", token, R"({"cycles": 1})", "application/json");
+  EXPECT_EQ(paused_step->body.find("paused to step"), std::string::npos) << paused_step->body;
+  ASSERT_EQ(client.Post("/api/run", token, "", "application/json")->status, 200);
+  for (int i = 0; i < 200 && run.server.stats().paused; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  ASSERT_FALSE(run.server.stats().paused) << "running again";
+  // Stepping the running loop pauses it: the answer says so.
+  const auto running_step = client.Post("/api/step", token, R"({"cycles": 1})", "application/json");
+  EXPECT_NE(running_step->body.find("the run was paused to step"), std::string::npos) << running_step->body;
   ASSERT_EQ(client.Post("/api/run", token, "", "application/json")->status, 200);
   loop.join();
   const phri::ComplianceController& compliance = run.controller.compliance();

@@ -298,6 +298,8 @@ void DashboardServer::Impl::serve_command(const httplib::Request& req, httplib::
   std::ostringstream reply;
   reply << "{\"ok\":true";
   if (parsed.command->kind == LiveCommand::Kind::kPush) reply << ",\"applied_N\":" << parsed.push_applied_N;
+  // Stepping a running loop pauses it first: the answer says so rather than a bare ok.
+  if (parsed.command->kind == LiveCommand::Kind::kStep && !last_paused) reply << ",\"note\":\"the run was paused to step\"";
   reply << "}";
   res.set_content(reply.str(), "application/json");
 }
