@@ -7,7 +7,9 @@
 
 #include <phri/model/algorithms.hpp>
 
+#include <cmath>
 #include <optional>
+#include <string>
 
 namespace phri::python {
 namespace {
@@ -167,6 +169,19 @@ py::array_t<double> jacobian_into(const Model& model, const Data& data, int fram
   return py::reinterpret_borrow<py::array_t<double>>(target);
 }
 
+// A joint vector as the function it enters names it: its size (the library's check_size wording,
+// naming this function, not the one it calls first) and finite entries (NaN in, NaN out would be
+// silent).
+const Vector& joint_vector(const char* function, const char* name, const Vector& v, long expected) {
+  check_size(function, name, v.size(), expected);
+  for (Eigen::Index i = 0; i < v.size(); ++i) {
+    if (!std::isfinite(v[i])) {
+      throw ArgumentError(std::string(function) + ": " + name + "[" + std::to_string(i) + "] is not finite");
+    }
+  }
+  return v;
+}
+
 void bind_kinematics(py::module_& m) {
   m.def("forward_kinematics", py::overload_cast<const Model&, Data&, const Vector&>(&forward_kinematics),
         py::arg("model"), py::arg("data"), py::arg("q"), "Body placements and joint motion subspaces.");
@@ -212,26 +227,31 @@ void bind_kinematics(py::module_& m) {
 
 void bind_dynamics(py::module_& m) {
   m.def("crba", [](const Model& model, Data& data, const Vector& q) {
-        return matrix_view(crba(model, data, q), owner_of(data));
+        return matrix_view(crba(model, data, joint_vector("crba", "q", q, model.nq())), owner_of(data));
       }, py::arg("model"), py::arg("data"), py::arg("q"), "M(q) (composite rigid-body algorithm): a view of data.mass_matrix.");
   m.def("compute_mass_matrix_cholesky", &compute_mass_matrix_cholesky, py::arg("data"),
         "Cholesky factor of data.mass_matrix; False if M is not positive definite.");
   m.def("mass_matrix_solve_in_place", &mass_matrix_solve_in_place, py::arg("data"), py::arg("x"),
         "x <- M^-1 x in place: x must be a writeable contiguous float64 vector (after compute_mass_matrix_cholesky).");
   m.def("rnea", [](const Model& model, Data& data, const Vector& q, const Vector& qd, const Vector& qdd) {
-        return data_vector(data, rnea(model, data, q, qd, qdd));
+        return data_vector(data, rnea(model, data, joint_vector("rnea", "q", q, model.nq()),
+                                      joint_vector("rnea", "qd", qd, model.nv()), joint_vector("rnea", "qdd", qdd, model.nv())));
       }, py::arg("model"), py::arg("data"), py::arg("q"), py::arg("qd"), py::arg("qdd"),
       "tau = M(q) qdd + h(q, qd) (recursive Newton-Euler): a view of data.tau.");
   m.def("nonlinear_effects", [](const Model& model, Data& data, const Vector& q, const Vector& qd) {
-        return data_vector(data, nonlinear_effects(model, data, q, qd));
+        return data_vector(data, nonlinear_effects(model, data, joint_vector("nonlinear_effects", "q", q, model.nq()),
+                                                   joint_vector("nonlinear_effects", "qd", qd, model.nv())));
       }, py::arg("model"), py::arg("data"), py::arg("q"), py::arg("qd"), "h(q, qd) = C qd + g: a view of data.nonlinear_effects.");
   m.def("compute_gravity", [](const Model& model, Data& data, const Vector& q) {
-        return data_vector(data, compute_gravity(model, data, q));
+        return data_vector(data, compute_gravity(model, data, joint_vector("compute_gravity", "q", q, model.nq())));
       }, py::arg("model"), py::arg("data"), py::arg("q"), "g(q): a view of data.gravity_torque.");
   m.def("coriolis_transpose_times_velocity", [](const Model& model, Data& data) {
         return data_vector(data, coriolis_transpose_times_velocity(model, data));
       }, py::arg("model"), py::arg("data"), "C(q, qd)^T qd (after compute_all_terms): a view of data.coriolis_transpose_qd.");
-  m.def("compute_all_terms", &compute_all_terms, py::arg("model"), py::arg("data"), py::arg("q"), py::arg("qd"),
+  m.def("compute_all_terms", [](const Model& model, Data& data, const Vector& q, const Vector& qd) {
+        return compute_all_terms(model, data, joint_vector("compute_all_terms", "q", q, model.nq()),
+                                 joint_vector("compute_all_terms", "qd", qd, model.nv()));
+      }, py::arg("model"), py::arg("data"), py::arg("q"), py::arg("qd"),
         "FK, velocities, drift accelerations, M and its Cholesky factor, h, g: the controller's one pass.");
 }
 

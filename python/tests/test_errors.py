@@ -51,9 +51,20 @@ def test_wrong_vector_size_is_an_argument_error_with_the_library_message():
     data = phri.Data(model)
     with pytest.raises(phri.ArgumentError) as caught:
         phri.crba(model, data, np.zeros(3))
-    # The library's check_size wording (core/error.hpp), raised in C++ by forward_kinematics.
-    assert str(caught.value) == "forward_kinematics: q has 3 entries, expected 7"
+    # The library's check_size wording (core/error.hpp), naming the function called.
+    assert str(caught.value) == "crba: q has 3 entries, expected 7"
     assert isinstance(caught.value, ValueError)
+
+
+def test_a_non_finite_joint_vector_is_an_argument_error_not_a_nan_result():
+    model = phri.Model.from_urdf_file(GEN3_URDF)
+    data = phri.Data(model)
+    q = np.zeros(7)
+    q[2] = np.nan
+    with pytest.raises(phri.ArgumentError, match=r"rnea: q\[2\] is not finite"):
+        phri.rnea(model, data, q, np.zeros(7), np.zeros(7))
+    with pytest.raises(phri.ArgumentError, match=r"compute_all_terms: qd\[0\] is not finite"):
+        phri.compute_all_terms(model, data, np.zeros(7), np.full(7, np.inf))
 
 
 def test_command_vectors_keep_their_size():
