@@ -259,10 +259,44 @@ Eigen::VectorXd parse_torque_limits(const YamlReader& q, const ActuatorTable& dr
   return limits;
 }
 
-void parse_qp(const YamlReader& q, const ActuatorTable& drives, WholeBodyQpSettings& s) {
+// A body region of a regions file (configs/iso_ts_15066_regions.yaml's form), by name.
+BodyRegion load_body_region(const std::string& file, const std::string& name, const YamlReader& at) {
+  const YamlReader root = YamlReader::load_file(file);
+  root.allow_keys({"regions"});
+  const YamlReader list = root.at("regions");
+  list.expect_sequence();
+  std::string known;
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    const YamlReader r = list.at(i);
+    r.allow_keys({"name", "stiffness_N_per_mm", "mass_kg", "quasi_static_force_N", "transient_factor"});
+    const std::string region_name = r.text("name");
+    known += (known.empty() ? "" : ", ") + region_name;
+    if (region_name != name) continue;
+    BodyRegion region;
+    region.name = region_name;
+    region.stiffness_N_per_m = 1e3 * r.number("stiffness_N_per_mm", 0.1, 1e4);
+    region.mass_kg = r.number("mass_kg", 0.01, 1000.0);
+    region.quasi_static_force_N = r.number("quasi_static_force_N", 1.0, 1e4);
+    region.transient_factor = r.number_or("transient_factor", 2.0, 1.0, 10.0);
+    return region;
+  }
+  throw at.error("region", "no region '" + name + "' in " + file + " (" + known + ")");
+}
+
+// controller.qp.power_force_limit: {regions_file, region, gain} (control/power_force_limit.hpp).
+PowerForceLimitSettings parse_power_force_limit(const YamlReader& p, const std::string& base_dir) {
+  p.allow_keys({"regions_file", "region", "gain"});
+  PowerForceLimitSettings s;
+  s.region = load_body_region(input_file(p, "regions_file", base_dir, false), p.text("region"), p);
+  s.gain = p.number_or("gain", s.gain, 1.0, 1e3);
+  return s;
+}
+
+void parse_qp(const YamlReader& q, const ActuatorTable& drives, const std::string& base_dir, WholeBodyQpSettings& s) {
   q.allow_keys({"torque_limit_Nm", "velocity_limit_rad_s", "velocity_limit_fraction", "joint_limits",
                 "velocity_limit_gain", "braking_reserve", "collision", "collision_braking", "regularization", "brake_damping",
-                "smoothing_time_constant_s", "singular_value_threshold"});
+                "smoothing_time_constant_s", "singular_value_threshold", "power_force_limit"});
+  if (q.has("power_force_limit")) s.power_force_limit = parse_power_force_limit(q.at("power_force_limit"), base_dir);
   const int dof = drives.size();
   if (q.has("torque_limit_Nm")) s.torque_limit = parse_torque_limits(q, drives);
   if (q.has("velocity_limit_rad_s")) {
@@ -300,7 +334,7 @@ void parse_wrench(const YamlReader& w, WrenchEstimatorSettings& s) {
   s.bias_samples = static_cast<int>(w.integer_or("bias_samples", s.bias_samples, 1, 1000000));
 }
 
-void parse_controller(const YamlReader& r, const ActuatorTable& drives, ControllerSettings& c) {
+void parse_controller(const YamlReader& r, const ActuatorTable& drives, const std::string& base_dir, ControllerSettings& c) {
   r.allow_keys({"period_s", "observer_gain", "external_torque_source", "position_mode_open_loop", "compliance_deadband",
                 "compliance", "qp", "wrench", "tasks"});
   c.position_mode_open_loop = r.boolean_or("position_mode_open_loop", c.position_mode_open_loop);
@@ -319,7 +353,7 @@ void parse_controller(const YamlReader& r, const ActuatorTable& drives, Controll
   }
   if (r.has("compliance_deadband")) parse_compliance_deadband(r.at("compliance_deadband"), drives.size(), c);
   if (r.has("compliance")) parse_compliance(r.at("compliance"), c);
-  if (r.has("qp")) parse_qp(r.at("qp"), drives, c.qp);
+  if (r.has("qp")) parse_qp(r.at("qp"), drives, base_dir, c.qp);
   if (r.has("wrench")) parse_wrench(r.at("wrench"), c.wrench);
   if (r.has("tasks")) c.tasks = parse_task_specs(r.at("tasks"));
 }
@@ -537,7 +571,7 @@ Config parse(const YamlReader& root, const std::string& base_dir, const std::str
                           std::to_string(dof));
   }
 
-  if (root.has("controller")) parse_controller(root.at("controller"), drives, c.controller);
+  if (root.has("controller")) parse_controller(root.at("controller"), drives, base_dir, c.controller);
   if (!c.plant.ft_sensor_present() && c.controller.external_torque_source != ExternalTorqueSource::kObserver) {
     throw ConfigError(source, "controller.external_torque_source",
                       std::string(to_string(c.controller.external_torque_source)) + " needs an F/T sensor, and the plant has none (" +

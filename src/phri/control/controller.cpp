@@ -74,6 +74,10 @@ WholeBodyQpSettings Controller::qp_settings(const ControllerSettings& settings, 
           actuators[i].default_compliance_deadband_Nm(settings.deadband_large_Nm, settings.deadband_small_Nm);
     }
   }
+  if (qp.power_force_limit && qp.rotor_inertia.size() == 0) {
+    qp.rotor_inertia.resize(actuators.size());
+    for (int i = 0; i < actuators.size(); ++i) qp.rotor_inertia[i] = actuators[i].reflected_inertia_kgm2;
+  }
   if (qp.velocity_limit.size() == 0) {
     qp.velocity_limit.resize(actuators.size());
     for (int i = 0; i < actuators.size(); ++i) qp.velocity_limit[i] = actuators[i].velocity_limit_rad_s;

@@ -107,6 +107,12 @@ WholeBodyQp::WholeBodyQp(const Model& model, const CollisionModel* collision, co
     self_collision_ = pairs.get();
     constraints_.push_back(std::move(pairs));
   }
+  if (settings.power_force_limit) {
+    if (!collision) throw ConfigError("WholeBodyQpSettings", "power_force_limit", "needs the collision capsules (robot.collision)");
+    auto limit = std::make_unique<PowerForceLimitConstraint>(model, *collision, settings.rotor_inertia, *settings.power_force_limit);
+    power_force_limit_ = limit.get();
+    constraints_.push_back(std::move(limit));
+  }
   resize_problem();
 }
 

@@ -26,6 +26,7 @@
 #include <phri/control/end_effector_task.hpp>
 #include <phri/control/joint_limit_constraint.hpp>
 #include <phri/control/posture_task.hpp>
+#include <phri/control/power_force_limit.hpp>
 #include <phri/control/self_collision_constraint.hpp>
 #include <phri/control/singular_direction_weight.hpp>
 #include <phri/control/torque_limit_constraint.hpp>
@@ -38,6 +39,7 @@
 #include <phri/qp/qp_solver.hpp>
 
 #include <memory>
+#include <optional>
 #include <string_view>
 #include <vector>
 
@@ -75,6 +77,11 @@ struct WholeBodyQpSettings {
   /// stays above 0.05, so its figures are the paper's; the outstretched elbow (q4 = 0) is below.
   double singular_value_threshold = 0.03;
   double brake_damping = 20.0;    ///< 1/s, the fallback's joint damping brake
+  /// Power and force limiting (power_force_limit.hpp; not in the paper): empty, off. Needs the
+  /// collision capsules (their end points are the points it bounds).
+  std::optional<PowerForceLimitSettings> power_force_limit;
+  /// Reflected rotor inertia per joint, for the power-and-force limit's reflected masses; empty: none.
+  Eigen::VectorXd rotor_inertia;
   double smoothing_time_constant = 0.1;  ///< s, of the tasks' gain filters
 };
 
@@ -135,6 +142,8 @@ public:
   WholeBodyQpStatus status() const { return status_; }
   QpStatus qp_status() const { return solver_.status(); }
   int qp_iterations() const { return solver_.iterations(); }
+  /// The power-and-force limit, or null when it is off.
+  const PowerForceLimitConstraint* power_force_limit() const { return power_force_limit_; }
   const CollisionData* collision_data() const { return self_collision_ ? &self_collision_->data() : nullptr; }
   const Eigen::VectorXd& torque_limit() const { return torque_limit_->torque_limit(); }
   /// Per joint, after velocity_limit_fraction.
@@ -167,6 +176,7 @@ private:
   JointLimitConstraint* joint_limits_ = nullptr;
   TorqueLimitConstraint* torque_limit_ = nullptr;
   SelfCollisionConstraint* self_collision_ = nullptr;
+  PowerForceLimitConstraint* power_force_limit_ = nullptr;
   QpProblem problem_;
   QpSolver solver_;
   Eigen::VectorXd deadband_;

@@ -1,0 +1,93 @@
+#pragma once
+// Power and force limiting (ISO/TS 15066 Annex A.3, now ISO 10218-2:2025 Annex A): how fast a point
+// of the arm may meet a body region so that a transient contact stays below the region's force.
+//
+// The two-body model: the arm's reflected mass along the motion u at the contact point,
+//   m_u = 1 / (u^T J_v (M + I_r)^-1 J_v^T u)            (Khatib 1995; rotor inertia I_r included)
+// meets the region's effective mass m_H through its spring k; reduced mass mu = (1/m_H + 1/m_u)^-1,
+// energy transferred E = 1/2 mu v^2 = F^2 / (2 k), so the force stays below F where
+//   v <= v_max = F / sqrt(mu k),   F = transient_factor x F_QS (the transient limit).
+//
+// PowerForceLimitConstraint (not in the paper; off unless configured) bounds the speed of each
+// capsule's end points (a capsule's fastest point is one of them: a rigid body's point velocity is
+// affine in the point) along their motion, as the velocity limit bounds the joints (paper eq.
+// sec-order-vel-damp's form): u^T (J_v qdd + J̇_v qd) <= gain (v_max - |v|). Stiff like the other
+// constraints: a push toward a faster motion is negated.
+#include <phri/control/constraint.hpp>
+#include <phri/model/collision_model.hpp>
+
+#include <Eigen/Cholesky>
+
+#include <string>
+#include <vector>
+
+namespace phri {
+
+/// A body region of the standard's table (values: configs/iso_ts_15066_regions.yaml, its source).
+struct BodyRegion {
+  std::string name;
+  double stiffness_N_per_m = 0.0;      ///< k
+  double mass_kg = 0.0;                ///< m_H
+  double quasi_static_force_N = 0.0;   ///< F_QS
+  double transient_factor = 2.0;       ///< transient limit / F_QS (1 for the skull and the face)
+  double transient_force_N() const { return transient_factor * quasi_static_force_N; }
+};
+
+/// mu = (1/m_H + 1/m_R)^-1.
+double reduced_mass(double robot_kg, double human_kg);
+/// v_max = F_T / sqrt(mu k) for a robot mass m_R meeting `region` [m/s].
+double permissible_speed(const BodyRegion& region, double robot_kg);
+/// m_u = 1 / (u^T J_v W J_v^T u) with W = (M + I_r)^-1 given by its Cholesky factor; `scratch` and
+/// `solved` of size nv (no allocation).
+double reflected_mass(const Eigen::Ref<const Eigen::MatrixXd>& linear_jacobian, const Eigen::LLT<Eigen::MatrixXd>& inertia,
+                      const Eigen::Vector3d& direction, Eigen::VectorXd& scratch, Eigen::VectorXd& solved);
+
+struct PowerForceLimitSettings {
+  BodyRegion region;          ///< the region every monitored point may meet
+  double gain = 50.0;         ///< [1/s] as the velocity limit's
+  double min_speed_m_s = 1e-3;  ///< below: the point's direction is undefined and its row left out
+};
+
+/// The latest cycle's figures at one monitored point.
+struct ContactPointState {
+  double speed_m_s = 0.0;
+  double reflected_mass_kg = 0.0;
+  double permissible_speed_m_s = 0.0;
+  double ratio() const { return permissible_speed_m_s > 0.0 ? speed_m_s / permissible_speed_m_s : 0.0; }
+  /// 1/2 mu v^2 with the region's mass [J].
+  double energy_J = 0.0;
+};
+
+class PowerForceLimitConstraint final : public Constraint {
+public:
+  /// rotor_inertia: reflected rotor inertia per joint (added to M's diagonal); zero: none.
+  PowerForceLimitConstraint(const Model& model, const CollisionModel& capsules, const Eigen::VectorXd& rotor_inertia,
+                            const PowerForceLimitSettings& settings);
+
+  std::string_view type() const override { return "power_force_limit"; }
+  int num_rows() const override { return static_cast<int>(points_.size()); }
+  void fill_rows(const ConstraintContext& context, Eigen::Ref<Eigen::MatrixXd> a, Eigen::Ref<Eigen::VectorXd> l,
+                 Eigen::Ref<Eigen::VectorXd> u) override;
+
+  /// Two points per capsule: its end points, in capsule order.
+  const std::vector<ContactPointState>& points() const { return states_; }
+  /// The largest v / v_max of the last cycle.
+  double worst_ratio() const;
+  const PowerForceLimitSettings& settings() const { return settings_; }
+
+private:
+  struct Point {
+    int body;
+    Eigen::Vector3d local;
+  };
+  PowerForceLimitSettings settings_;
+  std::vector<Point> points_;
+  std::vector<ContactPointState> states_;
+  Eigen::VectorXd rotor_inertia_;
+  Eigen::MatrixXd inertia_;        // M + I_r
+  Eigen::LLT<Eigen::MatrixXd> inertia_llt_;
+  Eigen::MatrixXd jacobian_;       // 3 x nv
+  Eigen::VectorXd scratch_, solved_;
+};
+
+}  // namespace phri

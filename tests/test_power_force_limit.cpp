@@ -1,0 +1,215 @@
+// ctest-labels: physics
+// Power and force limiting (control/power_force_limit.hpp, ISO/TS 15066 Annex A.3): the permissible
+// speed against the reference notes' worked example, the reflected mass against the minimum kinetic
+// energy of the motions that move the point along u at 1 m/s (measured by finite differences of the
+// forward kinematics), and the constraint in closed loop on the plant: a point's true speed stays
+// within its permissible speed while the arm is driven to a far target.
+#include <phri/config/config.hpp>
+#include <phri/control/controller.hpp>
+#include <phri/control/power_force_limit.hpp>
+#include <phri/model/algorithms.hpp>
+#include <phri/sim/sim_robot.hpp>
+
+#include "gen3_settings.hpp"
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <iterator>
+#include <random>
+
+namespace {
+
+const std::string kRoot = PHRI_SOURCE_DIR;
+
+TEST(PowerForceLimit, PermissibleSpeedOfTheWorkedExample) {
+  // Hand: k 75 000 N/m, m_H 0.6 kg, robot 5 kg: mu 0.536 kg; transient 280 N -> v_max 1.40 m/s.
+  const phri::BodyRegion hand{"hand_fingers", 75000.0, 0.6, 140.0, 2.0};
+  EXPECT_NEAR(phri::reduced_mass(5.0, 0.6), 0.5357, 1e-4);
+  EXPECT_NEAR(phri::permissible_speed(hand, 5.0), 1.40, 0.005);
+  // Energy form: 1/2 mu v_max^2 = F^2 / (2 k).
+  const double v = phri::permissible_speed(hand, 5.0);
+  EXPECT_NEAR(0.5 * phri::reduced_mass(5.0, 0.6) * v * v, 280.0 * 280.0 / (2.0 * 75000.0), 1e-9);
+}
+
+TEST(PowerForceLimit, ReflectedMassIsTheLeastKineticEnergyOfAUnitSpeedAlongU) {
+  const phri::Model model = phri::Model::from_urdf_file(kRoot + "/robots/kinova_gen3/gen3.urdf");
+  phri::Data data(model);
+  Eigen::VectorXd q(7);
+  q << 0.2, 0.6, 3.0, -1.8, 0.3, 0.9, 1.5;
+  phri::compute_all_terms(model, data, q, Eigen::VectorXd::Zero(7));
+  const int body = model.num_bodies() - 1;  // the last link's body
+  const Eigen::Vector3d local(0.0, 0.02, 0.05);
+  auto point_at = [&](const Eigen::VectorXd& at) {
+    phri::Data d(model);
+    phri::forward_kinematics(model, d, at);
+    return Eigen::Vector3d(d.body_placements[static_cast<std::size_t>(body)] * local);
+  };
+  Eigen::MatrixXd j(3, 7);
+  phri::body_point_linear_jacobian(model, data, body, point_at(q), j);
+  Eigen::VectorXd rotor = Eigen::VectorXd::Constant(7, 0.3);
+  Eigen::MatrixXd inertia = data.mass_matrix;
+  inertia.diagonal() += rotor;
+  const Eigen::LLT<Eigen::MatrixXd> llt(inertia);
+  const Eigen::Vector3d u = Eigen::Vector3d(0.3, -0.5, 0.8).normalized();
+  Eigen::VectorXd scratch(7), solved(7);
+  const double m_u = phri::reflected_mass(j, llt, u, scratch, solved);
+  // Any joint velocity moving the point along u at 1 m/s (u . dp/dt by central differences of the
+  // forward kinematics) has at least 1/2 m_u of kinetic energy; the least one has exactly that.
+  std::mt19937 random(7);
+  std::normal_distribution<double> normal;
+  double least = 1e9;
+  for (int k = 0; k < 2000; ++k) {
+    Eigen::VectorXd qd(7);
+    for (int i = 0; i < 7; ++i) qd[i] = normal(random);
+    const double h = 1e-6;
+    const double along = u.dot(point_at(q + h * qd) - point_at(q - h * qd)) / (2 * h);
+    if (std::abs(along) < 0.05) continue;
+    qd /= along;
+    least = std::min(least, 0.5 * qd.dot(inertia * qd));
+  }
+  const Eigen::VectorXd best = llt.solve(j.transpose() * u) * m_u;  // (M + I_r)^-1 J^T u m_u
+  const double h = 1e-6;
+  EXPECT_NEAR(u.dot(point_at(q + h * best) - point_at(q - h * best)) / (2 * h), 1.0, 1e-6);
+  EXPECT_NEAR(0.5 * best.dot(inertia * best), 0.5 * m_u, 1e-9 * m_u);
+  EXPECT_GE(least, 0.5 * m_u * (1.0 - 1e-6));
+  std::printf("reflected mass along u at the bracelet: %.3f kg (least sampled energy x 2: %.3f kg)\n", m_u, 2 * least);
+}
+
+// A region whose permissible speed is about 0.08 m/s for the Gen3's wrist, so that driving the end
+// effector at the governor's 0.25 m/s meets it (not a region of the standard: a test load).
+phri::BodyRegion slow_region() { return {"test_slow", 75000.0, 0.6, 8.0, 2.0}; }
+
+double worst_true_ratio(const phri::Controller& cycle, const phri::SimRobot& robot, phri::PowerForceLimitConstraint& probe,
+                        phri::Data& data, Eigen::MatrixXd& a, Eigen::VectorXd& l, Eigen::VectorXd& u) {
+  const Eigen::VectorXd& q = robot.truth().q_rad;
+  const Eigen::VectorXd& qd = robot.truth().qd_rad_s;
+  phri::compute_all_terms(cycle.model(), data, q, qd);
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(q.size());
+  const phri::ConstraintContext context{cycle.model(), data, q, qd, zero, zero, zero, zero};
+  probe.fill_rows(context, a, l, u);
+  return probe.worst_ratio();
+}
+
+double drive_far(bool limited, phri::LowLevelMode loop = phri::LowLevelMode::kCurrent) {
+  phri::SimRobotConfig config = phri::SimRobotConfig::from_yaml_file(kRoot + "/configs/plant_gen3.yaml");
+  config.initial_q_rad = {0, 0.58, 3.14, -1.84, 0, 0.85, 1.57};
+  config.mismatch.enabled = true;
+  phri::SimRobot robot(config);
+  phri::ControllerSettings settings = phri::test::gen3_controller_settings(phri::ComplianceMode::kStiff, loop);
+  phri::PowerForceLimitSettings pfl;
+  pfl.region = slow_region();
+  if (limited) settings.qp.power_force_limit = pfl;
+  phri::Controller cycle(settings);
+  // The same figures on the plant's true state, through a probe of its own.
+  const phri::CollisionModel capsules = *phri::Controller::collision_model(settings, cycle.model());
+  Eigen::VectorXd rotor(7);
+  for (int i = 0; i < 7; ++i) rotor[i] = cycle.actuators()[i].reflected_inertia_kgm2;
+  phri::PowerForceLimitConstraint probe(cycle.model(), capsules, rotor, pfl);
+  phri::Data data(cycle.model());
+  Eigen::MatrixXd a(probe.num_rows(), 7);
+  Eigen::VectorXd l(probe.num_rows()), u(probe.num_rows());
+  phri::RobotCommand command(7);
+  phri::ControllerTargets targets(7);
+  double worst = 0.0;
+  for (int k = 0; k < 3000; ++k) {
+    if (k == 300) {
+      Eigen::Isometry3d far = cycle.qp().end_effector().target_pose();
+      far.translation() += Eigen::Vector3d(0.0, -0.3, -0.1);
+      targets.has_pose = true;
+      targets.pose.pose = far;
+    }
+    cycle.step(robot.read(), targets, command);
+    targets.clear();
+    robot.write(command);
+    if (k > 300) worst = std::max(worst, worst_true_ratio(cycle, robot, probe, data, a, l, u));
+  }
+  EXPECT_EQ(cycle.status(), phri::CycleStatus::kOk);
+  return worst;
+}
+
+// The QP alone, its acceleration realised exactly (qd += qdd dt, q += qd dt): every point within its
+// permissible speed (the constraint's first-order bound, paper eq. sec-order-vel-damp's form).
+TEST(PowerForceLimit, TheQpHoldsEachPointWithinItsPermissibleSpeedWhenItsAccelerationIsRealised) {
+  const std::string gen3 = kRoot + "/robots/kinova_gen3/";
+  const phri::Model model = phri::Model::from_urdf_file(gen3 + "gen3.urdf");
+  const phri::CollisionModel capsules = phri::CollisionModel::from_yaml_file(gen3 + "collision.yaml", model);
+  phri::Data data(model);
+  phri::WholeBodyQpSettings settings;
+  settings.end_effector_frame = "end_effector_link";
+  phri::PowerForceLimitSettings limit;
+  limit.region = slow_region();
+  settings.power_force_limit = limit;
+  phri::WholeBodyQp qp(model, &capsules, settings);
+  Eigen::VectorXd q(7), qd = Eigen::VectorXd::Zero(7);
+  const Eigen::VectorXd tau_ext = Eigen::VectorXd::Zero(7);
+  q << 0, 0.58, 3.14, -1.84, 0, 0.85, 1.57;
+  phri::compute_all_terms(model, data, q, qd);
+  qp.end_effector().reset_gains(phri::Vector6d::Constant(400), phri::Vector6d::Constant(40), 1e4, phri::Vector6d::Zero());
+  qp.posture().reset_gains(20, 9, 1, 0);
+  qp.posture().set_target(q);
+  qp.end_effector().hold_current_pose(data);
+  Eigen::Isometry3d far = qp.end_effector().target_pose();
+  far.translation() += Eigen::Vector3d(0.0, -0.3, -0.1);
+  qp.end_effector().set_target(far);
+  double worst = 0.0, moved = 0.0;
+  const Eigen::Vector3d start = far.translation() - Eigen::Vector3d(0.0, -0.3, -0.1);
+  for (int k = 0; k < 2500; ++k) {
+    phri::compute_all_terms(model, data, q, qd);
+    ASSERT_EQ(qp.update(model, data, q, qd, tau_ext, 0.001), phri::WholeBodyQpStatus::kOk);
+    worst = std::max(worst, qp.power_force_limit()->worst_ratio());
+    qd += 0.001 * qp.desired_acceleration();
+    q += 0.001 * qd;
+  }
+  moved = (qp.end_effector().pose().translation() - start).norm();
+  std::printf("power and force limit, QP alone: worst v / v_max %.4f, the end effector moved %.0f mm in 2.5 s\n", worst,
+              1e3 * moved);
+  EXPECT_LT(worst, 1.01);
+  EXPECT_GT(moved, 0.1) << "slowed, not stopped";
+}
+
+// On the plant, through the loops: the bound holds as well as each loop realises the QP's acceleration.
+TEST(PowerForceLimit, OnThePlantTheConstraintCutsTheSpeedToNearItsBound) {
+  const double free = drive_far(false);
+  const double custom = drive_far(true);
+  const double position = drive_far(true, phri::LowLevelMode::kPosition);
+  const double kinova = drive_far(true, phri::LowLevelMode::kKinovaTorque);
+  std::printf("power and force limit on the plant, a 0.32 m move of the end effector (governor 0.25 m/s), worst true "
+              "v / v_max: %.3f without the constraint; with it %.3f custom loop, %.3f position loop, %.3f Kinova torque\n",
+              free, custom, position, kinova);
+  EXPECT_GT(free, 1.5) << "the test region must bind";
+  for (double limited : {custom, position, kinova}) EXPECT_LT(limited, 0.5 * free);
+}
+
+}  // namespace
+
+namespace {
+
+std::string force_table_with(const std::string& power_force_limit) {
+  std::ifstream in(kRoot + "/configs/force_table.yaml");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string key = "controller:\n";
+  text.insert(text.find(key) + key.size(), "  qp: {power_force_limit: " + power_force_limit + "}\n");
+  return text;
+}
+
+TEST(PowerForceLimit, TheRunYamlNamesARegionOfTheShippedFile) {
+  const phri::Config config = phri::Config::from_yaml_string(
+      force_table_with("{regions_file: iso_ts_15066_regions.yaml, region: hand_fingers}"), "test.yaml", kRoot + "/configs");
+  ASSERT_TRUE(config.controller.qp.power_force_limit);
+  const phri::BodyRegion& hand = config.controller.qp.power_force_limit->region;
+  EXPECT_EQ(hand.name, "hand_fingers");
+  EXPECT_EQ(hand.stiffness_N_per_m, 75000.0);
+  EXPECT_EQ(hand.mass_kg, 0.6);
+  EXPECT_EQ(hand.transient_force_N(), 280.0);
+  try {
+    phri::Config::from_yaml_string(force_table_with("{regions_file: iso_ts_15066_regions.yaml, region: elbow}"), "test.yaml",
+                                   kRoot + "/configs");
+    ADD_FAILURE() << "an unknown region is an error";
+  } catch (const phri::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("controller.qp.power_force_limit.region: no region 'elbow'"), std::string::npos)
+        << e.what();
+  }
+}
+
+}  // namespace
