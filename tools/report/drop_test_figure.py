@@ -165,7 +165,8 @@ def stabilisation_metric(rows, band, tcol, ccol):
     pt, pc = side("position")
     pval, z, eff, shorter, longer = gehan(tt, tc, pt, pc)
     horizon = max(tt + pt) if tt + pt else float("nan")
-    return {"label": f"stabilisation, band {band:g} mm [s]", "band_mm": band, "torque_centre": kaplan_meier_median(tt, tc),
+    label = "stabilisation [s]" if math.isnan(band) else f"stabilisation, band {band:g} mm [s]"
+    return {"label": label, "band_mm": band, "torque_centre": kaplan_meier_median(tt, tc),
             "position_centre": kaplan_meier_median(pt, pc), "centre": "Kaplan-Meier median", "horizon_s": horizon,
             "p": pval, "Z": z, "effect": eff, "effect_name": "Gehan pairwise", "better_pairs": shorter,
             "worse_pairs": longer, "n_torque": len(tt), "n_position": len(pt), "censored_torque": sum(tc),

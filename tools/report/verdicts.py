@@ -62,12 +62,13 @@ def effect_words(s):
 def comparison_sentence(s, unit):
     """What this run measured for one comparison, in one sentence."""
     t, p = s["torque_centre"], s["position_centre"]
+    lower, higher = ("shorter", "longer") if unit == "s" else ("lower", "higher")
     if t is None or p is None or _nan(t) or _nan(p):
         relation = "the two cannot be ordered by their centres"
     elif t < p:
-        relation = f"torque lower by {_num(p - t)} {unit}" + (f" (ratio {t / p:.2f})" if p > 0 else "")
+        relation = f"torque {lower} by {_num(p - t)} {unit}" + (f" (ratio {t / p:.2f})" if p > 0 else "")
     elif t > p:
-        relation = f"torque higher by {_num(t - p)} {unit}" + (f" (ratio {t / p:.2f})" if p > 0 else "")
+        relation = f"torque {higher} by {_num(t - p)} {unit}" + (f" (ratio {t / p:.2f})" if p > 0 else "")
     else:
         relation = "equal"
     censored = ""
