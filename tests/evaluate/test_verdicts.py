@@ -36,7 +36,7 @@ def write_runs(path, torque_better, seed):
             cens = m is bad and i in (8, 9)
             t = 5.0 if cens else stab
             bands = ",".join(f"{t:.3f},{int(cens)}" for _ in BANDS)
-            valid, why, loop = (0, "safe stop at 0.002 s (torque_current_mismatch, joint 2)", "position") \
+            valid, why, loop = (0, "safe stop at 0.002 s (torque_current_mismatch; joint 2)", "position") \
                 if (mode == "torque" and i == 11) else (1, "", "custom" if mode == "torque" else "position")
             lines.append(f"{mode},{i},{i + 1},6.2,{peak:.5f},{t:.3f},{int(cens)},{res:.5f},0.0,{res:.5f},{bands},"
                          f"0,{1 - valid},0,{loop},{valid},{why}")

@@ -137,6 +137,8 @@ def band_columns(rows):
         return []
     out = []
     for col in rows[0]:
+        if col is None:
+            continue
         m = re.fullmatch(r"stabilisation_(\d+)p(\d+)mm_s", col)
         if m:
             out.append((float(f"{m.group(1)}.{m.group(2)}"), col, col.replace("stabilisation_", "censored_")[:-2]))

@@ -418,6 +418,10 @@ def main(argv):
         f.write(rep.markdown())
     with open(f"{out}/report.html", "w") as f:
         f.write(rep.html())
+    # The validity header and every verdict on the console too (phri evaluate shows them).
+    for b in rep.blocks:
+        if b[0] == "p" and (b[1].startswith("Claim '") or b[1].startswith("Validity: ")):
+            print(b[1])
     print(f"report: {out}/report.md, {out}/report.html")
     return 0
 

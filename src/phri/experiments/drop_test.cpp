@@ -198,7 +198,8 @@ std::string runs_csv(const DropTestResult& r, const DropTestOptions& o) {
     for (std::size_t b = 0; b < d.band_stabilisation_s.size(); ++b) {
       s << ',' << format_fixed(d.band_stabilisation_s[b], 3) << ',' << static_cast<int>(d.band_censored[b]);
     }
-    const std::string why = d.invalid_reason();
+    std::string why = d.invalid_reason();
+    std::replace(why.begin(), why.end(), ',', ';');  // one CSV field
     s << ',' << d.qp_fallbacks << ',' << (d.safe_stop ? 1 : 0) << ',' << d.loop_mismatch_cycles << ',' << d.loop_ran << ','
       << (why.empty() ? 1 : 0) << ',' << why << '\n';
   }
