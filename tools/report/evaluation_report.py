@@ -115,7 +115,7 @@ def friction_section(rep, out):
                      f"{float(m['static_Nm']):.3f}", f"{float(m['plant_static_Nm']):.3f}"])
     rep.table(md_table(["joint", "actuator", "Fc identified [N.m]", "Fc plant", "Fc paper", "Fv identified [N.m.s/rad]",
                         "Fv plant", "Fv paper", "Fs identified [N.m]", "Fs plant"], rows))
-    rep.p("Why simulation and paper differ: the plant's friction is the paper's identified model (eq. friction-model) "
+    rep.p("The plant's friction (a protocol choice, not a finding): the paper's identified model (eq. friction-model) "
           "with every coefficient moved by up to 20 % (seeded), so that the identification has something to find; "
           "the identified values are to be compared with the plant's column, the paper's column is where the plant "
           "started from. The paper lumps static and Coulomb friction; the plant keeps them equal too.")
@@ -171,6 +171,8 @@ VARIANT_SETTING = {
     "observer_only_K50": "external torque from the observer alone (K_O 50)",
     "ft_only": "external torque from the F/T sensor alone",
     "cable_damping_50": "cable damping 50 N.s/m",
+    "cable_stiffness_8000": "cable stiffness 8000 N/m (damping ratio 0.1)",
+    "cable_stiffness_32620": "cable stiffness 32620 N/m (the reference's paracord estimate, damping ratio 0.1)",
     "vendor_gains_x0.5": "vendor servo gains x 0.5",
     "no_release_spread": "no release spread",
     "weight_latched_on_tool": "weight latched on the tool",

@@ -54,6 +54,7 @@ SimRobotConfig drop_plant(const DropShared& sh, int index) {
   c.elasticity.position_loop_encoder = o.servo_encoder;
   if (o.joint_stiffness_Nm_per_rad) c.elasticity.stiffness_Nm_per_rad = *o.joint_stiffness_Nm_per_rad;
   if (o.cable_damping_Ns_per_m) c.drop_test.cable_damping_Ns_per_m = *o.cable_damping_Ns_per_m;
+  if (o.cable_stiffness_N_per_m) c.drop_test.cable_stiffness_N_per_m = *o.cable_stiffness_N_per_m;
   if (o.release_spread_scale) {
     c.drop_test.release_vertical_spread_m *= *o.release_spread_scale;
     c.drop_test.release_horizontal_spread_m *= *o.release_spread_scale;

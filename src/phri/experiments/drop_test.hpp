@@ -96,6 +96,7 @@ struct DropTestOptions {
   // ---- plant variations for the sensitivity table (empty: the plant file's values)
   bool model_mismatch = true;
   std::optional<double> cable_damping_Ns_per_m;
+  std::optional<double> cable_stiffness_N_per_m;
   std::optional<double> vendor_gain_scale;  ///< x the vendor position servo's kp, kd, ki
   std::optional<double> release_spread_scale;  ///< x both release spreads
 };
