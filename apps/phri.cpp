@@ -293,6 +293,7 @@ int run_command(const RunArguments& args) {
   phri::RunOptions options;
   if (dashboard || backend->brake_on_interrupt()) options.live = &live;
   options.pushes = backend->pushes();
+  options.ground_truth = backend->ground_truth();
   // Until the files are written. On the arm, Ctrl-C brakes to rest first (InterruptToStop replaces
   // the SIGINT handler); SIGTERM ends the loop there too, then the backend's exit sequence.
   const StopOnSignals stop_on_signals;

@@ -344,3 +344,41 @@ TEST(RunSession, RealTimePacingRunsTheSameCyclesNoFasterThanTheClock) {
 }
 
 }  // namespace
+
+// With a ground truth (a simulated arm's true link-side joints), the summary's EE errors are
+// target - the true end effector and the QP's own task error stays beside them, labelled. Here the
+// "truth" is the fake arm's q with joint 2 off by 0.01 rad, an error the QP (on the measured q)
+// cannot see: the true error must show it, the QP's task error must not.
+TEST(RunSession, AGroundTruthMeasuresTheTrueEndEffectorBesideTheQpTaskError) {
+  struct OffsetTruth final : phri::GroundTruth {
+    explicit OffsetTruth(const phri::FakeRobot& r) : robot(r), q(7) {}
+    const Eigen::VectorXd& true_joint_positions() const override {
+      q = robot.state().q_rad;
+      q[1] += 0.01;
+      return q;
+    }
+    const phri::FakeRobot& robot;
+    mutable Eigen::VectorXd q;
+  };
+  Session session;
+  const OffsetTruth truth(session.robot_);
+  phri::RunOptions options;
+  options.duration_s = 0.2;
+  options.status_line = false;
+  options.ground_truth = &truth;
+  const phri::RunSummary s =
+      phri::run_session(session.robot_, session.controller_, session.fsm_, nullptr, nullptr, options, session.out_);
+  ASSERT_EQ(s.phases.size(), 1u);
+  const phri::PhaseSummary& p = s.phases[0];
+  EXPECT_TRUE(p.ee_error_true);
+  EXPECT_GT(p.ee_position_error_rms_mm, p.qp_task_position_error_rms_mm + 2.0);
+  std::ostringstream printed;
+  phri::print_run_summary(s, printed);
+  EXPECT_NE(printed.str().find("target - the true end effector"), std::string::npos) << printed.str();
+  EXPECT_NE(printed.str().find("QP task pos RMS mm"), std::string::npos);
+  // Without one, the EE errors are the QP's task error, and the summary says so.
+  Session plain;
+  const phri::RunSummary q = plain.run(0.2);
+  EXPECT_FALSE(q.phases[0].ee_error_true);
+  EXPECT_DOUBLE_EQ(q.phases[0].ee_position_error_rms_mm, q.phases[0].qp_task_position_error_rms_mm);
+}

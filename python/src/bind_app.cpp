@@ -117,6 +117,8 @@ void bind_run_session(py::module_& m) {
       .def_readonly("end_s", &PhaseSummary::end_s)
       .def_readonly("ee_position_error_max_mm", &PhaseSummary::ee_position_error_max_mm)
       .def_readonly("ee_position_error_rms_mm", &PhaseSummary::ee_position_error_rms_mm)
+      .def_readonly("ee_error_true", &PhaseSummary::ee_error_true, "True: the ee errors are from the plant's true state.")
+      .def_readonly("qp_task_position_error_rms_mm", &PhaseSummary::qp_task_position_error_rms_mm)
       .def_readonly("wrench_norm_max", &PhaseSummary::wrench_norm_max)
       .def_readonly("cycle_median_us", &PhaseSummary::cycle_median_us);
   py::class_<RunSummary>(m, "RunSummary", "What run_session measured.")

@@ -204,7 +204,12 @@ void bind_drop_test(py::module_& m) {
       .def_readonly("peak_mm", &DropRun::peak_mm)
       .def_readonly("stabilisation_s", &DropRun::stabilisation_s)
       .def_readonly("residual_mm", &DropRun::residual_mm)
+      .def_readonly("censored", &DropRun::censored)
+      .def_readonly("residual_shift_mm", &DropRun::residual_shift_mm)
       .def_readonly("qp_fallbacks", &DropRun::qp_fallbacks)
+      .def_readonly("safe_stop", &DropRun::safe_stop)
+      .def_readonly("loop_ran", &DropRun::loop_ran)
+      .def("invalid_reason", &DropRun::invalid_reason, "Empty: valid.")
       .def_readonly("error_mm", &DropRun::error_mm, "e_z over the window, one sample per period (a copy).");
   py::class_<DropTestResult>(m, "DropTestResult", "Every drop, torque mode first, and the files written.")
       .def_readonly("runs", &DropTestResult::runs)

@@ -13,6 +13,7 @@
 // An unknown name is one phri::ConfigError naming it and the known ones.
 #include <phri/config/config.hpp>
 #include <phri/model/model.hpp>
+#include <phri/robot/ground_truth.hpp>
 #include <phri/robot/push_input.hpp>
 #include <phri/robot/robot_interface.hpp>
 
@@ -31,6 +32,8 @@ public:
   virtual RobotInterface& robot() = 0;
   /// Where the live front end's pushes go (a simulated arm), or null.
   virtual PushInput* pushes() { return nullptr; }
+  /// The plant's true state for the run's error measurements (a simulated arm), or null.
+  virtual const GroundTruth* ground_truth() const { return nullptr; }
   /// Ctrl-C must brake the arm to rest through the FSM before the run ends (an arm behind a link).
   virtual bool brake_on_interrupt() const { return false; }
   /// One line on the link and the arm after the run; '' when there is nothing to say.

@@ -3,6 +3,7 @@
 #include <phri/app/fill_log_row.hpp>
 #include <phri/app/loop_clock.hpp>
 #include <phri/core/statistics.hpp>
+#include <phri/model/algorithms.hpp>
 
 #include <algorithm>
 #include <chrono>
@@ -26,12 +27,14 @@ constexpr int kMaxSteps = 1 << 30;  // single steps asked and not yet run (they 
 
 // The sums of one phase, for its row of the summary table.
 struct PhaseAccumulator {
-  double pos_max = 0, pos_sq = 0, ori_max = 0, ori_sq = 0, wrench_max = 0;
+  double pos_max = 0, pos_sq = 0, ori_max = 0, ori_sq = 0, wrench_max = 0, qp_pos_max = 0, qp_pos_sq = 0;
   long n = 0;
   int compliance_switches = 0, loop_switches = 0;
   std::size_t first_cycle = 0;
 
-  void add(double pos, double ori, double wrench) {
+  void add(double pos, double ori, double wrench, double qp_pos) {
+    qp_pos_max = std::max(qp_pos_max, qp_pos);
+    qp_pos_sq += qp_pos * qp_pos;
     pos_max = std::max(pos_max, pos);
     pos_sq += pos * pos;
     ori_max = std::max(ori_max, ori);
@@ -67,6 +70,8 @@ public:
         last_loop_switches_(cycle.low_level().switch_count()),
         live_(options.live),
         pushes_(options.pushes),
+        ground_truth_(options.ground_truth),
+        truth_data_(cycle.model()),
         observers_(options.observers) {
     if (live_) observers_.push_back(&live_->snapshots());
     if (live_ && pushes_) push_targets_ = push_targets(cycle.model(), *pushes_);
@@ -232,12 +237,29 @@ private:
     return snapshot_;
   }
 
-  // Adds the cycle to its phase's sums; returns the end-effector position error [mm].
+  // Target - the true end effector (forward kinematics of the plant's link-side joints) [mm, deg];
+  // false without a ground truth.
+  bool true_ee_error(double& pos_mm, double& ori_deg) {
+    if (ground_truth_ == nullptr || ground_truth_->true_joint_positions().size() != static_cast<Eigen::Index>(cycle_.model().nq())) return false;
+    forward_kinematics(cycle_.model(), truth_data_, ground_truth_->true_joint_positions());
+    update_frame_placements(cycle_.model(), truth_data_);
+    const auto& target = cycle_.qp().end_effector().target_pose();
+    const auto& pose = truth_data_.frame_placements[static_cast<std::size_t>(cycle_.end_effector_frame())];
+    pos_mm = 1e3 * (target.translation() - pose.translation()).norm();
+    const Eigen::Matrix3d r = target.linear() * pose.linear().transpose();
+    ori_deg = Eigen::AngleAxisd(r).angle() * 180.0 / std::numbers::pi;
+    return true;
+  }
+
+  // Adds the cycle to its phase's sums; returns the end-effector position error [mm] (the true one
+  // when the run has a ground truth, else the QP's task error).
   double accumulate_phase() {
     PhaseAccumulator& a = acc_[phase_];
     const Vector6d& error = cycle_.qp().end_effector().error();
-    const double pos = 1e3 * error.head<3>().norm(), ori = error.tail<3>().norm() * 180.0 / std::numbers::pi;
-    a.add(pos, ori, cycle_.wrench().norm());
+    const double qp_pos = 1e3 * error.head<3>().norm();
+    double pos = qp_pos, ori = error.tail<3>().norm() * 180.0 / std::numbers::pi;
+    true_ee_error(pos, ori);
+    a.add(pos, ori, cycle_.wrench().norm(), qp_pos);
     const ComplianceController& compliance = cycle_.compliance();
     if (compliance.mode() != last_mode_ || compliance.touch_count() != last_touches_) ++a.compliance_switches;
     if (cycle_.low_level().switch_count() != last_loop_switches_) ++a.loop_switches;
@@ -338,6 +360,9 @@ private:
     s.ee_position_error_rms_mm = std::sqrt(a.pos_sq / static_cast<double>(a.n));
     s.ee_orientation_error_max_deg = a.ori_max;
     s.ee_orientation_error_rms_deg = std::sqrt(a.ori_sq / static_cast<double>(a.n));
+    s.ee_error_true = ground_truth_ != nullptr && ground_truth_->true_joint_positions().size() == static_cast<Eigen::Index>(cycle_.model().nq());
+    s.qp_task_position_error_max_mm = a.qp_pos_max;
+    s.qp_task_position_error_rms_mm = std::sqrt(a.qp_pos_sq / static_cast<double>(a.n));
     s.wrench_norm_max = a.wrench_max;
     s.compliance_switches = a.compliance_switches;
     s.loop_switches = a.loop_switches;
@@ -374,6 +399,8 @@ private:
   // live front end
   LiveChannel* live_;
   PushInput* pushes_;
+  const GroundTruth* ground_truth_;
+  Data truth_data_;  // forward kinematics of the true joints, sized once
   std::vector<SnapshotChannel*> observers_;  // options.observers and the live front end's; sized before the loop
   std::vector<int> push_targets_;
   double push_start_s_ = 0.0, push_end_s_ = 0.0;
@@ -402,13 +429,20 @@ void print_run_summary(const RunSummary& s, std::ostream& out) {
                 s.safe_hold ? (" ; SAFE HOLD: " + s.safe_hold_reason).c_str() : "",
                 s.interrupted ? " ; INTERRUPTED before the end of its duration" : "");
   out << line;
-  out << "| phase | from s | to s | EE pos max mm | EE pos RMS mm | EE ori max deg | EE ori RMS deg | wrench max | mode switches | loop switches | cycle median us | cycle p99.9 us |\n";
-  out << "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+  const bool truth = !s.phases.empty() && s.phases.front().ee_error_true;
+  out << (truth ? "EE errors: target - the true end effector (the simulator's link-side joints); QP task error: the "
+                  "QP's own (target - its estimate of the pose)\n"
+                : "EE errors: the QP's task error (target - its estimate of the pose; no ground truth on this robot)\n");
+  out << "| phase | from s | to s | EE pos max mm | EE pos RMS mm | EE ori max deg | EE ori RMS deg | QP task pos max mm | "
+         "QP task pos RMS mm | wrench max | mode switches | loop switches | cycle median us | cycle p99.9 us |\n";
+  out << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const PhaseSummary& p : s.phases) {
-    std::snprintf(line, sizeof line, "| %s | %.1f | %.1f | %.2f | %.2f | %.2f | %.2f | %.1f | %d | %d | %.1f | %.1f |\n",
+    std::snprintf(line, sizeof line,
+                  "| %s | %.1f | %.1f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.1f | %d | %d | %.1f | %.1f |\n",
                   p.name.c_str(), p.start_s, p.end_s, p.ee_position_error_max_mm, p.ee_position_error_rms_mm,
-                  p.ee_orientation_error_max_deg, p.ee_orientation_error_rms_deg, p.wrench_norm_max,
-                  p.compliance_switches, p.loop_switches, p.cycle_median_us, p.cycle_p999_us);
+                  p.ee_orientation_error_max_deg, p.ee_orientation_error_rms_deg, p.qp_task_position_error_max_mm,
+                  p.qp_task_position_error_rms_mm, p.wrench_norm_max, p.compliance_switches, p.loop_switches,
+                  p.cycle_median_us, p.cycle_p999_us);
     out << line;
   }
 }

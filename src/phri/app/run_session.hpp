@@ -16,6 +16,7 @@
 #include <phri/app/live_channel.hpp>
 #include <phri/app/snapshot_channel.hpp>
 #include <phri/app/logger.hpp>
+#include <phri/robot/ground_truth.hpp>
 #include <phri/robot/push_input.hpp>
 #include <phri/robot/robot_interface.hpp>
 
@@ -44,6 +45,10 @@ struct RunOptions {
   /// Where the live front end's pushes go (a simulated arm: the backend that built the robot hands
   /// it over), or null: pushes are ignored.
   PushInput* pushes = nullptr;
+  /// The plant's true joint positions (a simulated arm), or null. Given, the summary's end-effector
+  /// errors are target - the true end effector (forward kinematics of the true link-side joints);
+  /// the QP's own task error is kept beside them, labelled as such.
+  const GroundTruth* ground_truth = nullptr;
   /// Observers of the run besides the live front end (a recorder, a bridge, a second monitor): each
   /// gets every `decimation`-th cycle's snapshot through its own lock-free ring; a full ring drops
   /// the snapshot, so none can block or slow the cycle. Each must outlive the run.
@@ -59,6 +64,11 @@ struct PhaseSummary {
   double start_s = 0.0, end_s = 0.0;
   double ee_position_error_max_mm = 0.0, ee_position_error_rms_mm = 0.0;
   double ee_orientation_error_max_deg = 0.0, ee_orientation_error_rms_deg = 0.0;
+  /// Whether the ee_* errors above are measured from the plant's true state (RunOptions::ground_truth);
+  /// false: they are the QP's task error (all a real arm's run has).
+  bool ee_error_true = false;
+  /// The QP's own end-effector task error (target - the controller's estimate of the pose).
+  double qp_task_position_error_max_mm = 0.0, qp_task_position_error_rms_mm = 0.0;
   double wrench_norm_max = 0.0;
   int compliance_switches = 0;   ///< compliance mode changes and dual-compliance touches
   int loop_switches = 0;

@@ -11,6 +11,7 @@ public:
   explicit SimBackend(const Config& config) : robot_(config.plant) {}
   RobotInterface& robot() override { return robot_; }
   PushInput* pushes() override { return &robot_; }
+  const GroundTruth* ground_truth() const override { return &robot_; }
 
 private:
   SimRobot robot_;

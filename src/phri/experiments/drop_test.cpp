@@ -54,6 +54,7 @@ SimRobotConfig drop_plant(const DropShared& sh, int index) {
   c.elasticity.position_loop_encoder = o.servo_encoder;
   if (o.joint_stiffness_Nm_per_rad) c.elasticity.stiffness_Nm_per_rad = *o.joint_stiffness_Nm_per_rad;
   if (o.cable_damping_Ns_per_m) c.drop_test.cable_damping_Ns_per_m = *o.cable_damping_Ns_per_m;
+  if (o.cable_stiffness_N_per_m) c.drop_test.cable_stiffness_N_per_m = *o.cable_stiffness_N_per_m;
   if (o.release_spread_scale) {
     c.drop_test.release_vertical_spread_m *= *o.release_spread_scale;
     c.drop_test.release_horizontal_spread_m *= *o.release_spread_scale;
@@ -67,8 +68,46 @@ SimRobotConfig drop_plant(const DropShared& sh, int index) {
   return c;
 }
 
+// The loop the row names: torque mode runs torque_loop from switch_s on, position mode the position loop.
+LowLevelMode expected_loop(const DropTestOptions& o, DropMode mode) {
+  return mode == DropMode::kTorque ? o.torque_loop : LowLevelMode::kPosition;
+}
+
+// Validity bookkeeping of one cycle: QP fallbacks, the supervisor's safe stop, the loop that ran.
+void check_cycle(const DropTestOptions& o, DropMode mode, bool switched, CycleStatus status, const Controller& cycle,
+                 const RobotCommand& command, DropRun& run) {
+  if (status == CycleStatus::kQpFallback) ++run.qp_fallbacks;
+  if (!run.safe_stop && cycle.supervisor().safe_stop()) {
+    const SafetyTransition& t = cycle.supervisor().safe_stop_transition();
+    run.safe_stop = true;
+    run.safe_stop_s = t.time_s;
+    run.safe_stop_reason = std::string(to_string(t.reason)) + (t.joint >= 0 ? ", joint " + std::to_string(t.joint + 1) : "");
+  }
+  if (switched && (command.mode != expected_loop(o, mode) || cycle.low_level().loop() != expected_loop(o, mode))) {
+    ++run.loop_mismatch_cycles;
+  }
+  run.loop_ran = std::string(to_string(command.mode));
+}
+
+// The metrics of a finished drop: peak, residual, its shift from before the drop, stabilisation per band.
+void finish_drop(const DropTestOptions& o, double dt, DropRun& run) {
+  drop_metrics(run.error_mm, dt, o.residual_window_s, run.peak_mm, run.residual_mm);
+  const std::size_t tail = std::min(run.error_mm.size(), static_cast<std::size_t>(std::lround(o.residual_window_s / dt)));
+  double mean = 0.0;
+  for (std::size_t k = run.error_mm.size() - tail; k < run.error_mm.size(); ++k) mean += run.error_mm[k];
+  mean /= static_cast<double>(std::max<std::size_t>(1, tail));
+  run.residual_shift_mm = std::abs(mean - run.before_mm);
+  for (double band : o.stabilisation_bands_mm) {
+    const Stabilisation s = drop_stabilisation(run.error_mm, dt, o.residual_window_s, band);
+    run.band_stabilisation_s.push_back(s.time_s);
+    run.band_censored.push_back(s.censored ? 1 : 0);
+  }
+  run.stabilisation_s = run.band_stabilisation_s.front();
+  run.censored = run.band_censored.front() != 0;
+}
+
 // One drop on a fresh plant and controller: hold, (torque mode: switch to the custom loop), release,
-// record e_z from the catch for window_s.
+// record e_z before the release (its mean) and from the catch for window_s.
 DropRun run_drop(const DropShared& sh, DropMode mode, int index) {
   const DropTestOptions& o = sh.o;
   SimRobot robot(drop_plant(sh, index));
@@ -76,6 +115,9 @@ DropRun run_drop(const DropShared& sh, DropMode mode, int index) {
   const int n = robot.dof();
   const double dt = robot.period_s();
   const int window = static_cast<int>(std::lround(o.window_s / dt));
+  const int switch_k = mode == DropMode::kTorque ? static_cast<int>(std::lround(o.switch_s / dt)) : 0;
+  const int before_k = static_cast<int>(std::lround((o.release_s - o.pre_release_s) / dt));
+  const int release_k = static_cast<int>(std::lround(o.release_s / dt));
   RobotCommand command(n);
   ControllerTargets targets(n);
   Data truth(cycle.model());
@@ -85,27 +127,37 @@ DropRun run_drop(const DropShared& sh, DropMode mode, int index) {
   run.index = index;
   run.seed = robot.config().seed;
   run.error_mm.reserve(static_cast<std::size_t>(window));
+  int before_samples = 0;
   // The catch must come within 1 s of the release (a 25 cm fall takes 0.23 s).
   const int last = static_cast<int>(std::lround((o.release_s + 1.0 + o.window_s) / dt));
   for (int k = 0; k < last && static_cast<int>(run.error_mm.size()) < window; ++k) {
     const RobotState& state = robot.read();
     if (state.fault) throw ExperimentError("drop test", "the simulated plant faulted (drop " + std::to_string(index) + ")");
     targets.clear();
-    if (mode == DropMode::kTorque && k == static_cast<int>(std::lround(o.switch_s / dt))) targets.low_level_mode = o.torque_loop;
-    if (cycle.step(state, targets, command) == CycleStatus::kQpFallback) ++run.qp_fallbacks;
+    if (mode == DropMode::kTorque && k == switch_k) targets.low_level_mode = o.torque_loop;
+    const CycleStatus status = cycle.step(state, targets, command);
+    check_cycle(o, mode, k >= switch_k + 1, status, cycle, command, run);
     robot.write(command);
     const SimRobot::Truth& t = robot.truth();
-    if (run.error_mm.empty() && !(t.drop_released && t.cable_force_N > 0.0)) continue;
-    if (run.error_mm.empty()) run.catch_s = t.time_s;
+    const bool recording = !run.error_mm.empty() || (t.drop_released && t.cable_force_N > 0.0);
+    if (!recording && (k < before_k || k >= release_k)) continue;
     forward_kinematics(cycle.model(), truth, t.q_rad);
     update_frame_placements(cycle.model(), truth);
-    const double e = cycle.qp().end_effector().target_pose().translation().z() - truth.frame_placements[ee].translation().z();
-    run.error_mm.push_back(static_cast<float>(1e3 * e));
+    const double e = 1e3 * (cycle.qp().end_effector().target_pose().translation().z() -
+                            truth.frame_placements[ee].translation().z());
+    if (!recording) {
+      run.before_mm += e;
+      ++before_samples;
+      continue;
+    }
+    if (run.error_mm.empty()) run.catch_s = t.time_s;
+    run.error_mm.push_back(static_cast<float>(e));
   }
   if (static_cast<int>(run.error_mm.size()) < window) {
     throw ExperimentError("drop test", "no catch within 1 s of the release (drop " + std::to_string(index) + ")");
   }
-  drop_metrics(run.error_mm, dt, o.residual_window_s, o.band_fraction, run.peak_mm, run.stabilisation_s, run.residual_mm);
+  run.before_mm /= std::max(1, before_samples);
+  finish_drop(o, dt, run);
   return run;
 }
 
@@ -118,17 +170,39 @@ void validate(const DropTestOptions& o) {
   if (!(o.window_s > o.residual_window_s && o.residual_window_s > 0.0)) {
     throw ConfigError(src, "window_s/residual_window_s", "need window_s > residual_window_s > 0");
   }
-  if (!(o.band_fraction > 0.0 && o.band_fraction < 1.0)) throw ConfigError(src, "band_fraction", "must be in (0, 1)");
+  if (o.stabilisation_bands_mm.empty() ||
+      std::any_of(o.stabilisation_bands_mm.begin(), o.stabilisation_bands_mm.end(), [](double b) { return !(b > 0.0); })) {
+    throw ConfigError(src, "stabilisation_bands_mm", "need at least one band, each > 0 mm");
+  }
+  if (!(o.pre_release_s > 0.0 && o.pre_release_s < o.release_s - o.switch_s)) {
+    throw ConfigError(src, "pre_release_s", "must be > 0 and end after the switch to torque control");
+  }
   if (!(o.observer_gain > 0.0 && o.observer_gain * 1e-3 < 1.0)) throw ConfigError(src, "observer_gain", "must be in (0, 1000)");
 }
 
-std::string runs_csv(const DropTestResult& r) {
+std::string band_name(double band_mm) {
+  std::string b = format_fixed(band_mm, 2);
+  std::replace(b.begin(), b.end(), '.', 'p');
+  return b + "mm";
+}
+
+// One row per drop: metrics, censoring, per-band stabilisation, then validity (valid 0/1 and why not).
+std::string runs_csv(const DropTestResult& r, const DropTestOptions& o) {
   std::ostringstream s;
-  s << "mode,index,seed,catch_s,peak_mm,stabilisation_s,residual_mm,qp_fallbacks\n";
+  s << "mode,index,seed,catch_s,peak_mm,stabilisation_s,censored,residual_mm,before_mm,residual_shift_mm";
+  for (double b : o.stabilisation_bands_mm) s << ",stabilisation_" << band_name(b) << "_s,censored_" << band_name(b);
+  s << ",qp_fallbacks,safe_stop,loop_mismatch_cycles,loop_ran,valid,invalid_reason\n";
   for (const DropRun& d : r.runs) {
     s << to_string(d.mode) << ',' << d.index << ',' << d.seed << ',' << format_fixed(d.catch_s, 3) << ','
-      << format_fixed(d.peak_mm, 5) << ',' << format_fixed(d.stabilisation_s, 3) << ',' << format_fixed(d.residual_mm, 5)
-      << ',' << d.qp_fallbacks << '\n';
+      << format_fixed(d.peak_mm, 5) << ',' << format_fixed(d.stabilisation_s, 3) << ',' << (d.censored ? 1 : 0) << ','
+      << format_fixed(d.residual_mm, 5) << ',' << format_fixed(d.before_mm, 5) << ',' << format_fixed(d.residual_shift_mm, 5);
+    for (std::size_t b = 0; b < d.band_stabilisation_s.size(); ++b) {
+      s << ',' << format_fixed(d.band_stabilisation_s[b], 3) << ',' << static_cast<int>(d.band_censored[b]);
+    }
+    std::string why = d.invalid_reason();
+    std::replace(why.begin(), why.end(), ',', ';');  // one CSV field
+    s << ',' << d.qp_fallbacks << ',' << (d.safe_stop ? 1 : 0) << ',' << d.loop_mismatch_cycles << ',' << d.loop_ran << ','
+      << (why.empty() ? 1 : 0) << ',' << why << '\n';
   }
   return s.str();
 }
@@ -158,8 +232,16 @@ void mean_sd(const std::vector<double>& v, double& mean, double& sd) {
 
 }  // namespace
 
-void drop_metrics(const std::vector<float>& e, double dt, double residual_window_s, double band_fraction, double& peak_mm,
-                  double& stabilisation_s, double& residual_mm) {
+std::string DropRun::invalid_reason() const {
+  std::string why;
+  auto add = [&why](const std::string& x) { why += (why.empty() ? "" : "; ") + x; };
+  if (safe_stop) add("safe stop at " + format_fixed(safe_stop_s, 3) + " s (" + safe_stop_reason + ")");
+  if (qp_fallbacks > 0) add(std::to_string(qp_fallbacks) + " QP fallbacks");
+  if (loop_mismatch_cycles > 0) add(std::to_string(loop_mismatch_cycles) + " cycles in another loop (" + loop_ran + " at the end)");
+  return why;
+}
+
+void drop_metrics(const std::vector<float>& e, double dt, double residual_window_s, double& peak_mm, double& residual_mm) {
   peak_mm = 0.0;
   for (float x : e) peak_mm = std::max(peak_mm, static_cast<double>(std::abs(x)));
   const std::size_t tail = std::min(e.size(), static_cast<std::size_t>(std::lround(residual_window_s / dt)));
@@ -167,13 +249,23 @@ void drop_metrics(const std::vector<float>& e, double dt, double residual_window
   for (std::size_t k = e.size() - tail; k < e.size(); ++k) mean += e[k];
   mean /= static_cast<double>(std::max<std::size_t>(1, tail));
   residual_mm = std::abs(mean);
+}
+
+Stabilisation drop_stabilisation(const std::vector<float>& e, double dt, double residual_window_s, double band_mm) {
+  const std::size_t tail = std::min(e.size(), static_cast<std::size_t>(std::lround(residual_window_s / dt)));
+  double mean = 0.0;
+  for (std::size_t k = e.size() - tail; k < e.size(); ++k) mean += e[k];
+  mean /= static_cast<double>(std::max<std::size_t>(1, tail));
   // The first sample after which the error never leaves the band around its final mean.
-  const double band = band_fraction * peak_mm;
   std::size_t settled = 0;
   for (std::size_t k = 0; k < e.size(); ++k) {
-    if (std::abs(e[k] - mean) > band) settled = k + 1;
+    if (std::abs(e[k] - mean) > band_mm) settled = k + 1;
   }
-  stabilisation_s = static_cast<double>(settled) * dt;
+  const std::size_t limit = e.size() - tail;
+  Stabilisation s;
+  s.censored = settled > limit;
+  s.time_s = static_cast<double>(s.censored ? limit : settled) * dt;
+  return s;
 }
 
 DropTestResult run_drop_test(const DropTestOptions& o, std::ostream* progress) {
@@ -198,15 +290,17 @@ DropTestResult run_drop_test(const DropTestOptions& o, std::ostream* progress) {
     ++done;
     if (progress) {
       *progress << "  [" << done << "/" << 2 * o.drops << "] " << to_string(mode) << " drop " << run.index << ": peak "
-                << format_fixed(run.peak_mm, 3) << " mm, stabilisation " << format_fixed(run.stabilisation_s, 3)
-                << " s, residual " << format_fixed(run.residual_mm, 4) << " mm" << std::endl;
+                << format_fixed(run.peak_mm, 3) << " mm, stabilisation " << (run.censored ? "> " : "")
+                << format_fixed(run.stabilisation_s, 3) << " s" << (run.censored ? " (censored)" : "") << ", residual "
+                << format_fixed(run.residual_mm, 4) << " mm"
+                << (run.invalid_reason().empty() ? "" : ", INVALID: " + run.invalid_reason()) << std::endl;
     }
     result.simulated_s += run.catch_s + o.window_s;
     result.runs[static_cast<std::size_t>(task)] = std::move(run);
   });
   result.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   if (!o.output_dir.empty()) {
-    result.files = write_output_files(o.output_dir, {{"drop_test_runs.csv", runs_csv(result)},
+    result.files = write_output_files(o.output_dir, {{"drop_test_runs.csv", runs_csv(result, o)},
                                                      {"drop_test_traces.csv", traces_csv(result, shared.plant.control_period_s)},
                                                      {"drop_test.md", drop_test_table(result, o)}});
   }
@@ -214,24 +308,38 @@ DropTestResult run_drop_test(const DropTestOptions& o, std::ostream* progress) {
 }
 
 std::string drop_test_table(const DropTestResult& r, const DropTestOptions& o) {
-  auto column = [&](DropMode mode, double DropRun::*field) {
+  // Valid drops only; stabilisation as the median of the settled ones plus the censored count (a
+  // censored drop has no settling time to average).
+  auto column = [&](DropMode mode, double DropRun::*field, bool settled_only) {
     std::vector<double> v;
     for (const DropRun& d : r.runs) {
-      if (d.mode == mode) v.push_back(d.*field);
+      if (d.mode == mode && d.invalid_reason().empty() && !(settled_only && d.censored)) v.push_back(d.*field);
     }
     return v;
   };
+  auto count = [&](DropMode mode, bool censored_only) {
+    return std::count_if(r.runs.begin(), r.runs.end(), [&](const DropRun& d) {
+      return d.mode == mode && d.invalid_reason().empty() && (!censored_only || d.censored);
+    });
+  };
   std::ostringstream s;
   s << "| metric | torque mean | torque sd | position mean | position sd |\n|---|---|---|---|---|\n";
-  const std::pair<const char*, double DropRun::*> metrics[] = {
-      {"peak [mm]", &DropRun::peak_mm}, {"stabilisation [s]", &DropRun::stabilisation_s}, {"residual [mm]", &DropRun::residual_mm}};
+  const std::pair<const char*, double DropRun::*> metrics[] = {{"peak [mm]", &DropRun::peak_mm},
+                                                               {"residual [mm]", &DropRun::residual_mm},
+                                                               {"residual shift from before the drop [mm]", &DropRun::residual_shift_mm},
+                                                               {"stabilisation, settled drops only [s]", &DropRun::stabilisation_s}};
   for (const auto& [name, field] : metrics) {
+    const bool settled_only = field == &DropRun::stabilisation_s;
     double mt = 0, st = 0, mp = 0, sp = 0;
-    mean_sd(column(DropMode::kTorque, field), mt, st);
-    mean_sd(column(DropMode::kPosition, field), mp, sp);
+    mean_sd(column(DropMode::kTorque, field, settled_only), mt, st);
+    mean_sd(column(DropMode::kPosition, field, settled_only), mp, sp);
     s << "| " << name << " | " << format_fixed(mt, 3) << " | " << format_fixed(st, 3) << " | " << format_fixed(mp, 3)
       << " | " << format_fixed(sp, 3) << " |\n";
   }
+  s << "\nValid drops: torque " << count(DropMode::kTorque, false) << ", position " << count(DropMode::kPosition, false)
+    << " of " << o.drops << " each (invalid: safe stop, QP fallback or another loop; left out). Not settled within "
+    << format_fixed(o.stabilisation_bands_mm.front(), 2) << " mm by " << format_fixed(o.window_s - o.residual_window_s, 1)
+    << " s (censored): torque " << count(DropMode::kTorque, true) << ", position " << count(DropMode::kPosition, true) << ".\n";
   s << "\n" << o.drops << " drops per mode; torque mode: " << to_string(o.torque_loop) << " loop, "
     << to_string(o.torque_compliance) << " compliance, external torque " << to_string(o.external_torque_source)
     << ", K_O " << format_fixed(o.observer_gain, 0) << " 1/s; position mode "

@@ -45,6 +45,7 @@
 #include <phri/sim/elastic_transmission.hpp>
 #include <phri/sim/mujoco_handles.hpp>
 #include <phri/sim/random_push_generator.hpp>
+#include <phri/robot/ground_truth.hpp>
 #include <phri/robot/push_input.hpp>
 #include <phri/robot/robot_interface.hpp>
 #include <phri/config/sim_robot_config.hpp>
@@ -58,7 +59,7 @@
 
 namespace phri {
 
-class SimRobot final : public RobotInterface, public PushInput {
+class SimRobot final : public RobotInterface, public PushInput, public GroundTruth {
 public:
   using Vector6d = Eigen::Matrix<double, 6, 1>;
 
@@ -121,6 +122,9 @@ public:
   // ---- PushInput: a step force as a live disturbance from the latest state's time on.
   int push_target(const std::string& link) const override { return body_id(link); }
   void push(int target, const Eigen::Vector3d& point_m, const Eigen::Vector3d& force_world_N, double hold_s) override;
+
+  // ---- GroundTruth: truth().q_rad, the link side of the joints.
+  const Eigen::VectorXd& true_joint_positions() const override { return truth_.q_rad; }
 
   /// MuJoCo model and data, read-only (viewers, tests comparing with MuJoCo's own quantities).
   const mjModel_* mujoco_model() const { return m_.get(); }

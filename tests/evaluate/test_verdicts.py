@@ -1,0 +1,103 @@
+"""ctest `report_verdicts_follow_the_numbers`: the evaluation report's verdicts are computed, not canned.
+
+Writes two synthetic drop-test result sets, one where torque mode wins every metric and one where it
+loses every metric (plus an invalid drop and censored drops in each), runs the report generator
+(tools/report/evaluation_report.py) on each, and checks that the verdict sentences differ
+accordingly: REPRODUCED with the signs + in the first, NOT REPRODUCED with the signs - in the
+second; the invalid drop is counted and left out; the censored drops are counted, not averaged.
+
+Usage: test_verdicts.py REPORT_SCRIPT WORK_DIR
+"""
+import os
+import re
+import subprocess
+import sys
+
+import numpy as np
+
+BANDS = ("0p25mm", "0p10mm", "0p50mm")
+
+
+def write_runs(path, torque_better, seed):
+    rng = np.random.default_rng(seed)
+    header = ("mode,index,seed,catch_s,peak_mm,stabilisation_s,censored,residual_mm,before_mm,residual_shift_mm,"
+              + ",".join(f"stabilisation_{b}_s,censored_{b}" for b in BANDS)
+              + ",qp_fallbacks,safe_stop,loop_mismatch_cycles,loop_ran,valid,invalid_reason")
+    lines = [header]
+    good = {"peak": 3.0, "stab": 0.5, "res": 0.1}
+    bad = {"peak": 6.0, "stab": 1.5, "res": 0.4}
+    for mode in ("torque", "position"):
+        m = good if (mode == "torque") == torque_better else bad
+        for i in range(12):
+            peak = m["peak"] * (1 + 0.1 * rng.standard_normal())
+            res = m["res"] * (1 + 0.1 * rng.standard_normal())
+            stab = m["stab"] * (1 + 0.1 * rng.standard_normal())
+            # the loser's last two drops never settle: censored at 5 s
+            cens = m is bad and i in (8, 9)
+            t = 5.0 if cens else stab
+            bands = ",".join(f"{t:.3f},{int(cens)}" for _ in BANDS)
+            valid, why, loop = (0, "safe stop at 0.002 s (torque_current_mismatch; joint 2)", "position") \
+                if (mode == "torque" and i == 11) else (1, "", "custom" if mode == "torque" else "position")
+            lines.append(f"{mode},{i},{i + 1},6.2,{peak:.5f},{t:.3f},{int(cens)},{res:.5f},0.0,{res:.5f},{bands},"
+                         f"0,{1 - valid},0,{loop},{valid},{why}")
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    with open(path, "w") as f:
+        f.write("\n".join(lines) + "\n")
+
+
+def run_report(script, out):
+    run = subprocess.run(["/usr/bin/python3", script, out, "quick", "1.0"], capture_output=True, text=True, timeout=300)
+    if run.returncode != 0:
+        print(run.stdout, run.stderr)
+        raise SystemExit(f"report generator exited with {run.returncode}")
+    with open(f"{out}/report.md") as f:
+        return f.read()
+
+
+def claims(md):
+    return [line for line in md.splitlines() if line.startswith("Claim '")]
+
+
+def main(argv):
+    script, work = argv[1], argv[2]
+    reports = {}
+    for name, better in (("torque_wins", True), ("torque_loses", False)):
+        out = f"{work}/{name}"
+        write_runs(f"{out}/drop_test/drop_test_runs.csv", better, seed=7)
+        reports[name] = run_report(script, out)
+    failures = []
+    win, lose = claims(reports["torque_wins"]), claims(reports["torque_loses"])
+    drop_win = [c for c in win if "torque mode" in c]
+    drop_lose = [c for c in lose if "torque mode" in c]
+    if len(drop_win) != 3 or len(drop_lose) != 3:
+        failures.append(f"expected 3 drop-test claims each, got {len(drop_win)} / {len(drop_lose)}")
+    for a, b in zip(drop_win, drop_lose):
+        if a == b:
+            failures.append(f"identical verdict for opposite data: {a[:120]}")
+        if ": REPRODUCED." not in a:
+            failures.append(f"torque wins but not REPRODUCED: {a[:160]}")
+        if "NOT REPRODUCED (torque mode significantly worse" not in b:
+            failures.append(f"torque loses but not NOT REPRODUCED: {b[:160]}")
+        if not re.search(r"effect size \+\d", a) or "in torque mode's favour" not in a:
+            failures.append(f"torque wins without a positive signed effect: {a[:200]}")
+        if not re.search(r"effect size -\d", b) or "against torque mode" not in b:
+            failures.append(f"torque loses without a negative signed effect: {b[:200]}")
+    for name, md in reports.items():
+        if "1 of 24 drops INVALID" not in md:
+            failures.append(f"{name}: the header does not count the invalid drop")
+        if "11 of 12 torque drops" not in md:
+            failures.append(f"{name}: the invalid drop is not left out of the counts")
+        loser = "torque" if name == "torque_loses" else "position"
+        n = 11 if loser == "torque" else 12
+        if f"{loser} 2 of {n}" not in md:
+            failures.append(f"{name}: the censored drops of the {loser} mode are not reported as 2 of {n}")
+    for f in failures:
+        print("FAIL:", f)
+    for c in drop_win + drop_lose:
+        print(c[:300])
+    print(f"verdicts checked: {len(failures)} failures")
+    return 1 if failures else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv))
