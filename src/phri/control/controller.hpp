@@ -118,7 +118,7 @@ public:
   /// The wrench norm the dual-compliance trigger sees (low-passed).
   double trigger_wrench_norm() const { return trigger_filter_.value(); }
   /// Where the dual-compliance trigger's wrench comes from. kForceTorque once the robot has
-  /// delivered an F/T sample (RobotState::wrench ever valid or sequenced); before that, and for
+  /// delivered a valid F/T sample (RobotState::wrench.valid); before that, and for
   /// the whole run on an arm without an F/T sensor, kEstimated: the end-effector wrench estimated
   /// from the momentum observer's tau_ext (estimated_wrench()).
   enum class TouchSource { kForceTorque, kEstimated };
