@@ -5,7 +5,7 @@
 //                                              a session: simulated arm (or the Gen3 through the
 //                                              Kortex backend, kortex_backend.cpp), FSM, gamepad,
 //                                              log, figure, and the live dashboard in a browser
-//   phri info --urdf FILE                      model summary of a robot description
+//   phri info --urdf FILE | --robot DIR        model summary of a robot description (a bundle: with its drives)
 //   phri fit-collision --robot DIR [--out FILE] self-collision capsules fitted from the robot's URDF
 //   phri identify-friction [options]           the paper's friction identification (simulated arm)
 //   phri experiment torque-tracking [options]  the paper's torque-tracking comparison
@@ -98,6 +98,50 @@ int print_model_summary(const std::string& urdf_path, const std::string& tip, co
   return 0;
 }
 
+// `phri info --robot DIR`: the bundle's arm as the controller sees it (its chain, payloads, frames),
+// its drive and loops, its end of arm and which wrench the touch trigger reads, the actuators.yaml
+// defaults in use, the loader's warnings; then the model summary of the chain.
+int print_robot_summary(const std::string& folder, const std::string& frame_name) {
+  const phri::RobotBundle bundle = phri::RobotBundle::from_folder(folder);
+  phri::ControllerSettings settings;
+  bundle.apply_to(settings);
+  const phri::Model model = phri::Model::from_urdf_file(bundle.urdf_path, phri::Controller::model_options(settings));
+  const phri::ActuatorTable drives = phri::ActuatorTable::from_yaml_file(bundle.actuators_path);
+  const bool ft = bundle.end_of_arm && bundle.end_of_arm->has_ft_sensor;
+  std::printf("robot '%s' from %s\n", bundle.name.c_str(), bundle.source.c_str());
+  std::printf("urdf %s, actuators %s\n", bundle.urdf_path.c_str(), bundle.actuators_path.c_str());
+  std::string loops;
+  for (int m = 0; m < phri::kLowLevelModeCount; ++m) {
+    const auto mode = static_cast<phri::LowLevelMode>(m);
+    if (settings.offered_loops.contains(mode)) loops += (loops.empty() ? "" : ", ") + std::string(phri::to_string(mode));
+  }
+  std::printf("drive %s: loops %s\n", std::string(phri::to_string(bundle.drive)).c_str(), loops.c_str());
+  std::printf("end of arm: %s; touch trigger: %s\n",
+              !bundle.end_of_arm ? "none (bare flange)" : ft ? "F/T sensor and tool" : "tool, no F/T sensor",
+              ft ? "F/T sensor wrench" : "end-effector wrench estimated from the observer's tau_ext");
+  std::printf("end effector %s, home_q_rad", bundle.end_effector_frame.c_str());
+  for (double q : bundle.home_q_rad) std::printf(" %.4f", q);
+  std::printf("\n");
+  for (const std::string& notice : drives.notices(bundle.actuators_path)) std::printf("default: %s\n", notice.c_str());
+  for (const std::string& warning : model.warnings()) std::printf("warning: %s\n", warning.c_str());
+  std::printf("chain %s -> %s: %d joints, moving mass %.4f kg (payloads included)\n\n", model.base_link().c_str(),
+              model.tip_link().c_str(), model.nq(), model.total_mass());
+  std::printf("%-3s %-16s %10s %10s %10s %10s %9s\n", "#", "joint", "lower", "upper", "vel.lim", "torque", "mass kg");
+  for (int i = 0; i < model.nq(); ++i) {
+    const phri::Joint& j = model.joint(i);
+    std::printf("%-3d %-16s %10.4f %10.4f %10.4f %10.2f %9.4f\n", i + 1, j.name.c_str(), j.lower, j.upper,
+                drives[i].velocity_limit_rad_s, drives[i].torque_limit_Nm, model.body_inertia(i).mass);
+  }
+  phri::Data data(model);
+  const Eigen::VectorXd home = Eigen::Map<const Eigen::VectorXd>(bundle.home_q_rad.data(), model.nq());
+  phri::compute_all_terms(model, data, home, Eigen::VectorXd::Zero(model.nv()));
+  const int frame = model.frame_id(frame_name.empty() ? bundle.end_effector_frame : frame_name);
+  const Eigen::Vector3d p = data.frame_placements[static_cast<std::size_t>(frame)].translation();
+  std::printf("\nat home: %s at (%.6f, %.6f, %.6f) m; |g(q)| = %.4f N.m\n", model.frame(frame).name.c_str(), p.x(), p.y(),
+              p.z(), data.gravity_torque.norm());
+  return 0;
+}
+
 // Files of the experiments are found from the working directory; when run from elsewhere, from
 // the source tree the program was built from.
 std::string locate(const std::string& relative) {
@@ -110,15 +154,18 @@ std::string locate(const std::string& relative) {
 
 // The figure of a run's log (tools/report/demo_figure.py), drawn by the system python through
 // run_process: the paths reach the script as arguments, never through a shell. A failure is a warning.
-void draw_demo_figure(const std::string& log_path, const std::string& png, const phri::ComplianceSettings& compliance) {
+void draw_demo_figure(const std::string& log_path, const std::string& png, const phri::Config& config) {
+  const phri::ComplianceSettings& compliance = config.controller.compliance;
   const std::string script = locate("tools/report/demo_figure.py");
   if (!std::filesystem::exists(phri::kSystemPython) || !std::filesystem::exists(script)) {
     std::printf("no figure: %s or %s missing\n", phri::kSystemPython, script.c_str());
     return;
   }
-  const std::vector<std::string> argv = {phri::kSystemPython, script, log_path, png,
+  std::vector<std::string> argv = {phri::kSystemPython, script, log_path, png,
                                          "--touch", phri::format_fixed(compliance.touch_threshold, 6),
                                          "--release", phri::format_fixed(compliance.release_threshold, 6)};
+  argv.insert(argv.end(), {"--arm", config.robot_name});
+  if (!config.plant.ft_sensor_present()) argv.push_back("--no-ft");
   try {
     if (phri::run_process(argv) != 0) std::fprintf(stderr, "phri: warning: the figure script failed\n");
   } catch (const phri::IoError& e) {
@@ -244,6 +291,10 @@ void print_run_line(const RunArguments& args, const phri::Config& config) {
   std::printf("phri run: %s, %.1f s, %s%s%s\n", args.config_path.c_str(), config.run.duration_s,
               config.run.pacing == phri::LoopClock::Pacing::kLockstep ? "lockstep" : "real time",
               args.kortex.backend == "sim" ? "" : (", backend " + args.kortex.backend).c_str(), args.kortex.dry_run ? ", dry run" : "");
+  // Which wrench drives dual compliance's touch trigger (Controller::touch_source()).
+  std::printf("touch trigger: %s\n", config.plant.ft_sensor_present()
+                                         ? "F/T sensor wrench"
+                                         : "end-effector wrench estimated from the observer's tau_ext (no F/T sensor; least squares through J_ee)");
 }
 
 // `phri run`: loads the configuration, runs the session, writes the log, summary and figure.
@@ -319,7 +370,7 @@ int run_command(const RunArguments& args) {
     const phri::LoggerStats stats = logger->close();
     std::printf("%s\n", logger->summary().c_str());
     if (stats.dropped > 0 || stats.write_error) std::fprintf(stderr, "phri: warning: log incomplete\n");
-    if (args.figure) draw_demo_figure(logger->path(), (out / "demo.png").string(), config.controller.compliance);
+    if (args.figure) draw_demo_figure(logger->path(), (out / "demo.png").string(), config);
   }
   return run_exit_status(summary, config.run.duration_s);
 }
@@ -402,12 +453,23 @@ CLI::App* add_run_command(CLI::App& app, RunArguments& args) {
 }
 
 struct InfoArguments {
-  std::string urdf_path, tip, frame;
+  std::string urdf_path, robot_folder, tip, frame;
 };
+
+int info_command(const InfoArguments& args) {
+  if (args.urdf_path.empty() && args.robot_folder.empty()) {
+    throw phri::ConfigError("phri info", "--urdf", "required: a URDF file (--urdf) or a robot bundle (--robot)");
+  }
+  if (!args.robot_folder.empty()) return print_robot_summary(args.robot_folder, args.frame);
+  return print_model_summary(args.urdf_path, args.tip, args.frame);
+}
 
 CLI::App* add_info_command(CLI::App& app, InfoArguments& args) {
   auto* info = app.add_subcommand("info", "Load a robot description and print a summary of its model");
-  info->add_option("--urdf", args.urdf_path, "URDF file")->required();
+  auto* urdf = info->add_option("--urdf", args.urdf_path, "URDF file");
+  auto* robot = info->add_option("--robot", args.robot_folder, "robot bundle (robots/<robot>): its chain, drives and end of arm")
+                    ->check(CLI::ExistingDirectory);
+  urdf->excludes(robot);
   info->add_option("--tip", args.tip, "tip link of the chain (default: end of the movable chain)");
   info->add_option("--frame", args.frame, "frame whose position is printed (default: the tip)");
   return info;
@@ -761,7 +823,7 @@ int main(int argc, char** argv) {
   }
   try {
     if (run->parsed()) return run_command(run_args);
-    if (info->parsed()) return print_model_summary(info_args.urdf_path, info_args.tip, info_args.frame);
+    if (info->parsed()) return info_command(info_args);
     if (fit_collision->parsed()) return fit_collision_command(fit_args);
     if (ft_monitor->parsed()) return ft_monitor_command(ft_args);
     if (identify->parsed() || friction_alias->parsed()) return friction_identification_command(friction);

@@ -146,4 +146,45 @@ TEST(CapsuleFit, CapsulesEncloseBoxesCylindersAndSpheres) {
   EXPECT_NEAR((cylinder->p1 - cylinder->p0).norm(), 0.18, 1e-9);
 }
 
+// A wrist whose axes meet (the 7-DoF arms' wrists): link_2's child joint sits at its origin and
+// link_3 is the tip with no child joint. Every link with mass gets a capsule through its centre
+// of mass (the COM the segment's middle), and the notes say what the link has.
+TEST(CapsuleFit, EveryLinkWithMassIsCoveredIncludingAWristWhoseJointsMeet) {
+  auto link = [](const std::string& name, double mass, const std::string& com) {
+    return "<link name=\"" + name + "\"><inertial><origin xyz=\"" + com + "\"/><mass value=\"" + std::to_string(mass) +
+           "\"/><inertia ixx=\"0.01\" iyy=\"0.01\" izz=\"0.01\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/></inertial></link>";
+  };
+  auto joint = [](const std::string& name, const std::string& parent, const std::string& child, const std::string& xyz) {
+    return "<joint name=\"" + name + "\" type=\"revolute\"><parent link=\"" + parent + "\"/><child link=\"" + child +
+           "\"/><origin xyz=\"" + xyz + "\" rpy=\"1.5707963 0 0\"/><axis xyz=\"0 0 1\"/>"
+           "<limit lower=\"-2\" upper=\"2\" effort=\"10\" velocity=\"1\"/></joint>";
+  };
+  const std::string urdf = "<robot name=\"wrist\">" + link("base_link", 2.0, "0 0 0.05") + link("link_1", 1.0, "0 0 0.1") +
+                           link("link_2", 0.8, "0 0.03 0.04") + link("link_3", 0.5, "0 0 0.06") +
+                           joint("joint_1", "base_link", "link_1", "0 0 0.1") + joint("joint_2", "link_1", "link_2", "0 0 0.3") +
+                           joint("joint_3", "link_2", "link_3", "0 0 0") + "</robot>";
+  const phri::Model model = phri::Model::from_urdf_string(urdf, {});
+  const Eigen::VectorXd home = Eigen::VectorXd::Constant(3, 0.3);
+  const phri::CapsuleFit fit = phri::fit_capsules(urdf, model, home, {.link_frame_radius_m = 0.04, .clearance_m = 0.0});
+  for (const std::string& note : fit.notes) std::printf("note: %s\n", note.c_str());
+  const phri::CollisionModel c = phri::CollisionModel::from_yaml_string(fit.yaml, model, "fitted");
+  for (const auto& [name, com] : {std::pair{"link_2", Eigen::Vector3d(0, 0.03, 0.04)}, std::pair{"link_3", Eigen::Vector3d(0, 0, 0.06)}}) {
+    const phri::Capsule* capsule = capsule_of(c, name);
+    ASSERT_TRUE(capsule) << name;
+    EXPECT_LT((0.5 * (capsule->p0 + capsule->p1) - com).norm(), 1e-12) << name;  // the COM in its middle
+    EXPECT_LT(capsule->p0.norm(), 1e-12) << name;                                 // from the link's origin
+  }
+  ASSERT_TRUE(capsule_of(c, "link_1"));  // a child joint away from its origin: up to it, as before
+  EXPECT_NEAR((capsule_of(c, "link_1")->p1 - Eigen::Vector3d(0, 0, 0.3)).norm(), 0.0, 1e-12);
+  // True notes: link_2 has a child joint (at its origin), link_3 none.
+  bool wrist_noted = false, tip_noted = false;
+  for (const std::string& note : fit.notes) {
+    EXPECT_EQ(note.find("no capsule"), std::string::npos) << note;
+    if (note.find("'link_2'") != std::string::npos) wrist_noted = note.find("child joints at its origin") != std::string::npos;
+    if (note.find("'link_3'") != std::string::npos) tip_noted = note.find("no child joint") != std::string::npos;
+  }
+  EXPECT_TRUE(wrist_noted);
+  EXPECT_TRUE(tip_noted);
+}
+
 }  // namespace

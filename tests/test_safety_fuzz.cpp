@@ -25,6 +25,7 @@
 #include <fstream>
 #include <iterator>
 #include <limits>
+#include <set>
 #include <sstream>
 
 namespace {
@@ -442,6 +443,59 @@ TEST(FaultInjectingRobot, NewKindsAllocateNothing) {
     }
     EXPECT_EQ(count.allocations(), 0u) << phri::to_string(kind);
   }
+}
+
+// ---- only what the arm has (issue 40)
+
+TEST(SafetyFuzzClassify, AWindowWhoseLoopOrModeDidNotRunIsInvalidNeverAPass) {
+  phri::WindowMetrics m;
+  m.recovery_time_s = 0.5;
+  EXPECT_TRUE(phri::classify(m, {}).passed());
+  m.off_intent_cycles = 1;
+  const phri::FuzzVerdict v = phri::classify(m, {});
+  EXPECT_TRUE(v.invalid);
+  EXPECT_FALSE(v.passed());
+  EXPECT_EQ(v.violations, 0u);  // not a violation of the controller: a window that tested nothing
+}
+
+// robots/example_6dof with `drive: generic`: the Kinova torque rows are skipped (reported, not run,
+// not counted), the generic torque loop is fuzzed, and every window ran its loop and mode.
+TEST(SafetyFuzz, AGenericDriveRunsOnlyItsOwnLoopsAndEveryWindowRanItsLoop) {
+  const std::string folder = phri::test::temp_path("phri_test_safety_fuzz", "generic_arm");
+  std::filesystem::create_directories(folder);
+  for (const char* file : {"example_6dof.urdf", "actuators.yaml"}) {
+    std::filesystem::copy_file(kRoot + "/robots/example_6dof/" + file, folder + "/" + file,
+                               std::filesystem::copy_options::overwrite_existing);
+  }
+  std::ifstream in(kRoot + "/robots/example_6dof/robot.yaml");
+  std::string robot((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  robot.replace(robot.find("drive: kinova"), std::string("drive: kinova").size(), "drive: generic");
+  std::ofstream(folder + "/robot.yaml") << robot;
+  phri::SafetyFuzzOptions o = small_options("");
+  o.robot_folder = folder;
+  o.pushes = 3;
+  o.pushes_per_run = 1;
+  o.modes = {phri::ComplianceMode::kNullSpace};
+  o.targeted_pushes = false;
+  o.faults = phri::FaultSet::kNone;
+  const phri::SafetyFuzzResult r = phri::run_safety_fuzz(o);
+  ASSERT_EQ(r.skipped_loops.size(), 2u);
+  EXPECT_EQ(r.skipped_loops[0], phri::LowLevelMode::kKinovaTorque);
+  EXPECT_EQ(r.skipped_loops[1], phri::LowLevelMode::kKinovaTorqueHighVelocity);
+  EXPECT_EQ(r.skipped_rows, 2);
+  std::set<phri::LowLevelMode> ran;
+  for (const phri::FuzzRecord& x : r.records) {
+    ran.insert(x.loop);
+    EXPECT_FALSE(x.verdict.invalid) << x.run_id << ": ran " << x.metrics.ran_loop;
+  }
+  EXPECT_EQ(ran, (std::set<phri::LowLevelMode>{phri::LowLevelMode::kPosition, phri::LowLevelMode::kCurrent,
+                                                phri::LowLevelMode::kTorque}));
+  EXPECT_EQ(r.pushes(), 3);
+  EXPECT_EQ(r.invalid_windows(), 0);
+  const std::string report = phri::safety_fuzz_report(r, o);
+  EXPECT_NE(report.find("2 mode x loop rows skipped (not run, not counted): the drive does not offer kinova_torque, "
+                        "kinova_torque_high_velocity"),
+            std::string::npos);
 }
 
 // ---- the harness end to end

@@ -170,6 +170,15 @@ SimRobotConfig parse_plant(const YamlReader& r, const std::string& base_dir, con
     absolutize_robot(plant, base_dir);
   }
   if (bundle != nullptr) fill_from_bundle(plant, *bundle);
+  // A generic drive has no Kinova loops: a vendor section would be silently unused (an error
+  // wherever it appears), and the plant is checked under the robot's drive, no Kinova key read.
+  if (bundle != nullptr && bundle->drive == DriveKind::kGeneric) {
+    if (plant["vendor"]) {
+      throw ConfigError(r.file(), "plant.vendor", "Kinova's drive loops; the robot's drive is generic (drive in " + bundle->source +
+                                                      "; its hold's gains: drive.position_hold)");
+    }
+    if (!plant["drive"]) plant["drive"] = "generic";
+  }
   YAML::Node document;
   document["plant"] = plant;
   YAML::Emitter out;
@@ -563,6 +572,7 @@ Config parse(const YamlReader& root, const std::string& base_dir, const std::str
     c.plant = parse_plant(root.at("plant"), base_dir, bundle ? &*bundle : nullptr);
   }
   if (bundle) bundle->apply_to(c.plant);
+  c.robot_name = bundle ? bundle->name : std::filesystem::path(c.controller.urdf_path).stem().string();
   // Without a bundle, a plant that names its drives decides the loops the controller may ask for.
   if (!bundle && c.plant.drive_stated) c.controller.offered_loops = offered_loops(c.plant.drive);
   if (c.plant.dof() != dof) {

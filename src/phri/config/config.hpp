@@ -76,6 +76,8 @@ struct Config {
   static Config from_yaml_string(const std::string& yaml, const std::string& source_name, const std::string& base_dir);
 
   std::string source;              ///< the file it came from
+  /// The arm's name for figures and summaries: its bundle's `name`, else its URDF's file stem.
+  std::string robot_name;
   ControllerSettings controller;
   SimRobotConfig plant;
   FsmSettings fsm;                 ///< with the `events:` timeline, sorted by time

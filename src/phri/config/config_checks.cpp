@@ -1,4 +1,5 @@
 #include <phri/config/config_checks.hpp>
+#include <phri/robot/actuator_table.hpp>
 
 #include <phri/control/controller.hpp>
 #include <phri/core/error.hpp>
@@ -101,6 +102,12 @@ void check_config_against_robot(const Config& config) {
 std::vector<std::string> config_warnings(const Config& config) {
   std::vector<std::string> warnings;
   const ControllerSettings& settings = config.controller;
+  // Each actuators.yaml default in use (a generic drive's data a maker does not publish), one line each.
+  if (!settings.actuators_path.empty()) {
+    for (std::string& notice : ActuatorTable::from_yaml_file(settings.actuators_path).notices(settings.actuators_path)) {
+      warnings.push_back(std::move(notice));
+    }
+  }
   const double threshold = settings.qp.singular_value_threshold;
   if (threshold <= 0.0) return warnings;
   const Model model = Model::from_urdf_file(settings.urdf_path, Controller::model_options(settings));

@@ -18,7 +18,8 @@ namespace phri {
 
 void check_config_against_robot(const Config& config);
 
-/// What the configuration allows but the user should know, one line each: the postures above
+/// What the configuration allows but the user should know, one line each: the actuators.yaml
+/// defaults in use (ActuatorTable::notices: keys a maker does not publish, left out), the postures above
 /// near a kinematic singularity (the end-effector Jacobian's smallest singular value below
 /// controller.qp.singular_value_threshold, where the task gives its weak directions to the posture).
 std::vector<std::string> config_warnings(const Config& config);

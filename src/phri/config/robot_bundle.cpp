@@ -232,6 +232,9 @@ void check_against_model(const RobotBundle& b) {
     }
   }
   const ActuatorTable drives = ActuatorTable::from_yaml_file(b.actuators_path);
+  if (b.drive == DriveKind::kKinova) {
+    drives.require_stated(b.actuators_path, "drive: kinova (" + b.source + ") emulates Kinova's loops on the motor data");
+  }
   for (int i = 0; i < model.nq(); ++i) {
     if (i >= drives.size() || drives[i].joint_name != model.joint(i).name) {
       throw ConfigError(b.source, "actuators", "entry " + std::to_string(i + 1) + " must be the chain's joint '" +

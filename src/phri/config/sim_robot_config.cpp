@@ -548,7 +548,11 @@ void SimRobotConfig::validate() const {
   if (noise.encoder_counts_per_rev != 0.0 && !(noise.encoder_counts_per_rev >= kMinEncoderCounts)) {
     throw ConfigError(f, "plant.noise.encoder_counts_per_rev", "must be 0 (no quantisation) or >= 4096");
   }
-  validate_vendor(*this);
+  // Kinova's loops and their keys are checked on a Kinova drive only (a generic drive reads none).
+  if (drive == DriveKind::kKinova) {
+    actuators.require_stated(actuators_path.empty() ? f : actuators_path, "the plant emulates Kinova's drive loops on the motor data");
+    validate_vendor(*this);
+  }
   validate_generic_hold(*this);
   check_size(*this, elasticity.stiffness_Nm_per_rad, "plant.elasticity.stiffness_Nm_per_rad");
   validate_plant_drives(*this);

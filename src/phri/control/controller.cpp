@@ -6,6 +6,8 @@
 #include <phri/core/error.hpp>
 #include <phri/model/algorithms.hpp>
 
+#include <Eigen/Eigenvalues>
+
 #include <algorithm>
 #include <cstdio>
 #include <cmath>
@@ -219,6 +221,7 @@ Controller::Controller(LoadedRobot robot, const ControllerSettings& settings)
       ft_torque_(Eigen::VectorXd::Zero(model_.nv())),
       tau_ext_(Eigen::VectorXd::Zero(model_.nv())),
       trigger_filter_(settings.wrench_trigger_filter_s, settings.period_s),
+      estimate_torque_(Eigen::VectorXd::Zero(model_.nv())),
       ft_fusion_(model_.nv(), settings.observer_gain, settings.period_s),
       no_targets_(model_.nv()),
       hold_q_(Eigen::VectorXd::Zero(model_.nv())),
@@ -338,6 +341,11 @@ void Controller::estimate(const RobotState& state, double dt) {
 // observer. A dropped source leaves the estimate at zero (the trigger released, the hand's pose the
 // target, as when a hand lets go) and select_external_torque() on the observer.
 void Controller::estimate_wrench(const RobotState& state) {
+  if (state.wrench.valid) ft_seen_ = true;  // a sensorless plant may still count samples: validity decides
+  if (!ft_seen_) {
+    estimate_wrench_from_observer();
+    return;
+  }
   if (wrench_supervisor_.check(state, qd_, observer_.external_torque())) {
     const Eigen::Isometry3d& sensor = data_.frame_placements[static_cast<std::size_t>(sensor_frame_)];
     const Eigen::Isometry3d& ee = data_.frame_placements[static_cast<std::size_t>(end_effector_frame_)];
@@ -365,6 +373,42 @@ void Controller::estimate_wrench(const RobotState& state) {
     wrench_samples_ = 0;
     ft_torque_.setZero();
   }
+}
+
+// Without an F/T sensor: the operator's wrench at the end effector from the observer's tau_ext,
+// the least-squares solution of J^T F = tau_ext, F = (J J^T)^-1 J tau_ext. tau_ext first loses the
+// compliance dead band per joint (soft threshold): the observer's bias from model error (5 % of
+// the link inertials on the plant) would otherwise read as a standing wrench of several newtons.
+// Joint torques cannot tell a hand on the tool from one elsewhere on the arm: on a 6-DoF arm every
+// push maps onto some end-effector wrench (a redundant arm's null-space part is left out).
+// Fixed-size 6x6 algebra: allocation-free.
+void Controller::estimate_wrench_from_observer() {
+  const Eigen::VectorXd& tau = observer_.external_torque();
+  const Eigen::VectorXd& band = qp_.compliance_deadband();
+  for (Eigen::Index i = 0; i < tau.size(); ++i) {
+    const double excess = std::abs(tau[i]) - (i < band.size() ? band[i] : 0.0);
+    estimate_torque_[i] = excess > 0.0 ? std::copysign(excess, tau[i]) : 0.0;
+  }
+  frame_jacobian(model_, data_, end_effector_frame_, ReferenceFrame::kLocalWorldAligned, ee_jacobian_);
+  Eigen::Matrix<double, 6, 6> jjt;
+  Vector6d jtau;
+  for (int r = 0; r < 6; ++r) {
+    jtau[r] = ee_jacobian_.row(r).dot(estimate_torque_);
+    for (int c = r; c < 6; ++c) jjt(r, c) = jjt(c, r) = ee_jacobian_.row(r).dot(ee_jacobian_.row(c));
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> eig(jjt);
+  const Vector6d& lambda = eig.eigenvalues();  // ascending
+  const double largest = lambda[5];
+  if (!(largest > 0.0) || !std::isfinite(largest)) {
+    estimated_wrench_.setZero();
+    estimated_condition_ = std::numeric_limits<double>::infinity();
+    return;
+  }
+  const double floor = 1e-6 * largest;
+  Vector6d projected = eig.eigenvectors().transpose() * jtau;
+  for (int k = 0; k < 6; ++k) projected[k] = lambda[k] > floor ? projected[k] / lambda[k] : 0.0;
+  estimated_wrench_ = eig.eigenvectors() * projected;
+  estimated_condition_ = lambda[0] > floor ? std::sqrt(largest / lambda[0]) : std::numeric_limits<double>::infinity();
 }
 
 // tau_ext for the QP and the inverse dynamics, from the source the settings choose.
@@ -671,9 +715,12 @@ void Controller::update_modes_and_targets() {
   // free the end effector for a few milliseconds.
   // A wrench that is not fresh (WrenchSupervisor::fresh: stuck or stale beyond a few of the
   // sensor's periods, or dropped) is no touch: released at once, as when the hand leaves.
-  const bool fresh = wrench_supervisor_.fresh() && wrench_.calibrated();
+  // Without an F/T sample (no sensor): the wrench estimated from the observer, the same trigger.
+  const bool estimated = !ft_seen_;
+  const bool fresh = estimated || (wrench_supervisor_.fresh() && wrench_.calibrated());
   if (!fresh) trigger_filter_.reset(0.0);
-  if (compliance_.update(fresh ? trigger_filter_.update(wrench_.norm()) : 0.0, qp_, data_)) {
+  const double norm = estimated ? estimated_wrench_.norm() : wrench_.norm();
+  if (compliance_.update(fresh ? trigger_filter_.update(norm) : 0.0, qp_, data_)) {
     // A hand let go in dual compliance: its pose is the end effector's new target (paper), and the
     // configuration it left the arm in is the posture's. The old posture target lies off the new
     // pose's self-motion manifold; the paper's posture stiffness of 0 there leaves the arm where the

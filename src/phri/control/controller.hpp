@@ -117,6 +117,19 @@ public:
   bool started() const { return started_; }
   /// The wrench norm the dual-compliance trigger sees (low-passed).
   double trigger_wrench_norm() const { return trigger_filter_.value(); }
+  /// Where the dual-compliance trigger's wrench comes from. kForceTorque once the robot has
+  /// delivered a valid F/T sample (RobotState::wrench.valid); before that, and for
+  /// the whole run on an arm without an F/T sensor, kEstimated: the end-effector wrench estimated
+  /// from the momentum observer's tau_ext (estimated_wrench()).
+  enum class TouchSource { kForceTorque, kEstimated };
+  TouchSource touch_source() const { return ft_seen_ ? TouchSource::kForceTorque : TouchSource::kEstimated; }
+  /// The end-effector wrench (world axes, about the end effector) estimated from the observer's
+  /// external torque beyond the compliance dead band, by least squares through the end-effector
+  /// Jacobian: F = (J J^T)^-1 J tau_ext (computed while touch_source() is kEstimated).
+  const Vector6d& estimated_wrench() const { return estimated_wrench_; }
+  /// The 2-norm condition number of that J (sqrt of cond(J J^T)) at the last estimate; its
+  /// eigenvalues below 1e-6 of the largest are left out (a singular direction gives no wrench).
+  double estimated_wrench_condition() const { return estimated_condition_; }
 
 private:
   struct LoadedRobot {
@@ -141,6 +154,7 @@ private:
   // the model terms of the integrated state the cycle runs on.
   void estimate(const RobotState& state, double dt);
   void estimate_wrench(const RobotState& state);
+  void estimate_wrench_from_observer();
   void select_external_torque();
   void bound_external_torque();
   void update_modes_and_targets();
@@ -179,6 +193,10 @@ private:
   Vector6d wrench_median_ = Vector6d::Zero();
   long wrench_samples_ = 0;
   LowPassFilter trigger_filter_;       // the wrench norm the dual-compliance trigger sees
+  bool ft_seen_ = false;               // an F/T sample ever arrived: the trigger reads the F/T
+  Vector6d estimated_wrench_ = Vector6d::Zero();  // least squares of J^T F = tau_ext beyond the dead band
+  double estimated_condition_ = 1.0;
+  Eigen::VectorXd estimate_torque_;    // tau_ext beyond the dead band (nv)
   ComplementaryFilter ft_fusion_;      // observer (low) + J^T F/T (high), ExternalTorqueSource::kFused
   ControllerTargets no_targets_;
   long qp_fallbacks_in_row_ = 0;

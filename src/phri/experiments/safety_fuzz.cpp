@@ -8,6 +8,7 @@
 #include <phri/experiments/fault_injecting_robot.hpp>
 #include <phri/model/algorithms.hpp>
 #include <phri/model/capsule_fit.hpp>
+#include <phri/robot/drive_kind.hpp>
 #include <phri/sim/sim_robot.hpp>
 #include <phri/sim/sim_scene.hpp>
 
@@ -54,6 +55,8 @@ struct Shared {
   std::vector<PushSpec> targeted;
   std::vector<FaultCase> faults;
   double dt = 1e-3;
+  std::vector<LowLevelMode> loops;    // o.loops the drive offers: the ones run
+  std::vector<LowLevelMode> skipped;  // o.loops the drive does not offer: not run, not counted
 };
 
 ControllerSettings controller_settings(const Shared& shared, ComplianceMode mode) {
@@ -103,6 +106,7 @@ RobotUnderTest robot_under_test(const SafetyFuzzOptions& o) {
     r.settings.collision_path = o.collision_path;
     r.settings.end_effector_frame = o.end_effector_frame;
     r.settings.set_end_of_arm(r.plant.end_of_arm());  // the F/T sensor and tool the plant file states
+    r.settings.offered_loops = offered_loops(r.plant.drive);  // the plant's drives decide the loops
     r.start_q = o.start_q_rad;
     return r;
   }
@@ -146,7 +150,7 @@ std::unique_ptr<Shared> load_shared(const SafetyFuzzOptions& o) {
   if (!collision) throw ConfigError(src, "collision_path", "the pushes land on the collision capsules: a collision model is needed");
   auto s = std::unique_ptr<Shared>(new Shared{o, robot.settings, robot.start_q, std::move(robot.plant), std::move(model),
                                               std::move(actuators), std::move(collision), Eigen::VectorXd(), Eigen::VectorXd(),
-                                              {}, {}, 1e-3});
+                                              {}, {}, 1e-3, {}, {}});
   const int n = s->model.nv();
   s->velocity_limit.resize(n);
   s->torque_limit.resize(n);
@@ -157,6 +161,10 @@ std::unique_ptr<Shared> load_shared(const SafetyFuzzOptions& o) {
   s->dt = s->plant.control_period_s;
   s->targeted = targeted_pushes(*s);
   s->faults = fault_catalogue(o.faults, n, o.seed);
+  // A loop the drive does not offer would be refused by the controller (the position loop runs in
+  // its place): its rows are not run and not counted, only reported as skipped.
+  for (LowLevelMode loop : o.loops) (s->settings.offered_loops.contains(loop) ? s->loops : s->skipped).push_back(loop);
+  if (s->loops.empty()) throw ConfigError(src, "loops", "the drive offers none of the loops asked for");
   return s;
 }
 
@@ -214,6 +222,7 @@ class Rig {
 public:
   Rig(const Shared& s, ComplianceMode mode, LowLevelMode loop, std::uint64_t plant_seed, const FaultSpec& fault)
       : s_(s),
+        mode_(mode),
         loop_(loop),
         robot_(make_plant(s, plant_seed)),
         tap_(*robot_),
@@ -233,6 +242,7 @@ public:
     if (refusal_pending_ && status != CycleStatus::kSafeStop) ++m.unhandled_refusals;
     refusal_pending_ = false;
     if (!setpoint_finite(command_)) m.nan_command = true;
+    check_intent(m);
     if (trace_.is_open()) write_trace_row(status);
     if (io_.write(command_) != WriteStatus::kOk) {
       const bool injected = io_.fault_active() && io_.fault().kind == FaultKind::kWriteRefused;
@@ -255,7 +265,7 @@ public:
   bool warm_up(WindowMetrics& m, bool stay_in_position = false) {
     const long n1 = std::lround(s_.o.position_phase_s / s_.dt), n2 = std::lround(s_.o.settle_s / s_.dt);
     for (long k = 0; k < n1 + n2; ++k) {
-      if (k == n1 && !stay_in_position) targets_.low_level_mode = loop_;
+      if (k == n1 && !stay_in_position) request_loop(loop_);
       step(m);
     }
     m.recovery_time_s = 0.0;
@@ -298,7 +308,10 @@ public:
   double time() const { return robot_->state().time_s; }
   long cycles() const { return io_.cycles(); }  ///< control cycles (reads the controller saw)
   long plant_cycles() const { return static_cast<long>(robot_->state().cycle); }  ///< periods the plant ran
-  void request_loop(LowLevelMode loop) { targets_.low_level_mode = loop; }  ///< at the next step
+  void request_loop(LowLevelMode loop) {  ///< at the next step
+    targets_.low_level_mode = loop;
+    expected_loop_ = loop;
+  }
   const FaultInjectingRobot& injector() const { return io_; }
   double speed() const { return speed_; }
   double safe_stop_time() const {
@@ -339,8 +352,22 @@ private:
     trace_ << '\n';
   }
 
+  // Whether the loop and mode under test are the ones running (before a safe stop, which holds in
+  // the position loop by design); what ran instead is kept for the report.
+  void check_intent(WindowMetrics& m) const {
+    if (cycle_.supervisor().safe_stop()) return;
+    const LowLevelMode ran = cycle_.low_level().loop();
+    if (ran == expected_loop_ && cycle_.compliance().mode() == mode_) return;
+    if (m.off_intent_cycles++ == 0) {
+      m.ran_loop = static_cast<int>(ran);
+      m.ran_mode = static_cast<int>(cycle_.compliance().mode());
+    }
+  }
+
   const Shared& s_;
+  ComplianceMode mode_;
   LowLevelMode loop_;
+  LowLevelMode expected_loop_ = LowLevelMode::kPosition;  // the run starts in the position loop
   std::unique_ptr<SimRobot> robot_;
   PlantTap tap_;
   FaultInjectingRobot io_;
@@ -813,10 +840,10 @@ std::uint64_t pair_key(ComplianceMode mode, LowLevelMode loop) {
 // The random pushes of every pair, pushes_per_run per run.
 void add_push_tasks(const Shared& s, std::vector<FuzzTask>& tasks) {
   const SafetyFuzzOptions& o = s.o;
-  const int pairs = static_cast<int>(o.modes.size() * o.loops.size());
+  const int pairs = static_cast<int>(o.modes.size() * s.loops.size());
   int pair = 0;
   for (ComplianceMode mode : o.modes) {
-    for (LowLevelMode loop : o.loops) {
+    for (LowLevelMode loop : s.loops) {
       const int count = o.pushes / pairs + (pair < o.pushes % pairs ? 1 : 0);
       ++pair;
       const std::uint64_t key = mix_seed(o.seed, pair_key(mode, loop));
@@ -841,7 +868,7 @@ void add_push_tasks(const Shared& s, std::vector<FuzzTask>& tasks) {
 void add_targeted_tasks(const Shared& s, std::vector<FuzzTask>& tasks) {
   if (!s.o.targeted_pushes || s.targeted.empty()) return;
   for (ComplianceMode mode : s.o.modes) {
-    for (LowLevelMode loop : s.o.loops) {
+    for (LowLevelMode loop : s.loops) {
       const std::string id = "targeted/" + pair_id(mode, loop);
       const std::uint64_t base = mix_seed(mix_seed(s.o.seed, pair_key(mode, loop)), 0x7A46E7ULL);
       double cost = 1.0;
@@ -858,7 +885,7 @@ void add_fault_tasks(const Shared& s, std::vector<FuzzTask>& references, std::ve
                      std::vector<std::unique_ptr<ReferencePath>>& paths) {
   if (s.faults.empty()) return;
   for (ComplianceMode mode : s.o.fault_modes) {
-    for (LowLevelMode loop : s.o.loops) {
+    for (LowLevelMode loop : s.loops) {
       paths.push_back(std::make_unique<ReferencePath>());
       ReferencePath* path = paths.back().get();
       const std::string ref_id = "reference/" + pair_id(mode, loop);
@@ -896,7 +923,7 @@ void add_motion_tasks(const Shared& s, std::vector<FuzzTask>& references, std::v
   const bool hand_on_tool_possible = s.plant.ft_sensor_present() && s.model.has_frame("ft_sensor");
   for (const bool with_switch : {false, true}) {
     for (ComplianceMode mode : modes) {
-      for (LowLevelMode loop : s.o.loops) {
+      for (LowLevelMode loop : s.loops) {
         if (with_switch && loop == LowLevelMode::kPosition) continue;  // no switch to make
         auto sc = std::make_unique<MotionScenario>();
         sc->with_switch = with_switch;
@@ -1029,6 +1056,14 @@ long SafetyFuzzResult::controller_failures() const {
   return std::count_if(records.begin(), records.end(), [](const FuzzRecord& r) { return r.verdict.controller_failure(); });
 }
 
+long SafetyFuzzResult::invalid_windows() const {
+  return std::count_if(records.begin(), records.end(), [](const FuzzRecord& r) { return r.verdict.invalid; });
+}
+
+long SafetyFuzzResult::passes() const {
+  return std::count_if(records.begin(), records.end(), [](const FuzzRecord& r) { return r.verdict.passed(); });
+}
+
 long SafetyFuzzResult::pushes() const {
   return std::count_if(records.begin(), records.end(), [](const FuzzRecord& r) {
     return r.kind == FuzzCaseKind::kRandomPush || r.kind == FuzzCaseKind::kLimitPush || r.kind == FuzzCaseKind::kWristFold;
@@ -1061,6 +1096,8 @@ SafetyFuzzResult run_safety_fuzz(const SafetyFuzzOptions& o, std::ostream* progr
               << " fault cases), " << o.jobs << " jobs" << std::endl;
   }
   SafetyFuzzResult result;
+  result.skipped_loops = shared->skipped;
+  result.skipped_rows = static_cast<int>(o.modes.size() * shared->skipped.size());
   std::vector<TaskOutput> reference_outputs, outputs;
   TaskPool(references, reference_outputs, progress, "references").run(o.jobs);
   TaskPool(tasks, outputs, progress, "runs").run(o.jobs);

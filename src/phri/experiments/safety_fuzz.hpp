@@ -83,8 +83,12 @@ struct SafetyFuzzOptions {
   bool targeted_pushes = true; ///< joint-limit pushes and wrist folds on every pair
   FaultSet faults = FaultSet::kAll;
   std::vector<ComplianceMode> fault_modes = {ComplianceMode::kNullSpace, ComplianceMode::kFullBody};
+  /// The loops to fuzz; those the robot's drive does not offer (robot.yaml `drive:`) are skipped
+  /// (not run, not counted; SafetyFuzzResult::skipped_loops): a Kinova arm runs the first four, a
+  /// generic drive position, custom (current) and its plain torque loop.
   std::vector<LowLevelMode> loops = {LowLevelMode::kPosition, LowLevelMode::kKinovaTorque,
-                                     LowLevelMode::kKinovaTorqueHighVelocity, LowLevelMode::kCurrent};
+                                     LowLevelMode::kKinovaTorqueHighVelocity, LowLevelMode::kCurrent,
+                                     LowLevelMode::kTorque};
   std::vector<ComplianceMode> modes = {ComplianceMode::kStiff, ComplianceMode::kNullSpace, ComplianceMode::kFullBody,
                                        ComplianceMode::kDual};
   std::vector<long> fault_cycles = {1, 100};  ///< at rest, for the faults without a length of their own
@@ -155,8 +159,13 @@ struct SafetyFuzzResult {
   double simulated_s = 0.0;
   double wall_s = 0.0;
   std::vector<std::string> files;
+  /// Loops of the options the drive does not offer: their mode x loop rows were not run.
+  std::vector<LowLevelMode> skipped_loops;
+  int skipped_rows = 0;  ///< mode x loop pairs not run (modes x skipped_loops)
 
   long controller_failures() const;
+  long invalid_windows() const;  ///< windows whose loop or mode under test did not run (never passes)
+  long passes() const;           ///< valid windows without a violation
   long pushes() const;    ///< push windows (random and targeted)
   long faults() const;    ///< fault windows, at rest, in motion and after a loop switch
   long faults_in(std::string_view context) const;  ///< "rest", "motion" or "switch"

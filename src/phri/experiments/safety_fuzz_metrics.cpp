@@ -38,6 +38,7 @@ FuzzVerdict classify(const WindowMetrics& m, const SafetyFuzzThresholds& t) {
   if (!m.crashed && !m.safe_stop && m.recovery_time_s < 0.0) v.violations |= kViolationNoRecovery;
   if (!m.crashed && m.safe_stop && m.safe_stop_rest_time_s < 0.0) v.violations |= kViolationSafeStopMoving;
   v.operator_possible = m.max_required_torque_ratio > 1.0;
+  v.invalid = m.off_intent_cycles > 0;
   return v;
 }
 

@@ -76,12 +76,22 @@ struct WindowMetrics {
   bool safe_stop = false;
   double safe_stop_time_s = -1.0;          ///< robot time of the safe stop's transition
   double safe_stop_rest_time_s = -1.0;     ///< from the transition to rest; -1: never at rest
+  /// Cycles (before any safe stop) where the loop or compliance mode under test was not the one
+  /// running (Controller::low_level().loop(), compliance().mode()): e.g. a loop the drive does
+  /// not offer, its target rejected. Any: the window is invalid, never a pass.
+  long off_intent_cycles = 0;
+  int ran_loop = -1;  ///< the first off-intent cycle's running loop and mode (LowLevelMode, ComplianceMode)
+  int ran_mode = -1;
 };
 
 struct FuzzVerdict {
   unsigned violations = 0;         ///< FuzzViolation bits
   bool operator_possible = false;  ///< the push exceeded what the actuators can resist
+  /// The loop or mode under test did not run (WindowMetrics::off_intent_cycles): the window tested
+  /// something else, so it is reported as invalid and never counted as a pass.
+  bool invalid = false;
   bool controller_failure() const { return violations != 0 && !operator_possible; }
+  bool passed() const { return !invalid && violations == 0; }
 };
 
 /// max_i |gravity_i - push_torque_i| / torque_limit_i: above 1, no actuator torque within the

@@ -78,10 +78,11 @@ std::string replay_command(const FuzzRecord& r, const SafetyFuzzOptions& o) {
 // Counts of one mode x loop pair.
 struct PairCounts {
   long pushes = 0, push_violations = 0, operator_possible = 0, push_failures = 0, push_safe_stops = 0, no_recovery = 0;
-  long faults = 0, fault_failures = 0, fault_safe_stops = 0, other_failures = 0;
+  long faults = 0, fault_failures = 0, fault_safe_stops = 0, other_failures = 0, invalid = 0;
 
   void add(const FuzzRecord& r) {
     const bool failure = r.verdict.controller_failure();
+    invalid += r.verdict.invalid;
     if (is_push(r)) {
       ++pushes;
       push_violations += r.verdict.violations != 0;
@@ -104,13 +105,54 @@ void pair_table(const SafetyFuzzResult& result, std::ostream& s) {
   for (const FuzzRecord& r : result.records) pairs[{static_cast<int>(r.mode), static_cast<int>(r.loop)}].add(r);
   s << "## Per compliance mode x low-level loop\n\n"
        "| mode | loop | pushes | with violations | operator-possible | controller failures | safe stops | not recovered | "
-       "faults | fault failures | fault safe stops | start-up/reference failures |\n"
-       "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+       "faults | fault failures | fault safe stops | start-up/reference failures | invalid windows |\n"
+       "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const auto& [key, c] : pairs) {
     s << "| " << to_string(static_cast<ComplianceMode>(key.first)) << " | " << to_string(static_cast<LowLevelMode>(key.second))
       << " | " << c.pushes << " | " << c.push_violations << " | " << c.operator_possible << " | " << c.push_failures << " | "
       << c.push_safe_stops << " | " << c.no_recovery << " | " << c.faults << " | " << c.fault_failures << " | "
-      << c.fault_safe_stops << " | " << c.other_failures << " |\n";
+      << c.fault_safe_stops << " | " << c.other_failures << " | " << c.invalid << " |\n";
+  }
+  s << "\n";
+}
+
+std::string loop_list(const std::vector<LowLevelMode>& loops) {
+  std::string out;
+  for (LowLevelMode loop : loops) out += (out.empty() ? "" : ", ") + std::string(to_string(loop));
+  return out;
+}
+
+// What the loop or mode under test ran as instead, e.g. "loop position instead of kinova_torque".
+std::string off_intent(const FuzzRecord& r) {
+  std::string out;
+  if (r.metrics.ran_loop >= 0 && r.metrics.ran_loop != static_cast<int>(r.loop)) {
+    out += "loop " + std::string(to_string(static_cast<LowLevelMode>(r.metrics.ran_loop))) + " instead of " +
+           std::string(to_string(r.loop));
+  }
+  if (r.metrics.ran_mode >= 0 && r.metrics.ran_mode != static_cast<int>(r.mode)) {
+    out += (out.empty() ? "" : ", ") + std::string("mode ") +
+           std::string(to_string(static_cast<ComplianceMode>(r.metrics.ran_mode))) + " instead of " + std::string(to_string(r.mode));
+  }
+  return out.empty() ? "the loop under test not running after the switch" : out;
+}
+
+// The rows not run (the drive does not offer their loop) and the windows whose loop or mode did
+// not run: neither is a pass.
+void validity_section(const SafetyFuzzResult& result, std::ostream& s) {
+  s << "## Skipped rows and invalid windows\n\n";
+  if (result.skipped_loops.empty()) {
+    s << "No row skipped: the drive offers every loop asked for.\n";
+  } else {
+    s << result.skipped_rows << " mode x loop rows skipped (not run, not counted): the drive does not offer " << loop_list(result.skipped_loops)
+      << ".\n";
+  }
+  s << "\n" << result.invalid_windows() << " invalid windows (the loop or compliance mode under test was not the one running "
+    << "before any safe stop: Controller::low_level().loop(), compliance().mode()); never counted as passes.\n\n";
+  int listed = 0;
+  for (const FuzzRecord& r : result.records) {
+    if (!r.verdict.invalid || listed++ >= 20) continue;
+    s << "- `" << r.run_id << "` #" << r.index << " " << to_string(r.kind) << ": " << off_intent(r) << " for "
+      << r.metrics.off_intent_cycles << " cycles\n";
   }
   s << "\n";
 }
@@ -329,7 +371,8 @@ std::string safety_fuzz_csv(const SafetyFuzzResult& result) {
   s << "run_id,index,kind,mode,loop,plant_seed,start_s,target,joint,force_N,profile,duration_s,fault_cycles,"
        "max_speed_ratio,min_limit_margin_rad,min_capsule_distance_mm,required_torque_ratio,max_deviation_rad,final_deviation_rad,final_deviation_joint,final_speed_rad_s,"
        "recovery_time_s,safe_stop,safe_stop_reason,safe_stop_rest_time_s,refused_writes,unhandled_refusals,nan_command,"
-       "crashed,violations,operator_possible,controller_failure,context,fault_kind,push_link,fault_offset_s,error\n";
+       "crashed,violations,operator_possible,controller_failure,context,fault_kind,push_link,fault_offset_s,error,invalid,"
+       "ran_loop,ran_mode\n";
   for (const FuzzRecord& r : result.records) {
     const WindowMetrics& m = r.metrics;
     std::string error = r.error;
@@ -345,7 +388,9 @@ std::string safety_fuzz_csv(const SafetyFuzzResult& result) {
       << m.unhandled_refusals << ',' << (m.nan_command ? 1 : 0) << ',' << (m.crashed ? 1 : 0) << ','
       << violation_list(r.verdict.violations) << ',' << (r.verdict.operator_possible ? 1 : 0) << ','
       << (r.verdict.controller_failure() ? 1 : 0) << ',' << r.context << ',' << r.fault_kind << ',' << r.push_link << ','
-      << format_fixed(r.fault_offset_s, 3) << ',' << error << '\n';
+      << format_fixed(r.fault_offset_s, 3) << ',' << error << ',' << (r.verdict.invalid ? 1 : 0) << ','
+      << (m.ran_loop >= 0 ? to_string(static_cast<LowLevelMode>(m.ran_loop)) : std::string_view()) << ','
+      << (m.ran_mode >= 0 ? to_string(static_cast<ComplianceMode>(m.ran_mode)) : std::string_view()) << '\n';
   }
   return s.str();
 }
@@ -362,7 +407,8 @@ std::string safety_fuzz_report(const SafetyFuzzResult& result, const SafetyFuzzO
     << " fault-free references) on "
     << result.runs << " plant + controller constructions; " << format_fixed(result.simulated_s, 0) << " s simulated in "
     << format_fixed(result.wall_s, 1) << " s of wall time with " << o.jobs << " jobs. **" << result.controller_failures()
-    << " controller failures.**" << (o.replay.empty() ? "" : " Replay of `" + o.replay + "` only.") << "\n\n"
+    << " controller failures, " << result.invalid_windows() << " invalid windows, " << result.skipped_rows
+    << " rows skipped.**" << (o.replay.empty() ? "" : " Replay of `" + o.replay + "` only.") << "\n\n"
     << "Violations, on the plant's true state: a joint beyond its URDF limit; |qd| above " << t.speed_factor
     << " x its velocity limit; a self-collision capsule pair below " << format_fixed(1e3 * t.collision_distance_m, 0)
     << " mm; a non-finite command; a crash or a diverged plant; a refused write (unhandled: no safe stop the next cycle); "
@@ -374,6 +420,7 @@ std::string safety_fuzz_report(const SafetyFuzzResult& result, const SafetyFuzzO
     << " s after it began. Operator-possible: the push needed more than a joint's torque limit to hold the arm "
        "(|g(q) - J_p^T F|_i > tau_limit_i, controller model, true q).\n\n";
   pair_table(result, s);
+  validity_section(result, s);
   category_table(result, s);
   fault_table(result, s);
   fault_kind_table(result, s);
@@ -392,6 +439,10 @@ int run_safety_fuzz_command(const SafetyFuzzOptions& options, bool fail_on_viola
   summary << r.pushes() << " pushes, " << r.faults() << " faults (" << r.faults_in("rest") << " at rest, " << r.faults_in("motion")
           << " in motion, " << r.faults_in("switch") << " after a loop switch), " << r.runs << " runs: " << format_fixed(r.simulated_s, 0)
           << " s simulated in " << format_fixed(r.wall_s, 1) << " s of wall time\n";
+  if (!r.skipped_loops.empty()) {
+    summary << "skipped: " << r.skipped_rows << " mode x loop rows (the drive does not offer " << loop_list(r.skipped_loops) << ")\n";
+  }
+  summary << "invalid windows: " << r.invalid_windows() << " (the loop or mode under test did not run; never a pass)\n";
   summary << "controller failures: " << r.controller_failures();
   for (int i = 0; i < kFuzzViolationCount; ++i) {
     const long n = std::count_if(r.records.begin(), r.records.end(), [i](const FuzzRecord& x) {
@@ -416,7 +467,7 @@ int run_safety_fuzz_command(const SafetyFuzzOptions& options, bool fail_on_viola
             << "\n";
   }
   report_experiment({summary.str(), r.files, options.output_dir, options.figure_script, "safety_fuzz.png"}, out);
-  return fail_on_violation && r.controller_failures() > 0 ? 1 : 0;
+  return fail_on_violation && (r.controller_failures() > 0 || r.invalid_windows() > 0) ? 1 : 0;
 }
 
 }  // namespace phri

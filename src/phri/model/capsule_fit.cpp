@@ -148,14 +148,26 @@ std::vector<FittedCapsule> fit_links(const urdf::ModelInterface& urdf, const Mod
       fit_to_pieces(pieces, capsule);
     } else if (is_body_link(*link, model)) {
       const urdf::Joint* next = next_joint(urdf, *link, model);
-      if (next == nullptr) {
-        notes.push_back("link '" + frame.name + "': no collision geometry and no child joint: no capsule");
+      capsule.p0 = Eigen::Vector3d::Zero();
+      capsule.radius = options.link_frame_radius_m;
+      if (next != nullptr) {
+        const urdf::Vector3& p = next->parent_to_joint_origin_transform.position;
+        capsule.p1 = Eigen::Vector3d(p.x, p.y, p.z);
+      } else if (link->inertial && link->inertial->mass > 0.0) {
+        // Its child joints (if any) sit at its origin, as in a wrist whose axes meet: the link's
+        // body still has mass around its centre of mass. A segment from the origin through the
+        // COM to twice as far (the COM in its middle; a sphere at the origin when they coincide).
+        const urdf::Vector3& c = link->inertial->origin.position;
+        capsule.p1 = 2.0 * Eigen::Vector3d(c.x, c.y, c.z);
+        notes.push_back("link '" + frame.name + "': no collision geometry and " +
+                        (link->child_joints.empty() ? std::string("no child joint") : "its child joints at its origin") +
+                        ": a capsule through its centre of mass");
+      } else {
+        notes.push_back("link '" + frame.name + "': no collision geometry, " +
+                        (link->child_joints.empty() ? std::string("no child joint") : "its child joints at its origin") +
+                        " and no mass: no capsule");
         continue;
       }
-      const urdf::Vector3& p = next->parent_to_joint_origin_transform.position;
-      capsule.p0 = Eigen::Vector3d::Zero();
-      capsule.p1 = Eigen::Vector3d(p.x, p.y, p.z);
-      capsule.radius = options.link_frame_radius_m;
     } else {
       continue;  // a frame merged into its parent's body, without geometry of its own
     }

@@ -18,6 +18,26 @@ enum class ActuatorSize { kLarge, kSmall };
 ///   can produce at least kLargeActuatorMinTorque_Nm (current_limit_A x K_T x G_r; the Gen3's
 ///   large 105 N.m, small 52 N.m), small below.
 inline constexpr double kDeadbandPerTorqueLimit = 0.01;
+
+/// What a maker publishes for a joint is its torque and speed limits; everything else in
+/// actuators.yaml is optional, with these defaults (docs/robots.md; a notice for each one used,
+/// ActuatorTable::notices()). A Kinova drive needs them all stated (its emulated loops run on them).
+inline constexpr double kDefaultGearRatio = 100.0;              ///< a harmonic drive's typical ratio
+inline constexpr double kDefaultTorqueConstant_Nm_per_A = 0.1;  ///< K_T G_r = 10 N.m/A with the ratio above
+inline constexpr double kDefaultCurrentHeadroom = 1.1;          ///< current limit: 1.1 x torque_limit / (K_T G_r)
+inline constexpr double kDefaultVelocityThreshold_rad_s = 0.1;  ///< friction model's thresholds (the Gen3's)
+inline constexpr double kDefaultAccelerationThreshold_rad_s2 = 1.0;
+
+/// The actuators.yaml keys a joint left out (bits of ActuatorParameters::defaulted).
+enum ActuatorDefault : unsigned {
+  kDefaultedGearRatio = 1u << 0,
+  kDefaultedTorqueConstant = 1u << 1,
+  kDefaultedRotorInertia = 1u << 2,
+  kDefaultedReflectedInertia = 1u << 3,
+  kDefaultedCurrentLimit = 1u << 4,
+  kDefaultedFriction = 1u << 5,  ///< any key of the friction model
+};
+inline constexpr int kActuatorDefaultCount = 6;
 inline constexpr double kLargeActuatorMinTorque_Nm = 75.0;
 
 struct ActuatorParameters {
@@ -34,6 +54,8 @@ struct ActuatorParameters {
   /// Torsional stiffness between rotor and torque sensor (harmonic drive) [N.m/rad]; 0: rigid.
   double transmission_stiffness_Nm_per_rad = 0.0;
   FrictionParameters friction;
+  /// The optional keys this joint left out (ActuatorDefault bits): their defaults are in use.
+  unsigned defaulted = 0;
 
   /// Joint torque per motor ampere, K_T G_r [N.m/A]: tau_joint = K_T G_r i.
   double torque_per_amp() const { return torque_constant_Nm_per_A * gear_ratio; }
