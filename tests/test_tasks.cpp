@@ -68,7 +68,10 @@ double inertia_along_minus_z(const Arm& arm) {
 std::pair<Eigen::MatrixXd, Eigen::VectorXd> objective(const phri::Task& task) {
   Eigen::MatrixXd h = Eigen::MatrixXd::Zero(7, 7);
   Eigen::VectorXd g = Eigen::VectorXd::Zero(7);
-  task.add_objective(h, g);
+  Eigen::VectorXd d = Eigen::VectorXd::Zero(7);
+  phri::ObjectiveTerms objective{h, d, g};
+  task.add_objective(objective);
+  h.diagonal() += d;
   return {h, g};
 }
 

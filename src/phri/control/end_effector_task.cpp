@@ -264,16 +264,16 @@ void EndEffectorTask::weigh_rows() {
   }
 }
 
-void EndEffectorTask::add_objective(Eigen::MatrixXd& hessian, Eigen::VectorXd& gradient) const {
+void EndEffectorTask::add_objective(ObjectiveTerms& objective) const {
   const double w = weight();
   const Eigen::MatrixXd& a = rows();
   if (weighted_) {
     // w || (S^1/2 W S^1/2)^1/2 (A qdd - b) ||^2 (singular_direction_weight.hpp).
-    hessian.noalias() += w * a.transpose() * weighted_rows_;
-    gradient.noalias() -= w * weighted_rows_.transpose() * reference_;
+    objective.hessian.noalias() += w * a.transpose() * weighted_rows_;
+    objective.gradient.noalias() -= w * weighted_rows_.transpose() * reference_;
   } else {
-    hessian.noalias() += w * a.transpose() * a;
-    gradient.noalias() -= w * a.transpose() * reference_;
+    objective.hessian.noalias() += w * a.transpose() * a;
+    objective.gradient.noalias() -= w * a.transpose() * reference_;
   }
 }
 

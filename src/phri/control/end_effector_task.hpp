@@ -57,7 +57,7 @@ public:
 
   // ---- task interface
   void update(const TaskContext& context) override { update(context.model, context.data, context.qdd_external, context.dt); }
-  void add_objective(Eigen::MatrixXd& hessian, Eigen::VectorXd& gradient) const override;
+  void add_objective(ObjectiveTerms& objective) const override;
   void set_role_gamma(double gamma) override {
     if (!fixed_gamma_) set_gamma(Vector6d::Constant(gamma));
   }

@@ -66,9 +66,9 @@ public:
     reference_ = damping_ * (speed_target - speed) - drift + gamma_ * row_.dot(c.qdd_external);
   }
 
-  void add_objective(Eigen::MatrixXd& hessian, Eigen::VectorXd& gradient) const override {
-    hessian.noalias() += weight_ * row_.transpose() * row_;
-    gradient.noalias() -= (weight_ * reference_) * row_.transpose();
+  void add_objective(ObjectiveTerms& objective) const override {
+    objective.hessian.noalias() += weight_ * row_.transpose() * row_;
+    objective.gradient.noalias() -= (weight_ * reference_) * row_.transpose();
   }
 
 private:

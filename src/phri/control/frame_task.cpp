@@ -51,9 +51,9 @@ public:
     weighted_rows_.array().colwise() *= selection_.array();
   }
 
-  void add_objective(Eigen::MatrixXd& hessian, Eigen::VectorXd& gradient) const override {
-    hessian.noalias() += weight_ * rows_.transpose() * weighted_rows_;
-    gradient.noalias() -= weight_ * weighted_rows_.transpose() * reference_;
+  void add_objective(ObjectiveTerms& objective) const override {
+    objective.hessian.noalias() += weight_ * rows_.transpose() * weighted_rows_;
+    objective.gradient.noalias() -= weight_ * weighted_rows_.transpose() * reference_;
   }
 
 private:

@@ -47,10 +47,10 @@ void PostureTask::set_fixed_gamma(double gamma) {
   gamma_.reset(Eigen::VectorXd::Constant(1, std::clamp(gamma, 0.0, 1.0)));
 }
 
-void PostureTask::add_objective(Eigen::MatrixXd& hessian, Eigen::VectorXd& gradient) const {
+void PostureTask::add_objective(ObjectiveTerms& objective) const {
   const double w = weight();
-  hessian.diagonal().array() += w;
-  gradient.noalias() -= w * reference_;
+  objective.hessian_diagonal.array() += w;
+  objective.gradient.noalias() -= w * reference_;
 }
 
 void PostureTask::set_target(const Eigen::VectorXd& q, const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd) {

@@ -28,7 +28,7 @@ public:
   // ---- task interface: rows A = I (nv rows)
   std::string_view type() const override { return "posture"; }
   void update(const TaskContext& context) override { update(context.q, context.qd, context.qdd_external, context.dt); }
-  void add_objective(Eigen::MatrixXd& hessian, Eigen::VectorXd& gradient) const override;
+  void add_objective(ObjectiveTerms& objective) const override;
   void set_role_gamma(double gamma) override {
     if (!fixed_gamma_) set_gamma(gamma);
   }

@@ -30,6 +30,15 @@ enum class ComplianceRole {
   kNone,       ///< the mode leaves it alone: the task's declared gamma (default 0)
 };
 
+/// The QP's objective as the tasks build it: 1/2 qdd^T (H + diag(d)) qdd + g^T qdd. A task whose
+/// Hessian is diagonal (a posture, a regularisation) adds to d, which the QP adds to H once: the
+/// diagonal's summation order then does not depend on the order tasks are declared in.
+struct ObjectiveTerms {
+  Eigen::MatrixXd& hessian;
+  Eigen::VectorXd& hessian_diagonal;
+  Eigen::VectorXd& gradient;
+};
+
 /// What a task reads in one cycle (all after the model terms of (q, qd)).
 struct TaskContext {
   const Model& model;
@@ -61,8 +70,9 @@ public:
   virtual void start(const Model& /*model*/, const Data& /*data*/) {}
   /// Computes this cycle's rows and reference (gamma term included); advances gain filters by dt.
   virtual void update(const TaskContext& context) = 0;
-  /// Adds w A^T W A to H and -w A^T W b to g (the least squares' factor 2 dropped).
-  virtual void add_objective(Eigen::MatrixXd& hessian, Eigen::VectorXd& gradient) const = 0;
+  /// Adds w A^T W A to H (or to d when diagonal) and -w A^T W b to g (the least squares' factor 2
+  /// dropped).
+  virtual void add_objective(ObjectiveTerms& objective) const = 0;
   /// The gamma a compliance mode asks for this task's role (0 or 1, or a live override in [0, 1]);
   /// ignored when the task keeps a gamma of its own.
   virtual void set_role_gamma(double gamma) = 0;

@@ -73,7 +73,8 @@ WholeBodyQp::WholeBodyQp(const Model& model, const CollisionModel* collision, co
       tau_desired_(Eigen::VectorXd::Zero(nv_)),
       last_good_tau_(Eigen::VectorXd::Zero(nv_)),
       hold_torque_(Eigen::VectorXd::Zero(nv_)),
-      inertia_diagonal_(Eigen::VectorXd::Zero(nv_)) {
+      inertia_diagonal_(Eigen::VectorXd::Zero(nv_)),
+      hessian_diagonal_(Eigen::VectorXd::Zero(nv_)) {
   constexpr std::size_t kReserved = 16;  // more than any configuration declares: no reallocation later
   tasks_.reserve(kReserved);
   constraints_.reserve(kReserved);
@@ -150,8 +151,10 @@ const Task* WholeBodyQp::find_task(std::string_view name) const { return const_c
 void WholeBodyQp::assemble_objective() {
   problem_.H.setZero();
   problem_.g.setZero();
-  for (const auto& task : tasks_) task->add_objective(problem_.H, problem_.g);
-  problem_.H.diagonal().array() += settings_.regularization;
+  hessian_diagonal_.setConstant(settings_.regularization);
+  ObjectiveTerms objective{problem_.H, hessian_diagonal_, problem_.g};
+  for (const auto& task : tasks_) task->add_objective(objective);
+  problem_.H.diagonal() += hessian_diagonal_;
 }
 
 // Bounds from -inf/+inf tightened by each constraint in order, then each constraint's rows.

@@ -182,6 +182,7 @@ private:
   Eigen::VectorXd deadband_;
   Eigen::VectorXd qdd_external_, qdd_desired_, tau_desired_, last_good_tau_;
   Eigen::VectorXd hold_torque_, inertia_diagonal_;  // the constraints' context
+  Eigen::VectorXd hessian_diagonal_;                // the tasks' diagonal Hessian terms (ObjectiveTerms)
   WholeBodyQpStatus status_ = WholeBodyQpStatus::kOk;
   bool warm_ = false;
 };
