@@ -164,6 +164,20 @@ TEST(Config, UnknownKeysNameTheirPath) {
                       {.element = "events[0].when", .mentions = {"unknown key"}, .file = "test.yaml"});
 }
 
+TEST(Config, DeclaredConstraintsAreCheckedAtLoad) {
+  const std::string posture = "    - {type: posture, name: posture}     # the null-space task\n";
+  const phri::Config ok = load_edited(
+      posture, posture + "  constraints:\n    - {type: plane, name: table, frame: end_effector, offset_m: 0.05}\n");
+  ASSERT_EQ(ok.controller.constraints.size(), 1u);
+  EXPECT_EQ(ok.controller.constraints[0].type, "plane");
+  EXPECT_EQ(ok.controller.constraints[0].numbers.at("offset_m"), std::vector<double>{0.05});
+  expect_config_error(loading_demo_with(posture, posture + "  constraints:\n    - {type: plane, name: t, ofset_m: 0.05}\n"),
+                      {.element = "controller.constraints[0].ofset_m", .mentions = {"unknown key for a plane constraint"},
+                       .file = "test.yaml"});
+  expect_config_error(loading_demo_with(posture, posture + "  constraints:\n    - {type: joint_limits, name: j}\n"),
+                      {.element = "controller.constraints[0].type", .mentions = {"always on"}, .file = "test.yaml"});
+}
+
 TEST(Config, WrongTypesNameTheirPath) {
   expect_config_error(loading_demo_with("observer_gain: 50.0", "observer_gain: fast"),
                       {.element = "controller.observer_gain", .mentions = {"expected a number"}, .file = "test.yaml"});

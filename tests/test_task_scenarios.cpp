@@ -9,6 +9,7 @@
 
 #include "gen3_settings.hpp"
 #include "hand_push.hpp"
+#include "task_spec.hpp"
 
 #include <gtest/gtest.h>
 #include <mujoco/mujoco.h>
@@ -19,14 +20,6 @@
 namespace {
 
 const std::string kRoot = PHRI_SOURCE_DIR;
-
-phri::TaskSpec task(const std::string& type, const std::string& name) {
-  phri::TaskSpec s;
-  s.type = type;
-  s.name = name;
-  s.source = "test";
-  return s;
-}
 
 phri::SimRobotConfig plant() {
   phri::SimRobotConfig c = phri::SimRobotConfig::from_yaml_file(kRoot + "/configs/plant_gen3.yaml");
@@ -88,9 +81,9 @@ TEST(TaskScenarios, ForceTaskPressesTenNewtonsOnATableWhileTheOtherAxesHold) {
   // compliance the posture yields to the table's reaction too, which the task then fights: +-1.9 N.)
   phri::ControllerSettings settings =
       phri::test::gen3_controller_settings(phri::ComplianceMode::kStiff, phri::LowLevelMode::kCurrent);
-  phri::TaskSpec ee = task("pose", "end_effector");
+  phri::TaskSpec ee = phri::test::task_spec("pose", "end_effector");
   ee.numbers["selection"] = {1, 1, 0, 1, 1, 1};  // z is the force task's
-  phri::TaskSpec press = task("force", "press");
+  phri::TaskSpec press = phri::test::task_spec("force", "press");
   press.numbers["force_N"] = {10.0};
   press.numbers["axis"] = {0, 0, -1};
   settings.tasks = {ee, press};
@@ -145,7 +138,7 @@ AxisRun per_axis_push(const Eigen::Vector3d& tool_axis, bool declared = true,
   phri::SimRobot robot(config);
   phri::ControllerSettings settings =
       phri::test::gen3_controller_settings(phri::ComplianceMode::kStiff, phri::LowLevelMode::kCurrent);
-  phri::TaskSpec ee = task("pose", "end_effector");
+  phri::TaskSpec ee = phri::test::task_spec("pose", "end_effector");
   ee.words["axes"] = "frame";
   ee.numbers["gamma"] = {0, 0, 1, 0, 0, 0};
   ee.numbers["stiffness"] = {400, 400, 0, 400, 400, 400};  // the paper's 400 on the stiff axes
@@ -182,6 +175,40 @@ TEST(TaskScenarios, PerAxisGammaLetsAPushAlongTheToolZThroughAndNegatesOneAcross
   // Observer-only, the transient is the observer's 20 ms (K_O 50/s) against the spring (K 400):
   // the same as the paper's stiff task, not the compliant axis leaking.
   EXPECT_LT(observer_across.along_mm, 10.0);
+}
+
+// A declared plane constraint 30 mm under the end effector (control/plane_constraint.cpp): in
+// full-body compliance a 30 N push down moves the tool freely, and without the plane further
+// than 30 mm; with it the tool's true height (the simulator's site) stays above the plane.
+double lowest_under_push(bool with_plane, double plane_below_m) {
+  phri::SimRobotConfig config = plant();
+  config.disturbances = {phri::test::hand_push("tool", Eigen::Vector3d(0, 0, 0.05), Eigen::Vector3d(0, 0, -30.0), 1.0, 1.5)};
+  phri::SimRobot robot(config);
+  phri::ControllerSettings settings =
+      phri::test::gen3_controller_settings(phri::ComplianceMode::kFullBody, phri::LowLevelMode::kCurrent);
+  settings.external_torque_source = phri::ExternalTorqueSource::kFused;
+  const double start_z = site_pose(robot, "end_effector").translation().z();
+  if (with_plane) {
+    phri::TaskSpec plane = phri::test::task_spec("plane", "table", "test");
+    plane.words["frame"] = "end_effector";
+    plane.numbers["offset_m"] = {start_z - plane_below_m};
+    settings.constraints = {plane};
+  }
+  phri::Controller cycle(settings);
+  Loop loop{robot, cycle};
+  double lowest = start_z;
+  loop.run(3.0, [&]() { lowest = std::min(lowest, site_pose(robot, "end_effector").translation().z()); });
+  EXPECT_EQ(cycle.status(), phri::CycleStatus::kOk);
+  return start_z - lowest;
+}
+
+TEST(ConstraintScenarios, ADeclaredPlaneUnderTheToolHoldsItAboveAgainstAPushDown) {
+  const double free_mm = 1e3 * lowest_under_push(false, 0.03);
+  const double held_mm = 1e3 * lowest_under_push(true, 0.03);
+  std::printf("plane constraint 30 mm under the end effector (d_s 10 mm), 30 N down for 1.5 s in full-body "
+              "compliance: without it the tool went %.1f mm down, with it %.1f mm\n", free_mm, held_mm);
+  EXPECT_GT(free_mm, 30.0);
+  EXPECT_LT(held_mm, 30.0 - 10.0 + 1.0);  // above the plane by its d_s, to within a millimetre
 }
 
 }  // namespace

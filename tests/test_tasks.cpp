@@ -1,12 +1,16 @@
 // ctest-labels: unit
 // Tasks as objects (control/task.hpp, task_registry.hpp): each type's rows against finite
 // differences of the model's forward kinematics, its reference against closed forms, the
-// registry's errors, per-axis gamma in the tool's axes, and the QP assembled from a list.
+// registry's errors, per-axis gamma in the tool's axes, and the QP assembled from a list; the
+// declared plane constraint's row against finite differences and its bound against the damper's
+// closed form.
+#include <phri/control/constraint_registry.hpp>
 #include <phri/control/task_registry.hpp>
 #include <phri/control/whole_body_qp.hpp>
 #include <phri/model/algorithms.hpp>
 
 #include "allocation_counter.hpp"
+#include "task_spec.hpp"
 
 #include <gtest/gtest.h>
 
@@ -47,14 +51,6 @@ struct Arm {
   }
 };
 
-phri::TaskSpec spec(const std::string& type, const std::string& name) {
-  phri::TaskSpec s;
-  s.type = type;
-  s.name = name;
-  s.source = "test.yaml: controller.tasks[0]";
-  return s;
-}
-
 // The end effector's inertia along -z with its other axes held, n' (J M^-1 J')^-1 n.
 double inertia_along_minus_z(const Arm& arm) {
   Eigen::MatrixXd j(6, 7);
@@ -77,7 +73,7 @@ std::pair<Eigen::MatrixXd, Eigen::VectorXd> objective(const phri::Task& task) {
 
 TEST(ForceTask, RowIsTheAxisAlongTheFiniteDifferenceJacobianAndReferenceTheAdmittance) {
   Arm arm;
-  phri::TaskSpec s = spec("force", "press");
+  phri::TaskSpec s = phri::test::task_spec("force", "press");
   s.numbers["force_N"] = {10.0};
   s.numbers["axis"] = {0.0, 0.0, -1.0};
   s.numbers["weight"] = {2.0};
@@ -103,7 +99,7 @@ TEST(ForceTask, RowIsTheAxisAlongTheFiniteDifferenceJacobianAndReferenceTheAdmit
 
 TEST(ForceTask, WithoutAnFtSensorTheWrenchIsTheLeastSquaresOneThatExplainsTauExt) {
   Arm arm;
-  phri::TaskSpec s = spec("force", "press");
+  phri::TaskSpec s = phri::test::task_spec("force", "press");
   s.numbers["force_N"] = {0.0};
   s.numbers["max_speed_m_s"] = {0.5};
   auto task = phri::make_task(s, arm.build());
@@ -124,7 +120,7 @@ TEST(ForceTask, WithoutAnFtSensorTheWrenchIsTheLeastSquaresOneThatExplainsTauExt
 TEST(FrameTask, RowsAreTheLinkPositionJacobianSelectedAndTheReferenceASpringToTheTarget) {
   Arm arm;
   const int elbow = arm.model.frame_id("forearm_link");
-  phri::TaskSpec s = spec("frame", "elbow_height");
+  phri::TaskSpec s = phri::test::task_spec("frame", "elbow_height");
   s.words["frame"] = "forearm_link";
   s.numbers["selection"] = {0.0, 0.0, 1.0};
   s.numbers["stiffness"] = {40.0};
@@ -211,22 +207,22 @@ TEST(TaskRegistry, ErrorsNameTheKeyAndListWhatIsKnown) {
     }
     return std::string("no error");
   };
-  EXPECT_NE(message(spec("polish", "p")).find("unknown task type 'polish' (known: pose, posture, force, frame)"),
+  EXPECT_NE(message(phri::test::task_spec("polish", "p")).find("unknown task type 'polish' (known: pose, posture, force, frame)"),
             std::string::npos);
-  phri::TaskSpec s = spec("force", "press");
+  phri::TaskSpec s = phri::test::task_spec("force", "press");
   s.numbers["forse_N"] = {10.0};
   EXPECT_NE(message(s).find("controller.tasks[0]: forse_N: unknown key for a force task"), std::string::npos);
-  s = spec("force", "press");
+  s = phri::test::task_spec("force", "press");
   s.numbers["force_N"] = {1e6};
   EXPECT_NE(message(s).find("force_N: 1e+06 is outside [-200, 200]"), std::string::npos);
-  s = spec("force", "press");
+  s = phri::test::task_spec("force", "press");
   s.numbers["axis"] = {0.0, 0.0, 0.0};
   EXPECT_NE(message(s).find("axis: must not be zero"), std::string::npos);
-  s = spec("frame", "elbow");
+  s = phri::test::task_spec("frame", "elbow");
   EXPECT_NE(message(s).find("frame: name the frame"), std::string::npos);
   s.words["frame"] = "no_such_link";
   EXPECT_NE(message(s).find("no frame 'no_such_link'"), std::string::npos);
-  s = spec("pose", "tool");
+  s = phri::test::task_spec("pose", "tool");
   s.words["frame"] = "end_effector";
   s.words["axes"] = "tool";
   EXPECT_NE(message(s).find("axes: 'tool' is not one of: world, frame"), std::string::npos);
@@ -240,8 +236,8 @@ TEST(WholeBodyQp, TasksAreAListNamesUniqueAndTheCycleAllocatesNothingWithTheNewT
   ASSERT_EQ(qp.tasks().size(), 2u);
   EXPECT_EQ(qp.tasks()[0]->name(), "end_effector");
   EXPECT_EQ(qp.tasks()[1]->type(), "posture");
-  phri::TaskSpec force = spec("force", "press");
-  phri::TaskSpec elbow = spec("frame", "elbow");
+  phri::TaskSpec force = phri::test::task_spec("force", "press");
+  phri::TaskSpec elbow = phri::test::task_spec("frame", "elbow");
   elbow.words["frame"] = "forearm_link";
   qp.add_task(phri::make_task(force, arm.build()));
   qp.add_task(phri::make_task(elbow, arm.build()));
@@ -255,6 +251,85 @@ TEST(WholeBodyQp, TasksAreAListNamesUniqueAndTheCycleAllocatesNothingWithTheNewT
   for (int i = 0; i < 10; ++i) qp.update(arm.model, arm.data, arm.q, arm.qd, arm.tau_ext, 0.001, i % 2 ? &wrench : nullptr);
   EXPECT_EQ(counter.allocations(), 0u);
   EXPECT_EQ(qp.status(), phri::WholeBodyQpStatus::kOk);
+}
+
+// The plane constraint (plane_constraint.cpp) on the end effector: its row predicts the distance's
+// second derivative (central differences of n . p along q(t) = q + qd t + qdd t^2 / 2), and its
+// lower bound is the paper's damper, -k (d - d_s) - lambda ḋ, written out here.
+TEST(PlaneConstraint, RowIsTheDistancesSecondDerivativeAndItsBoundThePapersDamper) {
+  Arm arm;
+  arm.qd << 0.3, -0.2, 0.4, 0.1, -0.5, 0.3, 0.2;
+  phri::compute_all_terms(arm.model, arm.data, arm.q, arm.qd);
+  const Eigen::Vector3d n = Eigen::Vector3d(0.2, -0.3, 1.0).normalized();
+  const double p0 = n.dot(arm.data.frame_placements[static_cast<std::size_t>(arm.ee)].translation());
+  phri::ConstraintSpec s = phri::test::task_spec("plane", "table");
+  s.words["frame"] = "end_effector";
+  s.numbers["normal"] = {0.2, -0.3, 1.0};
+  s.numbers["offset_m"] = {p0 - 0.03};  // 30 mm from the plane: within the influence distance
+  s.numbers["influence_distance_m"] = {0.05};
+  s.numbers["safety_distance_m"] = {0.01};
+  s.numbers["approach_speed_m_s"] = {0.1};
+  s.numbers["amortization"] = {1.8};
+  std::unique_ptr<phri::Constraint> plane = phri::make_constraint(s, {arm.model, arm.ee});
+  ASSERT_EQ(plane->num_rows(), 1);
+  const Eigen::VectorXd torque_limit = Eigen::VectorXd::Constant(7, 50.0), diag = arm.data.mass_matrix.diagonal();
+  const phri::ConstraintContext context{arm.model, arm.data, arm.q, arm.qd, arm.tau_ext, arm.tau_ext, torque_limit, diag};
+  Eigen::MatrixXd a(1, 7);
+  Eigen::VectorXd l(1), u(1);
+  plane->fill_rows(context, a, l, u);
+
+  Eigen::VectorXd qdd(7);
+  qdd << 1.0, -0.5, 0.7, 0.2, -1.1, 0.4, 0.9;
+  const double h = 1e-4;
+  auto d = [&](double t) { return n.dot(arm.position(arm.ee, arm.q + arm.qd * t + 0.5 * qdd * t * t)) - (p0 - 0.03); };
+  const double d_dot = (d(h) - d(-h)) / (2 * h);
+  const double d_ddot = (d(h) - 2 * d(0) + d(-h)) / (h * h);
+  const double drift = d_ddot - a.row(0).dot(qdd);  // n . J̇ qd, if the row is right for every qdd
+  Eigen::VectorXd qdd2 = -2.0 * qdd;
+  auto d2 = [&](double t) { return n.dot(arm.position(arm.ee, arm.q + arm.qd * t + 0.5 * qdd2 * t * t)); };
+  EXPECT_NEAR((d2(h) - 2 * d2(0) + d2(-h)) / (h * h) - a.row(0).dot(qdd2), drift, 1e-4);
+  EXPECT_NEAR(a.row(0).dot(arm.qd), d_dot, 1e-7);
+
+  const double lambda = 4.0 * 1.8 * 1.8 * 0.1 / (0.05 - 0.01);
+  const double k = lambda * lambda / (4.0 * 1.8 * 1.8);
+  EXPECT_NEAR(l[0], -k * (0.03 - 0.01) - lambda * d_dot - drift, 1e-4);
+  EXPECT_TRUE(std::isinf(u[0]) && u[0] > 0);
+
+  // Beyond the influence distance the row is free.
+  s.numbers["offset_m"] = {p0 - 0.2};
+  phri::make_constraint(s, {arm.model, arm.ee})->fill_rows(context, a, l, u);
+  EXPECT_TRUE(std::isinf(l[0]) && l[0] < 0);
+}
+
+TEST(ConstraintRegistry, ErrorsNameTheKeyAndSayThePapersConstraintsAreAlwaysOn) {
+  Arm arm;
+  auto message = [&](const phri::ConstraintSpec& s) {
+    try {
+      phri::make_constraint(s, {arm.model, arm.ee});
+    } catch (const phri::ConfigError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  const std::string unknown = message(phri::test::task_spec("joint_limits", "j"));
+  EXPECT_NE(unknown.find("unknown constraint type 'joint_limits' (known: plane; the paper's safety constraints are "
+                         "always on"),
+            std::string::npos)
+      << unknown;
+  phri::ConstraintSpec s = phri::test::task_spec("plane", "table");
+  s.words["frame"] = "end_effector";
+  EXPECT_NE(message(s).find("offset_m"), std::string::npos);
+  s.numbers["offset_m"] = {0.1};
+  s.numbers["ofset"] = {0.1};
+  EXPECT_NE(message(s).find("controller.tasks[0]: ofset: unknown key for a plane constraint (known: type, name, frame"),
+            std::string::npos)
+      << message(s);
+  s.numbers.erase("ofset");
+  s.numbers["safety_distance_m"] = {0.08};
+  EXPECT_NE(message(s).find("safety_distance_m: must be below influence_distance_m"), std::string::npos) << message(s);
+  s.numbers.erase("safety_distance_m");
+  s.words["frame"] = "elbow_that_is_not";
+  EXPECT_NE(message(s).find("no frame 'elbow_that_is_not'"), std::string::npos) << message(s);
 }
 
 }  // namespace

@@ -15,15 +15,6 @@ namespace {
 // Joint limits of the URDF and of the plant agree to this (the MJCF copies the URDF's values).
 constexpr double kLimitTolerance_rad = 1e-3;
 
-std::string range_text(double lower, double upper) {
-  std::string text = "[";  // appended piece by piece: GCC 12's -Wrestrict misfires on "[" + std::string
-  text += format_general(lower, 6);
-  text += ", ";
-  text += format_general(upper, 6);
-  text += "]";
-  return text;
-}
-
 std::string joint_type_name(JointType type) { return type == JointType::kRevolute ? "revolute" : "continuous"; }
 
 // One joint of the controller's URDF against the same joint of the plant's MJCF.
@@ -39,15 +30,15 @@ void check_joint_matches_plant(const Joint& joint, const SimScene::ArmJoint& pla
   }
   if (joint.type == JointType::kContinuous || !joint.has_position_limits()) {
     if (plant.limited) {
-      throw ConfigError(urdf, where, "unlimited in the URDF but limited to " + range_text(plant.lower, plant.upper) +
+      throw ConfigError(urdf, where, "unlimited in the URDF but limited to " + format_range(plant.lower, plant.upper) +
                                          " rad in the plant (" + mjcf + ")");
     }
     return;
   }
   if (plant.limited && (joint.lower < plant.lower - kLimitTolerance_rad || joint.upper > plant.upper + kLimitTolerance_rad)) {
     throw ConfigError(urdf, where + " <limit>",
-                      "limits " + range_text(joint.lower, joint.upper) + " rad go beyond the plant's range " +
-                          range_text(plant.lower, plant.upper) + " (" + mjcf + ")");
+                      "limits " + format_range(joint.lower, joint.upper) + " rad go beyond the plant's range " +
+                          format_range(plant.lower, plant.upper) + " (" + mjcf + ")");
   }
 }
 

@@ -345,7 +345,7 @@ void parse_wrench(const YamlReader& w, WrenchEstimatorSettings& s) {
 
 void parse_controller(const YamlReader& r, const ActuatorTable& drives, const std::string& base_dir, ControllerSettings& c) {
   r.allow_keys({"period_s", "observer_gain", "external_torque_source", "position_mode_open_loop", "compliance_deadband",
-                "compliance", "qp", "wrench", "tasks"});
+                "compliance", "qp", "wrench", "tasks", "constraints"});
   c.position_mode_open_loop = r.boolean_or("position_mode_open_loop", c.position_mode_open_loop);
   c.period_s = positive_or(r, "period_s", c.period_s, 0.1);
   if (r.has("external_torque_source")) {
@@ -365,6 +365,7 @@ void parse_controller(const YamlReader& r, const ActuatorTable& drives, const st
   if (r.has("qp")) parse_qp(r.at("qp"), drives, base_dir, c.qp);
   if (r.has("wrench")) parse_wrench(r.at("wrench"), c.wrench);
   if (r.has("tasks")) c.tasks = parse_task_specs(r.at("tasks"));
+  if (r.has("constraints")) c.constraints = parse_constraint_specs(r.at("constraints"));
 }
 
 // ------------------------------------------------------------------------------------ low level

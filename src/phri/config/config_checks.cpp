@@ -16,15 +16,6 @@
 namespace phri {
 namespace {
 
-std::string range_text(double lower, double upper) {
-  std::string text = "[";  // appended piece by piece: GCC 12's -Wrestrict misfires on "[" + std::string
-  text += format_general(lower, 6);
-  text += ", ";
-  text += format_general(upper, 6);
-  text += "]";
-  return text;
-}
-
 void check_end_effector_frame(const Model& model, const Config& config) {
   const std::string& name = config.controller.end_effector_frame;
   if (!model.has_frame(name)) {
@@ -48,7 +39,7 @@ void check_within_limits(const Model& model, const std::vector<double>& q, const
     if (joint.has_position_limits() && (value < joint.lower || value > joint.upper)) {
       throw ConfigError(source, key + "[" + std::to_string(i) + "]",
                         format_general(value, 6) + " rad is beyond " + joint.name + "'s limits " +
-                            range_text(joint.lower, joint.upper) + " (URDF)");
+                            format_range(joint.lower, joint.upper) + " (URDF)");
     }
   }
 }

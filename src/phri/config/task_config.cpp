@@ -1,5 +1,6 @@
 #include <phri/config/task_config.hpp>
 
+#include <phri/control/constraint_registry.hpp>
 #include <phri/control/task_registry.hpp>
 
 namespace phri {
@@ -9,7 +10,7 @@ namespace {
 // check each key's own range.
 constexpr double kAnyNumber = 1e12;
 
-TaskSpec parse_task_spec(const YamlReader& entry) {
+TaskSpec parse_spec(const YamlReader& entry, void (*check_keys)(const TaskSpec&)) {
   entry.expect_map();
   TaskSpec spec;
   spec.source = entry.file();
@@ -34,23 +35,28 @@ TaskSpec parse_task_spec(const YamlReader& entry) {
       }
     }
   }
-  check_task_keys(spec);
+  check_keys(spec);
   return spec;
 }
 
-}  // namespace
-
-std::vector<TaskSpec> parse_task_specs(const YamlReader& list) {
+std::vector<TaskSpec> parse_specs(const YamlReader& list, void (*check_keys)(const TaskSpec&), const char* kind) {
   list.expect_sequence();
   std::vector<TaskSpec> specs;
   for (std::size_t i = 0; i < list.size(); ++i) {
-    TaskSpec spec = parse_task_spec(list.at(i));
+    TaskSpec spec = parse_spec(list.at(i), check_keys);
     for (const TaskSpec& other : specs) {
-      if (other.name == spec.name) spec.fail("name", "a second task named '" + spec.name + "'");
+      if (other.name == spec.name) spec.fail("name", std::string("a second ") + kind + " named '" + spec.name + "'");
     }
     specs.push_back(std::move(spec));
   }
   return specs;
+}
+
+}  // namespace
+
+std::vector<TaskSpec> parse_task_specs(const YamlReader& list) { return parse_specs(list, &check_task_keys, "task"); }
+std::vector<TaskSpec> parse_constraint_specs(const YamlReader& list) {
+  return parse_specs(list, &check_constraint_keys, "constraint");
 }
 
 }  // namespace phri

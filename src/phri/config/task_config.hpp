@@ -11,5 +11,8 @@
 namespace phri {
 
 std::vector<TaskSpec> parse_task_specs(const YamlReader& list);
+/// `controller.constraints:`, the same form, checked against the constraint types
+/// (control/constraint_registry.hpp).
+std::vector<TaskSpec> parse_constraint_specs(const YamlReader& list);
 
 }  // namespace phri

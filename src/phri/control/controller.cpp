@@ -1,5 +1,6 @@
 #include <phri/control/controller.hpp>
 
+#include <phri/control/constraint_registry.hpp>
 #include <phri/control/task_registry.hpp>
 
 #include <phri/control/torque_guards.hpp>
@@ -253,6 +254,13 @@ Controller::Controller(LoadedRobot robot, const ControllerSettings& settings)
     static_friction_[i] = std::max(actuators_[i].friction.static_Nm, actuators_[i].friction.coulomb_Nm);
   }
   add_declared_tasks(settings.tasks);
+  add_declared_constraints(settings.constraints);
+}
+
+// The run's declared constraints, after the paper's safety constraints.
+void Controller::add_declared_constraints(const std::vector<TaskSpec>& specs) {
+  const ConstraintBuildContext context{model_, end_effector_frame_};
+  for (const TaskSpec& spec : specs) qp_.add_constraint(make_constraint(spec, context));
 }
 
 // The run's declared tasks: the paper's two configured, the others built and added to the QP.

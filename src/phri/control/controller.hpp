@@ -143,6 +143,7 @@ private:
   static WholeBodyQpSettings qp_settings(const ControllerSettings& settings, const ActuatorTable& actuators);
   static ComplianceSettings with_main_task_stiffness(ComplianceSettings compliance, const std::vector<TaskSpec>& specs);
   void add_declared_tasks(const std::vector<TaskSpec>& specs);
+  void add_declared_constraints(const std::vector<TaskSpec>& specs);
   bool apply(const ControllerTargets& targets);
   void hold_previous(const RobotState& state, RobotCommand& command);
   void safe_stop(bool sample_good, RobotCommand& command);

@@ -179,6 +179,9 @@ struct ControllerSettings {
   /// The run YAML's `controller.tasks:` (control/task_registry.hpp): "end_effector" and "posture"
   /// configure the paper's two tasks, any other name adds a task. Empty: the paper's two as they are.
   std::vector<TaskSpec> tasks;
+  /// The run YAML's `controller.constraints:` (control/constraint_registry.hpp): constraints added
+  /// to the paper's safety constraints, which are always on.
+  std::vector<TaskSpec> constraints;
   /// Time constant of the low-pass on the wrench norm that drives the dual-compliance trigger [s]
   /// (0: none). A hand's push builds up over tens of milliseconds; 10 ms rejects one-sample spikes.
   double wrench_trigger_filter_s = 0.01;

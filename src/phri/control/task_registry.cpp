@@ -35,11 +35,6 @@ const TaskType* find_task_type(std::string_view name) {
 }
 
 namespace {
-std::string joined(const std::vector<std::string_view>& words) {
-  std::string text;
-  for (std::string_view w : words) text += (text.empty() ? "" : ", ") + std::string(w);
-  return text;
-}
 std::vector<std::string_view> type_names() {
   std::vector<std::string_view> names;
   for (const TaskType* type : task_types()) names.push_back(type->name);
@@ -49,14 +44,8 @@ std::vector<std::string_view> type_names() {
 
 void check_task_keys(const TaskSpec& spec) {
   const TaskType* type = find_task_type(spec.type);
-  if (!type) spec.fail("type", "unknown task type '" + spec.type + "' (known: " + joined(type_names()) + ")");
-  auto check = [&](const std::string& key) {
-    if (std::find(type->keys.begin(), type->keys.end(), key) == type->keys.end()) {
-      spec.fail(key, "unknown key for a " + spec.type + " task (known: type, name, " + joined(type->keys) + ")");
-    }
-  };
-  for (const auto& [key, value] : spec.numbers) check(key);
-  for (const auto& [key, value] : spec.words) check(key);
+  if (!type) spec.fail("type", "unknown task type '" + spec.type + "' (known: " + join_words(type_names()) + ")");
+  spec.check_keys("task", type->keys);
 }
 
 std::unique_ptr<Task> make_task(const TaskSpec& spec, const TaskBuildContext& context) {
@@ -121,6 +110,22 @@ std::string TaskSpec::word(std::string_view key, const std::string& fallback, co
     fail(std::string(key), "'" + it->second + "' is not one of: " + list);
   }
   return it->second;
+}
+
+void TaskSpec::check_keys(std::string_view kind, const std::vector<std::string_view>& keys) const {
+  auto check = [&](const std::string& key) {
+    if (std::find(keys.begin(), keys.end(), key) == keys.end()) {
+      fail(key, "unknown key for a " + type + " " + std::string(kind) + " (known: type, name, " + join_words(keys) + ")");
+    }
+  };
+  for (const auto& [key, value] : numbers) check(key);
+  for (const auto& [key, value] : words) check(key);
+}
+
+std::string join_words(const std::vector<std::string_view>& words) {
+  std::string text;
+  for (std::string_view w : words) text += (text.empty() ? "" : ", ") + std::string(w);
+  return text;
 }
 
 ComplianceRole task_role(const TaskSpec& spec, ComplianceRole fallback) {

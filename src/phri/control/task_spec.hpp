@@ -7,6 +7,7 @@
 #include <phri/model/spatial.hpp>
 
 #include <map>
+#include <string_view>
 #include <optional>
 #include <string>
 #include <vector>
@@ -33,6 +34,12 @@ struct TaskSpec {
   Eigen::Vector3d three(std::string_view key, const Eigen::Vector3d& fallback, double low, double high) const;
   /// A word among `choices`; `fallback` when absent.
   std::string word(std::string_view key, const std::string& fallback, const std::vector<std::string>& choices) const;
+  /// Fails on the first key not among `keys` (besides type and name), e.g. "unknown key for a
+  /// force task (known: ...)"; `kind` is "task" or "constraint".
+  void check_keys(std::string_view kind, const std::vector<std::string_view>& keys) const;
 };
+
+/// "a, b, c": the names listed in error messages.
+std::string join_words(const std::vector<std::string_view>& words);
 
 }  // namespace phri

@@ -139,13 +139,14 @@ Constraint& WholeBodyQp::add_constraint(std::unique_ptr<Constraint> constraint) 
   return *constraints_.back();
 }
 
-Task* WholeBodyQp::find_task(std::string_view name) {
+Task* WholeBodyQp::task_named(std::string_view name) const {
   for (const auto& task : tasks_) {
     if (task->name() == name) return task.get();
   }
   return nullptr;
 }
-const Task* WholeBodyQp::find_task(std::string_view name) const { return const_cast<WholeBodyQp*>(this)->find_task(name); }
+Task* WholeBodyQp::find_task(std::string_view name) { return task_named(name); }
+const Task* WholeBodyQp::find_task(std::string_view name) const { return task_named(name); }
 
 // Objective: 1/2 qdd' H qdd + g' qdd, the sum of the tasks' weighted least squares (factor 2 dropped).
 void WholeBodyQp::assemble_objective() {

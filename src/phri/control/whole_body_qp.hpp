@@ -154,6 +154,7 @@ public:
   const WholeBodyQpSettings& settings() const { return settings_; }
 
 private:
+  Task* task_named(std::string_view name) const;  // both find_task()s
   struct Limits {
     Eigen::VectorXd torque, velocity;  // velocity after the fraction
   };

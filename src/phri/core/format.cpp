@@ -27,6 +27,15 @@ std::string format_fixed(double value, int digits) { return format(true, digits,
 
 std::string format_general(double value, int significant) { return format(false, significant, value); }
 
+std::string format_range(double lower, double upper, int significant) {
+  std::string text = "[";  // appended piece by piece: GCC 12's -Wrestrict misfires on "[" + std::string
+  text += format_general(lower, significant);
+  text += ", ";
+  text += format_general(upper, significant);
+  text += "]";
+  return text;
+}
+
 std::optional<double> parse_number(const std::string& text) {
   std::size_t used = 0;
   double value = 0.0;

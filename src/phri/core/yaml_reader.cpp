@@ -16,10 +16,6 @@ namespace {
 // Significant digits of the numbers in error messages.
 constexpr int kMessageDigits = 10;
 
-std::string range_text(double min, double max) {
-  return "[" + format_general(min, kMessageDigits) + ", " + format_general(max, kMessageDigits) + "]";
-}
-
 std::string child_path(const std::string& path, const std::string& key) { return path.empty() ? key : path + "." + key; }
 
 // Bounds of a document's walk. yaml-cpp shares an aliased node instead of copying it, so a few
@@ -205,7 +201,7 @@ double YamlReader::as_number(double min, double max) const {
   }
   if (!std::isfinite(value)) throw error("", "must be finite, got '" + node_.Scalar() + "'");
   if (value < min || value > max) {
-    throw error("", "must be in " + range_text(min, max) + ", got " + format_general(value, kMessageDigits));
+    throw error("", "must be in " + format_range(min, max, kMessageDigits) + ", got " + format_general(value, kMessageDigits));
   }
   return value;
 }
