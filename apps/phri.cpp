@@ -13,6 +13,7 @@
 //   phri experiment drop-test [options]        30 + 30 drops, torque vs position mode
 //   phri experiment dynamic-tracking [options] the dynamic scenario with the four low-level loops
 //   phri experiment dual-compliance [options]  guiding the end effector by hand, release, drift
+//   phri experiment iso9283 [options]          ISO 9283 pose accuracy and repeatability per loop
 //   phri evaluate [--out DIR] [--quick]        all five of the paper's evaluations and report.md/.html
 //   phri experiment dashboard-load [options]   loop cycle time with vs without the dashboard and its clients
 //   phri ft-monitor [--device DEV | --emulate] the Bota F/T sensor's wrench and counters (apps/ft_monitor.cpp)
@@ -44,6 +45,7 @@
 #include <phri/dashboard/dashboard_server.hpp>
 #include <phri/experiments/experiment_files.hpp>
 #include <phri/experiments/friction_identification.hpp>
+#include <phri/experiments/iso9283.hpp>
 #include <phri/experiments/safety_fuzz.hpp>
 #include <phri/experiments/torque_tracking.hpp>
 #include <phri/experiments/torque_tracking_sweep.hpp>
@@ -672,6 +674,55 @@ int dual_compliance_command(phri::DualComplianceOptions d) {
   return phri::run_dual_compliance_command(d, std::cout);
 }
 
+const CLI::App* add_dynamic_tracking_command(CLI::App& experiment, phri::TorqueTrackingOptions& options) {
+  auto* dynamic = experiment.add_subcommand("dynamic-tracking", "The dynamic scenario: position, custom, Kinova torque loops");
+  dynamic->add_option("--out", options.output_dir, "output folder")->capture_default_str();
+  dynamic->add_option("--duration", options.dynamic_duration_s, "after the switch [s]")
+      ->check(CLI::Range(1.0, 600.0))
+      ->capture_default_str();
+  return dynamic;
+}
+
+struct Iso9283Arguments {
+  phri::Iso9283Options options;
+  std::vector<std::string> loops;
+};
+
+const CLI::App* add_iso9283_command(CLI::App& experiment, Iso9283Arguments& args) {
+  auto* iso = experiment.add_subcommand("iso9283", "ISO 9283 pose accuracy and repeatability (AP, RP) per low-level loop");
+  iso->add_option("--out", args.options.output_dir, "output folder")->capture_default_str();
+  iso->add_option("--cycles", args.options.cycles, "cycles through the five poses (the standard: 30)")
+      ->check(CLI::Range(2, 1000))
+      ->capture_default_str();
+  iso->add_option("--loops", args.loops, "loops to measure (default: position custom kinova_torque_high_velocity kinova_torque)")
+      ->check(CLI::IsMember({"position", "custom", "kinova_torque", "kinova_torque_high_velocity"}));
+  iso->add_option("--dwell", args.options.dwell_s, "wait at each pose before it is taken [s]")
+      ->check(CLI::Range(0.2, 10.0))
+      ->capture_default_str();
+  iso->add_option("--speed", args.options.max_speed_m_s, "peak speed of the moves [m/s]")
+      ->check(CLI::Range(0.01, 1.0))
+      ->capture_default_str();
+  iso->add_option("--bands", args.options.bands_mm, "the tight and the coarse stabilisation band [mm]")
+      ->check(CLI::Range(0.001, 10.0))
+      ->capture_default_str();
+  iso->add_option("--seed", args.options.seed, "plant seed (model mismatch, noise)")->capture_default_str();
+  iso->add_option("--jobs", args.options.jobs, "threads (one loop each)")->check(CLI::Range(1, 64))->capture_default_str();
+  return iso;
+}
+
+int iso9283_command(Iso9283Arguments args) {
+  phri::Iso9283Options& o = args.options;
+  for (std::string* path : {&o.plant_config_path, &o.urdf_path, &o.actuators_path, &o.collision_path, &o.figure_script}) {
+    *path = locate(*path);
+  }
+  if (!args.loops.empty()) {
+    o.loops.clear();
+    for (const std::string& name : args.loops) o.loops.push_back(*phri::low_level_mode_from_string(name));
+  }
+  phri::ensure_output_directory(o.output_dir);
+  return phri::run_iso9283_command(o, std::cout);
+}
+
 // `phri evaluate`: the files are found from the working directory, else from the source tree.
 int evaluate_command(phri::EvaluationOptions e) {
   const std::string probe = locate("configs/plant_gen3.yaml");
@@ -797,13 +848,11 @@ int main(int argc, char** argv) {
   friction_alias->add_option("--out", friction.output_dir, "output folder");
   friction_alias->add_option("--seed", friction.seed, "seed");
   const CLI::App* drop = add_drop_test_command(*experiment, drop_args);
-  auto* dynamic = experiment->add_subcommand("dynamic-tracking", "The dynamic scenario: position, custom, Kinova torque loops");
-  dynamic->add_option("--out", dynamic_options.output_dir, "output folder")->capture_default_str();
-  dynamic->add_option("--duration", dynamic_options.dynamic_duration_s, "after the switch [s]")
-      ->check(CLI::Range(1.0, 600.0))
-      ->capture_default_str();
+  const CLI::App* dynamic = add_dynamic_tracking_command(*experiment, dynamic_options);
   auto* dual = experiment->add_subcommand("dual-compliance", "Guide the end effector by hand in dual compliance, release");
   dual->add_option("--out", dual_options.output_dir, "output folder")->capture_default_str();
+  Iso9283Arguments iso_args;
+  const CLI::App* iso = add_iso9283_command(*experiment, iso_args);
   auto* evaluate = app.add_subcommand("evaluate", "The paper's five evaluations and a report (report.md, report.html)");
   evaluate->add_option("--out", evaluation.output_dir, "output folder")->capture_default_str();
   evaluate->add_flag("--quick", evaluation.quick, "short protocols (a smoke test; not the paper's numbers)");
@@ -832,6 +881,7 @@ int main(int argc, char** argv) {
     if (drop->parsed()) return drop_test_command(drop_args);
     if (dynamic->parsed()) return dynamic_tracking_command(dynamic_options);
     if (dual->parsed()) return dual_compliance_command(dual_options);
+    if (iso->parsed()) return iso9283_command(iso_args);
     if (evaluate->parsed()) return evaluate_command(evaluation);
     if (load->parsed()) {
       load_args.config_path = locate(load_args.config_path);
