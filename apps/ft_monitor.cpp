@@ -1,5 +1,7 @@
 #include "ft_monitor.hpp"
 
+#include "exit_status.hpp"
+
 #include <phri/hardware/bota_emulator.hpp>
 #include <phri/hardware/bota_sens_one.hpp>
 
@@ -100,7 +102,7 @@ int ft_monitor_command(const FtMonitorArguments& args) {
   // A monitor that never heard the sensor has not monitored it: say so in the exit status too.
   if (sensor.counters().decoder.frames_ok == 0) {
     std::printf("phri ft-monitor: no valid frame from %s\n", settings.device.c_str());
-    return 1;
+    return phri::cli::kChecksFailed;
   }
-  return 0;
+  return phri::cli::kOk;
 }

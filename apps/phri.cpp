@@ -22,6 +22,7 @@
 // `phri run` exits 0, 3 after a safe hold, and 128 + the signal's number (130 SIGINT, 143 SIGTERM)
 // when a signal ended it early: the run then stops as if its duration had run out, and the log,
 // summary.md and figure are still written (a second signal kills as usual).
+#include "exit_status.hpp"
 #include "ft_monitor.hpp"
 #include "kortex_backend.hpp"
 
@@ -252,11 +253,11 @@ private:
 
 // 128 + the signal's number when one ended the run (said on stderr), 3 after a safe hold, else 0.
 int run_exit_status(const phri::RunSummary& summary, double duration_s) {
-  if (!summary.interrupted) return summary.safe_hold ? 3 : 0;
+  if (!summary.interrupted) return summary.safe_hold ? phri::cli::kSafetyStop : phri::cli::kOk;
   const int signal = g_stop_signal.load();
   std::fprintf(stderr, "phri: interrupted by %s after %.3f s of the %.1f s run; it ended there, its files written\n",
                signal == SIGINT ? "SIGINT" : "SIGTERM", summary.simulated_s, duration_s);
-  return 128 + signal;
+  return phri::cli::kSignalBase + signal;
 }
 
 struct RunArguments {
@@ -796,7 +797,7 @@ std::string command_word_error(CLI::App& app, int argc, char** argv) {
 
 // One line whatever the message: a library's multi-line text (every phri error is one line
 // already) is joined with "; ".
-int print_error(const char* what) {
+int print_error(const char* what, int status = phri::cli::kBadInput) {
   std::string line;
   for (const char* c = what; *c != '\0'; ++c) {
     if (*c != '\n' && *c != '\r') {
@@ -806,7 +807,7 @@ int print_error(const char* what) {
     }
   }
   std::fprintf(stderr, "phri: error: %s\n", line.c_str());
-  return 2;
+  return status;
 }
 
 // Progress lines reach a pipe as they are printed, not at exit (std::cout writes through stdout:
@@ -868,7 +869,7 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     // --help and --version exit 0; every refusal 2, as phri's own (CLI11 has a code per kind).
-    return app.exit(e) == 0 ? 0 : 2;
+    return app.exit(e) == 0 ? phri::cli::kOk : phri::cli::kBadInput;
   }
   try {
     if (run->parsed()) return run_command(run_args);
@@ -888,10 +889,14 @@ int main(int argc, char** argv) {
       load_args.web_root = dashboard_web_root(load_args.web_root);
       return phri::run_dashboard_load_command(load_args, std::cout);
     }
-  } catch (const phri::Error& e) {
+  } catch (const phri::IoError& e) {
+    return print_error(e.what(), phri::cli::kSystemError);
+  } catch (const phri::ExperimentError& e) {
+    return print_error(e.what(), phri::cli::kSystemError);
+  } catch (const phri::Error& e) {  // ConfigError, ArgumentError: the input
     return print_error(e.what());
   } catch (const std::exception& e) {  // from a library below (yaml-cpp, the standard library)
-    return print_error(e.what());
+    return print_error(e.what(), phri::cli::kSystemError);
   }
   return 0;
 }

@@ -1,5 +1,6 @@
 # Runs a command line that must be refused, and checks how (ctest: tests/CMakeLists.txt, cli_rejects_*):
-#   * the exit status is a non-zero number (a crash, reported by CMake as text, is not a refusal);
+#   * the exit status is a non-zero number (a crash, reported by CMake as text, is not a refusal),
+#     STATUS when it is given (2 bad input, 4 the system refused: docs/configuration.md);
 #   * nothing on standard output;
 #   * exactly one line on standard error, "phri: error: ...", containing every fragment of MENTIONS
 #     (literal text, separated by '|'), e.g. the missing file's path or the bad option.
@@ -32,6 +33,9 @@ if(NOT status MATCHES "^[0-9]+$")
 endif()
 if(status EQUAL 0)
   message(FATAL_ERROR "exit status 0 for a command line that must be refused\n${report}")
+endif()
+if(DEFINED STATUS AND NOT status EQUAL STATUS)
+  message(FATAL_ERROR "exit status ${status}, expected ${STATUS} (docs/configuration.md, exit statuses)\n${report}")
 endif()
 if(NOT out STREQUAL "")
   message(FATAL_ERROR "output on stdout; the refusal must be one line on stderr only\n${report}")
