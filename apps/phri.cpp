@@ -889,9 +889,7 @@ int main(int argc, char** argv) {
       load_args.web_root = dashboard_web_root(load_args.web_root);
       return phri::run_dashboard_load_command(load_args, std::cout);
     }
-  } catch (const phri::IoError& e) {
-    return print_error(e.what(), phri::cli::kSystemError);
-  } catch (const phri::ExperimentError& e) {
+  } catch (const phri::SubjectError& e) {  // IoError, ExperimentError: the system refused
     return print_error(e.what(), phri::cli::kSystemError);
   } catch (const phri::Error& e) {  // ConfigError, ArgumentError: the input
     return print_error(e.what());

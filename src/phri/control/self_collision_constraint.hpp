@@ -63,17 +63,27 @@ public:
     return true;
   }
 
-  /// Distances at the current state (data: after the model terms), then one row per pair.
+  /// Distances at the current state (data: after the model terms), then one row per pair. A pair
+  /// beyond the influence distance whose braking row is left out bounds nothing (-inf <= row):
+  /// its row is zero and its Jacobian is not computed (the broad phase; the QP is the same).
   template <class Rows, class Bound>
   void rows(const Model& model, const Data& data, Rows&& a, Bound&& l, Bound&& u) {
-    compute_collision_distances(model, data, *collision_, data_, true);
+    compute_collision_distance_rates(model, data, *collision_, data_);
     constexpr double kInf = std::numeric_limits<double>::infinity();
     braking_binds_ = false;
     for (int p = 0; p < num_rows(); ++p) {
-      a.row(p) = data_.jacobian.row(p);
       u[p] = kInf;
       const double d = data_.distance[p];
       const double d_dot = data_.velocity[p];
+      if (d >= influence_distance_ && collision_braking_bound(d, d_dot, safety_distance_, braking_) == -kInf) {
+        a.row(p).setZero();
+        data_.jacobian.row(p).setZero();
+        data_.jdot_qdot[p] = 0.0;
+        l[p] = damper_lower_[p] = -kInf;
+        continue;
+      }
+      compute_collision_pair_derivatives(model, data, *collision_, p, data_);
+      a.row(p) = data_.jacobian.row(p);
       damper_lower_[p] = (d < influence_distance_ ? damper_.min_acceleration(d, d_dot) : -kInf) - data_.jdot_qdot[p];
       const double braking = collision_braking_bound(d, d_dot, safety_distance_, braking_) - data_.jdot_qdot[p];
       braking_binds_ = braking_binds_ || braking > damper_lower_[p];

@@ -103,6 +103,8 @@ CollisionData::CollisionData(const Model& model, const CollisionModel& collision
       jacobian(Eigen::MatrixXd::Zero(collision.num_pairs(), model.nv())),
       jdot_qdot(Eigen::VectorXd::Zero(collision.num_pairs())),
       velocity(Eigen::VectorXd::Zero(collision.num_pairs())),
+      s(Eigen::VectorXd::Zero(collision.num_pairs())),
+      t(Eigen::VectorXd::Zero(collision.num_pairs())),
       scratch_first(Eigen::MatrixXd::Zero(3, model.nv())),
       scratch_second(Eigen::MatrixXd::Zero(3, model.nv())) {}
 
@@ -112,70 +114,107 @@ const Eigen::Isometry3d& placement_of(const Model& model, const Data& data, int 
 }
 }  // namespace
 
+namespace {
+const Eigen::Vector3d kZero = Eigen::Vector3d::Zero();
+
+// The end points of a capsule's axis in the world.
+std::pair<Eigen::Vector3d, Eigen::Vector3d> axis_of(const Model& model, const Data& data, const Capsule& c) {
+  const Eigen::Isometry3d& placement = placement_of(model, data, c.body);
+  return {placement * c.p0, placement * c.p1};
+}
+
+// Distance, closest points and normal of pair k; with_rate: its velocity too.
+void pair_distance(const Model& model, const Data& data, const CollisionModel& collision, int k, bool with_rate,
+                   CollisionData& out) {
+  const CapsulePair& pair = collision.pairs()[static_cast<std::size_t>(k)];
+  const Capsule& a = collision.capsules()[static_cast<std::size_t>(pair.first)];
+  const Capsule& b = collision.capsules()[static_cast<std::size_t>(pair.second)];
+  const auto [a0, a1] = axis_of(model, data, a);
+  const auto [b0, b1] = axis_of(model, data, b);
+  const SegmentClosestPoints closest = closest_points_between_segments(a0, a1, b0, b1);
+  const Eigen::Vector3d gap = closest.on_first - closest.on_second;
+  const double axis_distance = gap.norm();
+  Eigen::Vector3d n;
+  if (axis_distance > 1e-9) {
+    n = gap / axis_distance;
+  } else {
+    // Axes intersect (deep penetration): any direction normal to both axes separates them.
+    n = (a1 - a0).cross(b1 - b0);
+    if (n.norm() < 1e-12) n = (a1 - a0).unitOrthogonal();
+    n.normalize();
+  }
+  out.distance[k] = axis_distance - a.radius - b.radius;
+  out.point_first.col(k) = closest.on_first;
+  out.point_second.col(k) = closest.on_second;
+  out.normal.col(k) = n;
+  out.s[k] = closest.s;
+  out.t[k] = closest.t;
+  if (!with_rate) return;
+  // d = n.(p_a - p_b) changes at n.(v_a - v_b), with v the velocities of the body-fixed points
+  // now at the closest points (envelope theorem).
+  out.velocity[k] = n.dot(body_point_velocity(model, data, a.body, closest.on_first) -
+                          body_point_velocity(model, data, b.body, closest.on_second));
+}
+}  // namespace
+
+void compute_collision_distance_rates(const Model& model, const Data& data, const CollisionModel& collision,
+                                      CollisionData& out) {
+  for (int k = 0; k < collision.num_pairs(); ++k) pair_distance(model, data, collision, k, true, out);
+}
+
 void compute_collision_distances(const Model& model, const Data& data, const CollisionModel& collision,
                                  CollisionData& out, bool with_derivatives) {
   for (int k = 0; k < collision.num_pairs(); ++k) {
-    const CapsulePair& pair = collision.pairs()[static_cast<std::size_t>(k)];
-    const Capsule& a = collision.capsules()[static_cast<std::size_t>(pair.first)];
-    const Capsule& b = collision.capsules()[static_cast<std::size_t>(pair.second)];
-    const Eigen::Isometry3d& pa = placement_of(model, data, a.body);
-    const Eigen::Isometry3d& pb = placement_of(model, data, b.body);
-    const Eigen::Vector3d a0 = pa * a.p0, a1 = pa * a.p1, b0 = pb * b.p0, b1 = pb * b.p1;
-    const SegmentClosestPoints closest = closest_points_between_segments(a0, a1, b0, b1);
-    const Eigen::Vector3d gap = closest.on_first - closest.on_second;
-    const double axis_distance = gap.norm();
-    Eigen::Vector3d n;
-    if (axis_distance > 1e-9) {
-      n = gap / axis_distance;
-    } else {
-      // Axes intersect (deep penetration): any direction normal to both axes separates them.
-      n = (a1 - a0).cross(b1 - b0);
-      if (n.norm() < 1e-12) n = (a1 - a0).unitOrthogonal();
-      n.normalize();
-    }
-    out.distance[k] = axis_distance - a.radius - b.radius;
-    out.point_first.col(k) = closest.on_first;
-    out.point_second.col(k) = closest.on_second;
-    out.normal.col(k) = n;
-    if (!with_derivatives) continue;
-    // d = n.(p_a - p_b) changes at n.(v_a - v_b), with v the velocities of the body-fixed points
-    // now at the closest points (envelope theorem): that gives the distance Jacobian.
-    body_point_linear_jacobian(model, data, a.body, closest.on_first, out.scratch_first);
-    body_point_linear_jacobian(model, data, b.body, closest.on_second, out.scratch_second);
-    out.jacobian.row(k).noalias() = n.transpose() * (out.scratch_first - out.scratch_second);
-    const Eigen::Vector3d relative_velocity = body_point_velocity(model, data, a.body, closest.on_first) -
-                                              body_point_velocity(model, data, b.body, closest.on_second);
-    out.velocity[k] = n.dot(relative_velocity);
-    // Second derivative: the closest points also slide along the axes (s', t'), found by
-    // differentiating the optimality conditions gap.u_a = 0 (s free) and gap.u_b = 0 (t free).
-    const Eigen::Vector3d u_a = a1 - a0, u_b = b1 - b0;
-    const Eigen::Vector3d w_a = a.body < 0 ? Eigen::Vector3d::Zero() : Eigen::Vector3d(data.body_velocities.col(a.body).tail<3>());
-    const Eigen::Vector3d w_b = b.body < 0 ? Eigen::Vector3d::Zero() : Eigen::Vector3d(data.body_velocities.col(b.body).tail<3>());
-    const bool s_free = closest.s > 0.0 && closest.s < 1.0 && u_a.squaredNorm() > 1e-18;
-    const bool t_free = closest.t > 0.0 && closest.t < 1.0 && u_b.squaredNorm() > 1e-18;
-    const double r_a = -relative_velocity.dot(u_a) - gap.dot(w_a.cross(u_a));
-    const double r_b = -relative_velocity.dot(u_b) - gap.dot(w_b.cross(u_b));
-    double s_rate = 0.0, t_rate = 0.0;
-    if (s_free && t_free) {
-      const double uaua = u_a.squaredNorm(), uaub = u_a.dot(u_b), ubub = u_b.squaredNorm();
-      const double det = uaub * uaub - uaua * ubub;  // zero for parallel axes: closest points not unique
-      if (std::abs(det) > 1e-9 * uaua * ubub) {
-        s_rate = (-ubub * r_a + uaub * r_b) / det;
-        t_rate = (-uaub * r_a + uaua * r_b) / det;
-      }
-    } else if (s_free) {
-      s_rate = r_a / u_a.squaredNorm();
-    } else if (t_free) {
-      t_rate = -r_b / u_b.squaredNorm();
-    }
-    const Eigen::Vector3d relative_bias = body_point_jdot_qdot(model, data, a.body, closest.on_first) -
-                                          body_point_jdot_qdot(model, data, b.body, closest.on_second) +
-                                          w_a.cross(s_rate * u_a) - w_b.cross(t_rate * u_b);
-    const Eigen::Vector3d gap_rate = relative_velocity + s_rate * u_a - t_rate * u_b;
-    const Eigen::Vector3d tangential = gap_rate - n * n.dot(gap_rate);  // rotation of n
-    out.jdot_qdot[k] = n.dot(relative_bias) +
-                       (axis_distance > 1e-9 ? tangential.dot(relative_velocity) / axis_distance : 0.0);
+    pair_distance(model, data, collision, k, with_derivatives, out);
+    if (with_derivatives) compute_collision_pair_derivatives(model, data, collision, k, out);
   }
+}
+
+void compute_collision_pair_derivatives(const Model& model, const Data& data, const CollisionModel& collision, int k,
+                                        CollisionData& out) {
+  const CapsulePair& pair = collision.pairs()[static_cast<std::size_t>(k)];
+  const Capsule& a = collision.capsules()[static_cast<std::size_t>(pair.first)];
+  const Capsule& b = collision.capsules()[static_cast<std::size_t>(pair.second)];
+  const auto [a0, a1] = axis_of(model, data, a);
+  const auto [b0, b1] = axis_of(model, data, b);
+  const Eigen::Vector3d on_first = out.point_first.col(k), on_second = out.point_second.col(k);
+  const Eigen::Vector3d n = out.normal.col(k);
+  const Eigen::Vector3d gap = on_first - on_second;
+  const double axis_distance = gap.norm();
+  // The distance Jacobian: n^T (J_a - J_b) at the closest points.
+  body_point_linear_jacobian(model, data, a.body, on_first, out.scratch_first);
+  body_point_linear_jacobian(model, data, b.body, on_second, out.scratch_second);
+  out.jacobian.row(k).noalias() = n.transpose() * (out.scratch_first - out.scratch_second);
+  const Eigen::Vector3d relative_velocity =
+      body_point_velocity(model, data, a.body, on_first) - body_point_velocity(model, data, b.body, on_second);
+  // Second derivative: the closest points also slide along the axes (s', t'), found by
+  // differentiating the optimality conditions gap.u_a = 0 (s free) and gap.u_b = 0 (t free).
+  const Eigen::Vector3d u_a = a1 - a0, u_b = b1 - b0;
+  const Eigen::Vector3d w_a = a.body < 0 ? kZero : Eigen::Vector3d(data.body_velocities.col(a.body).tail<3>());
+  const Eigen::Vector3d w_b = b.body < 0 ? kZero : Eigen::Vector3d(data.body_velocities.col(b.body).tail<3>());
+  const bool s_free = out.s[k] > 0.0 && out.s[k] < 1.0 && u_a.squaredNorm() > 1e-18;
+  const bool t_free = out.t[k] > 0.0 && out.t[k] < 1.0 && u_b.squaredNorm() > 1e-18;
+  const double r_a = -relative_velocity.dot(u_a) - gap.dot(w_a.cross(u_a));
+  const double r_b = -relative_velocity.dot(u_b) - gap.dot(w_b.cross(u_b));
+  double s_rate = 0.0, t_rate = 0.0;
+  if (s_free && t_free) {
+    const double uaua = u_a.squaredNorm(), uaub = u_a.dot(u_b), ubub = u_b.squaredNorm();
+    const double det = uaub * uaub - uaua * ubub;  // zero for parallel axes: closest points not unique
+    if (std::abs(det) > 1e-9 * uaua * ubub) {
+      s_rate = (-ubub * r_a + uaub * r_b) / det;
+      t_rate = (-uaub * r_a + uaua * r_b) / det;
+    }
+  } else if (s_free) {
+    s_rate = r_a / u_a.squaredNorm();
+  } else if (t_free) {
+    t_rate = -r_b / u_b.squaredNorm();
+  }
+  const Eigen::Vector3d relative_bias = body_point_jdot_qdot(model, data, a.body, on_first) -
+                                        body_point_jdot_qdot(model, data, b.body, on_second) +
+                                        w_a.cross(s_rate * u_a) - w_b.cross(t_rate * u_b);
+  const Eigen::Vector3d gap_rate = relative_velocity + s_rate * u_a - t_rate * u_b;
+  const Eigen::Vector3d tangential = gap_rate - n * n.dot(gap_rate);  // rotation of n
+  out.jdot_qdot[k] = n.dot(relative_bias) + (axis_distance > 1e-9 ? tangential.dot(relative_velocity) / axis_distance : 0.0);
 }
 
 }  // namespace phri

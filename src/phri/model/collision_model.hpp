@@ -54,6 +54,7 @@ struct CollisionData {
   Eigen::MatrixXd jacobian;        ///< pairs x nv: d(distance)/dt = jacobian * qd
   Eigen::VectorXd jdot_qdot;       ///< d2(distance)/dt2 = jacobian * qdd + jdot_qdot
   Eigen::VectorXd velocity;        ///< d(distance)/dt
+  Eigen::VectorXd s, t;            ///< where the closest points are along each axis, in [0, 1]
   Eigen::MatrixXd scratch_first;   ///< 3 x nv point Jacobians (workspace)
   Eigen::MatrixXd scratch_second;
 };
@@ -63,5 +64,13 @@ struct CollisionData {
 /// the distance Jacobian, its J̇q̇ and the distance velocity.
 void compute_collision_distances(const Model& model, const Data& data, const CollisionModel& collision,
                                  CollisionData& out, bool with_derivatives);
+/// Distances and their rates of every pair (requires velocities), without the Jacobians: the
+/// broad phase of a constraint that needs the Jacobian of the pairs near their limit only.
+void compute_collision_distance_rates(const Model& model, const Data& data, const CollisionModel& collision,
+                                      CollisionData& out);
+/// The distance Jacobian and J̇q̇ of pair k (requires drift accelerations), after
+/// compute_collision_distance_rates (or compute_collision_distances) of the same state.
+void compute_collision_pair_derivatives(const Model& model, const Data& data, const CollisionModel& collision, int k,
+                                        CollisionData& out);
 
 }  // namespace phri
