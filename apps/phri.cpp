@@ -2,6 +2,7 @@
 //   phri run --config FILE [--robot DIR] [--lockstep|--realtime] [--duration S] [--out DIR]
 //            [--dashboard [--port P] [--bind ADDR] [--push-max N]]
 //            [--backend sim|kortex|kortex-emulator [--ip ADDR] [--ft-serial DEV] [--dry-run]]
+//            [--ros2 [--ros-domain N] [--ros-namespace NS]]  (ros2_cli.cpp, docs/ros2.md)
 //                                              a session: simulated arm (or the Gen3 through the
 //                                              Kortex backend, kortex_backend.cpp), FSM, gamepad,
 //                                              log, figure, and the live dashboard in a browser
@@ -23,6 +24,7 @@
 // summary.md and figure are still written (a second signal kills as usual).
 #include "ft_monitor.hpp"
 #include "kortex_backend.hpp"
+#include "ros2_cli.hpp"
 
 #include <phri/app/sim_backend.hpp>
 #include <phri/app/loop_clock.hpp>
@@ -267,6 +269,7 @@ struct RunArguments {
   std::string out_dir = "out";
   bool figure = true;
   KortexArguments kortex;
+  Ros2Arguments ros2;
 };
 
 // The generated plant's warnings (none for a hand-written MJCF).
@@ -303,6 +306,7 @@ int run_command(const RunArguments& args) {
   if (args.lockstep) config.run.pacing = phri::LoopClock::Pacing::kLockstep;
   if (args.real_time) config.run.pacing = phri::LoopClock::Pacing::kRealTime;
   if (args.duration_s > 0.0) config.run.duration_s = args.duration_s;
+  apply_ros2_arguments(args.ros2, config.ros2);
   phri::ensure_output_directory(args.out_dir);
   const std::filesystem::path out(args.out_dir);
   config.logging.path = (out / std::filesystem::path(config.logging.path).filename()).string();
@@ -355,10 +359,13 @@ int run_command(const RunArguments& args) {
   options.real_time = config.run.pacing == phri::LoopClock::Pacing::kRealTime;
   options.phases.push_back({0.0, "startup"});
   for (const phri::TimedEvent& e : config.fsm.timeline) options.phases.push_back({e.time_s, std::string(phri::to_string(e.event))});
+  std::unique_ptr<Ros2Run> ros2;
+  if (config.ros2.enabled) ros2 = std::make_unique<Ros2Run>(config.ros2, cycle, options, std::cout);
   const phri::RunSummary summary = phri::run_session(robot, cycle, fsm, gamepad.get(), logger ? &*logger : nullptr, options, std::cout);
   if (gamepad) gamepad->stop();
   if (dashboard) dashboard->stop();
   std::printf("\n");
+  if (ros2) ros2->finish(std::cout);
   if (const std::string report = backend->report(); !report.empty()) std::printf("%s\n", report.c_str());
   phri::print_run_summary(summary, std::cout);
   std::ostringstream md;
@@ -449,6 +456,7 @@ CLI::App* add_run_command(CLI::App& app, RunArguments& args) {
       ->check(CLI::Range(1.0, 1000.0))->needs(dashboard)->capture_default_str();
   run->add_option("--web-root", args.dashboard.web_root, "folder of the dashboard's page (default: web/)")
       ->needs(dashboard)->check(CLI::ExistingDirectory);
+  add_ros2_options(*run, args.ros2);
   return run;
 }
 

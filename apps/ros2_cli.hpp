@@ -1,0 +1,38 @@
+#pragma once
+// `phri run --ros2 [--ros-domain N] [--ros-namespace NS]`: the ROS 2 bridge (src/phri/ros2/,
+// docs/ros2.md) as one observer and one input of the run, when phri is built with it
+// (PHRI_BUILD_ROS2, on when Cyclone DDS is found).
+#include <phri/app/run_session.hpp>
+#include <phri/config/ros2_settings.hpp>
+#include <phri/control/controller.hpp>
+
+#include <CLI/CLI.hpp>
+
+#include <iosfwd>
+#include <memory>
+#include <string>
+
+struct Ros2Arguments {
+  bool enabled = false;
+  int domain = -1;              ///< -1: the configuration's (else ROS_DOMAIN_ID, else 0)
+  std::string topic_namespace;  ///< empty: the configuration's
+};
+
+void add_ros2_options(CLI::App& run, Ros2Arguments& args);
+/// The command line over the run YAML's `ros2:` (a bad namespace: phri::ConfigError).
+void apply_ros2_arguments(const Ros2Arguments& args, phri::Ros2Settings& settings);
+
+/// The bridge of one run: started here (its topics printed), its observer and input added to
+/// `options`; finish() stops it and prints what it published and refused.
+class Ros2Run {
+public:
+  Ros2Run(const phri::Ros2Settings& settings, const phri::Controller& cycle, phri::RunOptions& options, std::ostream& out);
+  ~Ros2Run();
+  Ros2Run(const Ros2Run&) = delete;
+  Ros2Run& operator=(const Ros2Run&) = delete;
+  void finish(std::ostream& out);
+
+private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
