@@ -16,12 +16,15 @@
 //   phri experiment dual-compliance [options]  guiding the end effector by hand, release, drift
 //   phri evaluate [--out DIR] [--quick]        all five of the paper's evaluations and report.md/.html
 //   phri experiment dashboard-load [options]   loop cycle time with vs without the dashboard and its clients
+//   phri experiment ros2-load [options]        loop cycle time with vs without the ROS 2 bridge, F/T round trip (ros2_cli.cpp)
 //   phri ft-monitor [--device DEV | --emulate] the Bota F/T sensor's wrench and counters (apps/ft_monitor.cpp)
+//   phri ft-bridge [--device DEV | --emulate] the Bota F/T sensor published on ROS 2 /phri/ft_in (apps/ft_bridge.cpp)
 // Every bad argument or file, and every failure of a run or an experiment (phri::Error: ConfigError,
 // IoError, ExperimentError), gives one line on stderr naming what is wrong and exit status 2.
 // `phri run` exits 0, 3 after a safe hold, and 128 + the signal's number (130 SIGINT, 143 SIGTERM)
 // when a signal ended it early: the run then stops as if its duration had run out, and the log,
 // summary.md and figure are still written (a second signal kills as usual).
+#include "ft_bridge.hpp"
 #include "ft_monitor.hpp"
 #include "kortex_backend.hpp"
 #include "ros2_cli.hpp"
@@ -318,6 +321,10 @@ int run_command(const RunArguments& args) {
   const bool real_arm = args.kortex.backend == "kortex";
   if (real_arm && args.lockstep) throw phri::ConfigError("--lockstep", "", "the real arm runs in real time (--backend kortex)");
   if (real_arm) config.run.pacing = phri::LoopClock::Pacing::kRealTime;
+  if (config.ros2.enabled && config.ros2.ft_in && config.run.pacing == phri::LoopClock::Pacing::kLockstep) {
+    throw phri::ConfigError("ros2.ft_in", "", "the F/T sensor from /ft_in needs real-time pacing (--realtime): in lockstep "
+                                              "robot time outruns its samples");
+  }
   phri::Controller cycle(config.controller);
   // What the URDF loader and the plant generator accepted but the user should know (one line each,
   // naming the link): odd inertias, a base inertial ignored, inertias MuJoCo balanced.
@@ -361,7 +368,8 @@ int run_command(const RunArguments& args) {
   for (const phri::TimedEvent& e : config.fsm.timeline) options.phases.push_back({e.time_s, std::string(phri::to_string(e.event))});
   std::unique_ptr<Ros2Run> ros2;
   if (config.ros2.enabled) ros2 = std::make_unique<Ros2Run>(config.ros2, cycle, options, std::cout);
-  const phri::RunSummary summary = phri::run_session(robot, cycle, fsm, gamepad.get(), logger ? &*logger : nullptr, options, std::cout);
+  phri::RobotInterface& driven = ros2 ? ros2->robot(robot) : robot;
+  const phri::RunSummary summary = phri::run_session(driven, cycle, fsm, gamepad.get(), logger ? &*logger : nullptr, options, std::cout);
   if (gamepad) gamepad->stop();
   if (dashboard) dashboard->stop();
   std::printf("\n");
@@ -801,6 +809,8 @@ int main(int argc, char** argv) {
   const CLI::App* tracking = add_torque_tracking_command(*experiment, tracking_args);
   const CLI::App* fuzz = add_safety_fuzz_command(*experiment, fuzz_args);
   const CLI::App* load = add_dashboard_load_command(*experiment, load_args);
+  Ros2LoadArguments ros2_load_args;
+  const CLI::App* ros2_load = add_ros2_load_command(*experiment, ros2_load_args);
   auto* friction_alias = experiment->add_subcommand("friction-identification", "Same as 'phri identify-friction'");
   friction_alias->add_option("--out", friction.output_dir, "output folder");
   friction_alias->add_option("--seed", friction.seed, "seed");
@@ -820,6 +830,8 @@ int main(int argc, char** argv) {
   const CLI::App* fit_collision = add_fit_collision_command(app, fit_args);
   FtMonitorArguments ft_args;
   const CLI::App* ft_monitor = add_ft_monitor_command(app, ft_args);
+  FtBridgeArguments ft_bridge_args;
+  const CLI::App* ft_bridge = add_ft_bridge_command(app, ft_bridge_args);
 
   add_shared_checks(app);
   if (const std::string error = command_word_error(app, argc, argv); !error.empty()) return print_error(error.c_str());
@@ -834,6 +846,8 @@ int main(int argc, char** argv) {
     if (info->parsed()) return info_command(info_args);
     if (fit_collision->parsed()) return fit_collision_command(fit_args);
     if (ft_monitor->parsed()) return ft_monitor_command(ft_args);
+    if (ft_bridge->parsed()) return ft_bridge_command(ft_bridge_args);
+    if (ros2_load->parsed()) return ros2_load_command(ros2_load_args);
     if (identify->parsed() || friction_alias->parsed()) return friction_identification_command(friction);
     if (tracking->parsed()) return torque_tracking_command(tracking_args);
     if (fuzz->parsed()) return safety_fuzz_command(fuzz_args);

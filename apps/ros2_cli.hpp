@@ -5,6 +5,7 @@
 #include <phri/app/run_session.hpp>
 #include <phri/config/ros2_settings.hpp>
 #include <phri/control/controller.hpp>
+#include <phri/robot/robot_interface.hpp>
 
 #include <CLI/CLI.hpp>
 
@@ -16,11 +17,23 @@ struct Ros2Arguments {
   bool enabled = false;
   int domain = -1;              ///< -1: the configuration's (else ROS_DOMAIN_ID, else 0)
   std::string topic_namespace;  ///< empty: the configuration's
+  bool ft_in = false;           ///< the F/T sensor from <namespace>/ft_in
 };
 
 void add_ros2_options(CLI::App& run, Ros2Arguments& args);
 /// The command line over the run YAML's `ros2:` (a bad namespace: phri::ConfigError).
 void apply_ros2_arguments(const Ros2Arguments& args, phri::Ros2Settings& settings);
+
+/// `phri experiment ros2-load` (phri/ros2/ros2_load.hpp).
+struct Ros2LoadArguments {
+  std::string config_path = "configs/dashboard.yaml";
+  double segment_s = 5.0;
+  int repeats = 3;
+  int domain = 47;
+  bool ft = true;
+};
+CLI::App* add_ros2_load_command(CLI::App& experiment, Ros2LoadArguments& args);
+int ros2_load_command(const Ros2LoadArguments& args);
 
 /// The bridge of one run: started here (its topics printed), its observer and input added to
 /// `options`; finish() stops it and prints what it published and refused.
@@ -30,6 +43,9 @@ public:
   ~Ros2Run();
   Ros2Run(const Ros2Run&) = delete;
   Ros2Run& operator=(const Ros2Run&) = delete;
+  /// The robot the loop drives: `robot` itself, or with --ros-ft-in its state's F/T wrench from
+  /// /phri/ft_in (phri::FtInRobot). Valid while this lives.
+  phri::RobotInterface& robot(phri::RobotInterface& robot);
   void finish(std::ostream& out);
 
 private:

@@ -14,6 +14,12 @@
 // off the control thread): joint states, commands, external torque, poses, wrench value by value
 // (the log's numbers are shortest round-trip decimal, so equality is exact), status lines by cycle,
 // and /tf composed with /tf_static against /phri/ee_pose (forward kinematics by the peer).
+// --scenario ft-touch | ft-stale (tests/ros2/ros2_ft_run.yaml: phri's F/T sensor is /phri/ft_in): the
+// peer is the F/T sensor, publishing a noisy wrench at 500 Hz from before phri starts; an absurd
+// sample (1e9 N) is refused; ft-touch presses 15 N and dual compliance's trigger sees the touch
+// (status touched=1), then the supervisor drops the phantom wrench the observer does not see
+// (ft=inconsistent, never a push); ft-stale stops publishing and the supervisor drops the stale
+// source (ft=stale) while the arm holds its pose.
 // Exit status 0 only if every check passed; each check prints its figures.
 #include "ros2_messages.h"
 #include "ros2_messagesPubSubTypes.h"
@@ -36,6 +42,7 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -98,6 +105,7 @@ struct Peer {
   Inbox<stdm::String_> status;
   fdds::DataWriter* target_writer = nullptr;
   fdds::DataWriter* event_writer = nullptr;
+  fdds::DataWriter* ft_writer = nullptr;
   std::map<std::string, fdds::TypeSupport> types;
 
   explicit Peer(int domain) {
@@ -128,6 +136,19 @@ struct Peer {
     subscribe(status, "rt/phri/status", new stdm::String_PubSubType());
     target_writer = writer("rt/phri/target_pose", new gm::PoseStamped_PubSubType());
     event_writer = writer("rt/phri/event", new stdm::String_PubSubType());
+    ft_writer = writer("rt/phri/ft_in", new gm::WrenchStamped_PubSubType());
+  }
+
+  void send_wrench(double fx, double fy, double fz) {
+    gm::WrenchStamped_ m;
+    const auto ns = std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
+    m.header().stamp().sec(static_cast<std::int32_t>(ns / 1000000000));
+    m.header().stamp().nanosec(static_cast<std::uint32_t>(ns % 1000000000));
+    m.header().frame_id("ft_sensor");
+    m.wrench().force().x(fx);
+    m.wrench().force().y(fy);
+    m.wrench().force().z(fz);
+    ft_writer->write(&m);
   }
 
   ~Peer() {
@@ -251,9 +272,79 @@ namespace {
 
 // ------------------------------------------------------------------------------------ the run
 struct Options {
-  std::string phri, config, out;
+  std::string phri, config, out, scenario = "interop";
   int domain = 41;
 };
+
+// The peer as the F/T sensor: 500 Hz, noise of +-0.05 N (strain gauges are never bit-identical),
+// plus `press_N` along z; `streaming` false: silent.
+struct FtSource {
+  std::atomic<bool> streaming{true}, running{true};
+  std::atomic<double> press_N{0.0};
+  std::thread thread;
+  std::uint32_t lcg = 12345;
+  double noise() {
+    lcg = lcg * 1664525u + 1013904223u;
+    return 0.1 * (static_cast<double>(lcg >> 8) / 16777216.0 - 0.5);
+  }
+  void start(Peer& peer) {
+    thread = std::thread([this, &peer] {
+      auto next = Clock::now();
+      while (running) {
+        if (streaming) peer.send_wrench(noise(), noise(), press_N + noise());
+        next += std::chrono::microseconds(2000);
+        std::this_thread::sleep_until(next);
+      }
+    });
+  }
+  void stop() {
+    running = false;
+    if (thread.joinable()) thread.join();
+  }
+};
+
+bool wait_for_hold(Peer& peer) {
+  const bool holding = wait_for(peer, 6.0, [&] {
+    const auto kv = last_status(peer);
+    return kv.count("fsm") && kv.at("fsm") == "static" && std::atof(kv.at("err_mm").c_str()) < 1.0 &&
+           peer.ee_target.messages.size() > 60 && kv.at("ft") == "ok";
+  });
+  check(holding, "phri holds the static pose with the F/T source ok (status fsm=static, ft=ok)");
+  return holding;
+}
+
+// ft-touch / ft-stale (the header's comment).
+void ft_scenario(Peer& peer, FtSource& ft, const std::string& scenario) {
+  if (!wait_for_hold(peer)) return;
+  const double refused = status_number(peer, "inputs_refused");
+  peer.send_wrench(1e9, 0.0, 0.0);
+  const bool absurd = wait_for(peer, 1.0, [&] { return status_number(peer, "inputs_refused") >= refused + 1; });
+  check(absurd && last_status(peer)["last_refusal"] == "absurd_wrench" && last_status(peer)["ft"] == "ok",
+        "a 1e9 N sample is refused (absurd_wrench) and the F/T source stays ok");
+  const Eigen::Vector3d held = position_of(peer.ee_pose.messages.back());
+  const auto t0 = Clock::now();
+  if (scenario == "ft-touch") {
+    ft.press_N = 15.0;
+    const bool touched = wait_for(peer, 1.0, [&] { return last_status(peer)["touched"] == "1"; });
+    check(touched, fmt("a 15 N press on /phri/ft_in: dual compliance's trigger sees the touch after %.3f s", seconds_since(t0)));
+    const bool dropped = wait_for(peer, 2.0, [&] { return last_status(peer)["ft"] == "inconsistent"; });
+    check(dropped, fmt("the phantom wrench (no force on the arm: the observer sees none) is dropped: ft=inconsistent after %.3f s",
+                       seconds_since(t0)));
+    ft.press_N = 0.0;
+  } else {
+    ft.streaming = false;
+    const bool stale = wait_for(peer, 1.0, [&] { return last_status(peer)["ft"] == "stale"; });
+    check(stale, fmt("the peer stops publishing: ft=stale in the status after %.3f s", seconds_since(t0)));
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  peer.poll();
+  const double moved = (position_of(peer.ee_pose.messages.back()) - held).norm();
+  auto kv = last_status(peer);
+  check(moved < 0.01 && kv["safety"] == "normal" && kv["touched"] == "0",
+        fmt("the dropped source is no push: the end effector is %.2f mm from where it was held, not touched", 1e3 * moved));
+  peer.send_event("stop");
+}
+
 
 pid_t start_phri(const Options& o) {
   const std::string log = o.out + "/phri_stdout.txt";
@@ -437,22 +528,22 @@ void check_joint_topics(const Peer& peer, const Log& log) {
     for (std::size_t i = 0; names && i < 7; ++i) names = m.name().size() == 7 && m.name()[i] == "joint_" + std::to_string(i + 1);
   }
   check(names, "/joint_states names are joint_1 .. joint_7 (the URDF's)");
-  check_matches<sm::JointState_>("/joint_states (q, qd, tau_s)", log, js, 300, [&](const sm::JointState_& m, std::size_t r) {
+  check_matches<sm::JointState_>("/joint_states (q, qd, tau_s)", log, js, 100, [&](const sm::JointState_& m, std::size_t r) {
     return joints_equal(m.position(), log, r, "q") && joints_equal(m.velocity(), log, r, "qd") &&
            joints_equal(m.effort(), log, r, "tau_s");
   });
-  check_matches<sm::JointState_>("/phri/joint_commands (tau_d)", log, peer.joint_commands.messages, 150,
+  check_matches<sm::JointState_>("/phri/joint_commands (tau_d)", log, peer.joint_commands.messages, 50,
                                  [&](const sm::JointState_& m, std::size_t r) { return joints_equal(m.effort(), log, r, "tau_d"); });
-  check_matches<sm::JointState_>("/phri/external_torque (tau_ext)", log, peer.external_torque.messages, 150,
+  check_matches<sm::JointState_>("/phri/external_torque (tau_ext)", log, peer.external_torque.messages, 50,
                                  [&](const sm::JointState_& m, std::size_t r) { return joints_equal(m.effort(), log, r, "tau_ext"); });
 }
 
 void check_pose_topics(const Peer& peer, const Log& log) {
-  check_matches<gm::PoseStamped_>("/phri/ee_pose", log, peer.ee_pose.messages, 150,
+  check_matches<gm::PoseStamped_>("/phri/ee_pose", log, peer.ee_pose.messages, 50,
                                   [&](const gm::PoseStamped_& m, std::size_t r) { return pose_equal(m, log, r, "ee"); });
-  check_matches<gm::PoseStamped_>("/phri/ee_target", log, peer.ee_target.messages, 150,
+  check_matches<gm::PoseStamped_>("/phri/ee_target", log, peer.ee_target.messages, 50,
                                   [&](const gm::PoseStamped_& m, std::size_t r) { return pose_equal(m, log, r, "target"); });
-  check_matches<gm::WrenchStamped_>("/phri/wrench", log, peer.wrench.messages, 150, [&](const gm::WrenchStamped_& m, std::size_t r) {
+  check_matches<gm::WrenchStamped_>("/phri/wrench", log, peer.wrench.messages, 50, [&](const gm::WrenchStamped_& m, std::size_t r) {
     const auto& f = m.wrench().force();
     const auto& t = m.wrench().torque();
     return f.x() == log.at(r, "wrench_fx") && f.y() == log.at(r, "wrench_fy") && f.z() == log.at(r, "wrench_fz") &&
@@ -476,7 +567,7 @@ void check_status(const Peer& peer, const Log& log) {
       ++matched;
     }
   }
-  check(peer.status.messages.size() >= 150 && matched == static_cast<int>(peer.status.messages.size()),
+  check(peer.status.messages.size() >= 50 && matched == static_cast<int>(peer.status.messages.size()),
         fmt("/phri/status: %.0f received, %.0f with the time and mode of their cycle's log row", peer.status.messages.size(), matched));
 }
 
@@ -518,9 +609,23 @@ void check_tf(const Peer& peer) {
       break;
     }
   }
-  check(chain && compared >= 150 && worst < 1e-9,
+  check(chain && compared >= 50 && worst < 1e-9,
         fmt("/tf: %.0f messages, a chain base -> 7 links; composed with /tf_static, %.0f equal /phri/ee_pose within %.2g m",
             peer.tf.messages.size(), compared, worst));
+}
+
+// In phri's log: the F/T status codes (safety/wrench_supervisor.hpp: 5 stale, 7 inconsistent).
+void check_ft_log(const Log& log, const std::string& scenario) {
+  const int wanted = scenario == "ft-touch" ? 7 : 5;
+  int touched_rows = 0;
+  std::size_t first_drop = log.rows.size();
+  for (std::size_t r = 0; r < log.rows.size(); ++r) {
+    if (log.at(r, "touched") == 1.0 && first_drop == log.rows.size()) ++touched_rows;
+    if (log.at(r, "ft_status") == wanted && first_drop == log.rows.size()) first_drop = r;
+  }
+  check(first_drop < log.rows.size(), fmt("phri's log: the F/T source dropped (code %.0f) at t = %.3f s", wanted,
+                                          first_drop < log.rows.size() ? log.at(first_drop, "time_s") : -1.0));
+  if (scenario == "ft-touch") check(touched_rows > 0, fmt("phri's log: %.0f cycles touched before the drop", touched_rows));
 }
 
 }  // namespace
@@ -533,6 +638,7 @@ int main(int argc, char** argv) {
     if (a == "--config") o.config = argv[i + 1];
     if (a == "--out") o.out = argv[i + 1];
     if (a == "--domain") o.domain = std::atoi(argv[i + 1]);
+    if (a == "--scenario") o.scenario = argv[i + 1];
   }
   if (o.phri.empty() || o.config.empty() || o.out.empty()) {
     std::fprintf(stderr, "usage: phri_fastdds_peer --phri PATH --config RUN.yaml --out DIR [--domain N]\n");
@@ -540,10 +646,15 @@ int main(int argc, char** argv) {
   }
   std::system(("mkdir -p '" + o.out + "'").c_str());
   Peer peer(o.domain);
+  const bool ft_scenarios = o.scenario == "ft-touch" || o.scenario == "ft-stale";
+  FtSource ft;
+  if (ft_scenarios) ft.start(peer);  // the sensor streams before phri starts, as a real one would
   const pid_t pid = start_phri(o);
   const bool matched = wait_for(peer, 5.0, [&] { return peer.writers_matched() && !peer.status.messages.empty(); });
   check(matched, "discovery over loopback (unicast): phri's status received, our writers matched its readers");
-  if (matched) {
+  if (matched && ft_scenarios) {
+    ft_scenario(peer, ft, o.scenario);
+  } else if (matched) {
     target_moves_end_effector(peer);
     malformed_input_refused(peer);
     flood_does_not_disturb(peer);
@@ -558,6 +669,7 @@ int main(int argc, char** argv) {
     kill(pid, SIGKILL);
     waitpid(pid, &status, 0);
   }
+  ft.stop();
   peer.poll();
   check(WIFEXITED(status) && WEXITSTATUS(status) == 0, fmt("phri exited with status %.0f", WIFEXITED(status) ? WEXITSTATUS(status) : -1));
   const Log log(o.out + "/phri_ros2_test.csv");
@@ -567,6 +679,7 @@ int main(int argc, char** argv) {
     check_pose_topics(peer, log);
     check_status(peer, log);
     check_tf(peer);
+    if (ft_scenarios) check_ft_log(log, o.scenario);
   }
   std::printf("%s: %d check(s) failed\n", g_failures ? "FAILED" : "OK", g_failures);
   return g_failures == 0 ? 0 : 1;

@@ -7,8 +7,12 @@
 #include <phri/ros2/ros2_bridge.hpp>
 #include <phri/ros2/status_text.hpp>
 
+#include <phri/config/config.hpp>
+#include <phri/core/error.hpp>
 #include <phri/model/algorithms.hpp>
 #include <phri/model/model.hpp>
+#include <phri/robot/fake_robot.hpp>
+#include <phri/ros2/ft_in_robot.hpp>
 
 #include "ros2_messages.h"
 
@@ -18,7 +22,10 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <fstream>
 #include <map>
+#include <tuple>
+#include <vector>
 #include <memory>
 #include <sstream>
 #include <string>
@@ -159,6 +166,77 @@ TEST(Ros2Bridge, NamesOnTheWire) {
   EXPECT_FALSE(valid_ros_namespace("/1arm"));
   EXPECT_FALSE(valid_ros_namespace("/a//b"));
   EXPECT_FALSE(valid_ros_namespace("/a b"));
+}
+
+// /phri/ft_in as the robot's F/T: the sequence advances only with new samples, the stamp is the
+// robot time a sample came (this cycle's time - its age), nothing before the first sample.
+TEST(FtInRobot, SequenceAndStampFollowTheSamples) {
+  FakeRobot fake;
+  TripleBuffer<FtInSample> source;
+  FtInRobot robot(fake, source, 8);
+  const RobotState& s0 = robot.read();
+  EXPECT_FALSE(s0.wrench.valid);
+  EXPECT_EQ(s0.wrench.sequence, 0u);
+  const auto now_ns = [] {
+    return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch()).count();
+  };
+  FtInSample sample;
+  sample.wrench = {1.0, 2.0, 3.0, 0.1, 0.2, 0.3};
+  sample.count = 1;
+  sample.received_ns = now_ns() - 4000000;  // received 4 ms ago
+  source.publish(sample);
+  const RobotState& s1 = robot.read();
+  EXPECT_TRUE(s1.wrench.valid);
+  EXPECT_EQ(s1.wrench.sequence, 1u);
+  EXPECT_NEAR(s1.time_s - s1.wrench.stamp_s, 0.004, 0.002);  // its age, give or take the test's own time
+  EXPECT_EQ(s1.wrench_sensor[2], 3.0);
+  EXPECT_EQ(s1.wrench_sensor[5], 0.3);
+  const double stamp = s1.wrench.stamp_s;
+  const RobotState& s2 = robot.read();  // no new sample: same sequence and stamp (the supervisor sees it stale later)
+  EXPECT_EQ(s2.wrench.sequence, 1u);
+  EXPECT_EQ(s2.wrench.stamp_s, stamp);
+  sample.count = 2;
+  sample.received_ns = now_ns();
+  source.publish(sample);
+  EXPECT_EQ(robot.read().wrench.sequence, 2u);
+  ASSERT_EQ(robot.ages_s().size(), 2u);
+  EXPECT_NEAR(robot.ages_s()[0], 0.004, 0.002);
+  EXPECT_EQ(robot.samples_seen(), 2u);
+}
+
+// The run YAML's ros2: section (configs/demo.yaml documents every key).
+TEST(Ros2Config, DemoKeysAndRefusals) {
+  const std::string dir = std::string(PHRI_SOURCE_DIR) + "/configs";
+  std::ifstream file(dir + "/demo.yaml");
+  std::stringstream text;
+  text << file.rdbuf();
+  const std::string demo = text.str();
+  const Config c = Config::from_yaml_string(demo, "demo.yaml", dir);
+  EXPECT_FALSE(c.ros2.enabled);
+  EXPECT_EQ(c.ros2.topic_namespace, "/phri");
+  EXPECT_EQ(c.ros2.joint_states_decimation, 10);
+  EXPECT_EQ(c.ros2.discovery, "loopback");
+  const auto with = [&](const std::string& from, const std::string& to) {
+    std::string y = demo;
+    const auto pos = y.find(from);
+    if (pos == std::string::npos) throw std::runtime_error("test bug: " + from);
+    return y.replace(pos, from.size(), to);
+  };
+  const Config d = Config::from_yaml_string(with("  domain: -1 ", "  domain: 7 "), "demo.yaml", dir);
+  EXPECT_EQ(d.ros2.domain, 7);
+  for (const auto& [from, to, key] : std::vector<std::tuple<std::string, std::string, std::string>>{
+           {"namespace: /phri ", "namespace: /phri/ ", "ros2.namespace"},
+           {"  domain: -1 ", "  domain: 233 ", "ros2.domain"},
+           {"discovery: loopback ", "discovery: multicast ", "ros2.discovery"},
+           {"  decimation: 20 ", "  decimation: 0 ", "ros2.decimation"},
+           {"  ft_in: false ", "  ft_in: false\n  typo: 1 ", "ros2"}}) {
+    try {
+      Config::from_yaml_string(with(from, to), "demo.yaml", dir);
+      ADD_FAILURE() << "accepted " << to;
+    } catch (const ConfigError& e) {
+      EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << e.what();
+    }
+  }
 }
 
 // ------------------------------------------------------------------------------------ the bridge on DDS

@@ -535,7 +535,7 @@ void parse_run(const YamlReader& r, RunSettings& s) {
 
 void parse_ros2(const YamlReader& r, Ros2Settings& s) {
   r.allow_keys({"enabled", "domain", "namespace", "joint_states_decimation", "decimation", "subscribe",
-                "max_input_rate_hz", "max_reach_m", "discovery"});
+                "max_input_rate_hz", "max_reach_m", "discovery", "ft_in"});
   s.enabled = r.boolean_or("enabled", s.enabled);
   s.domain = static_cast<int>(r.integer_or("domain", s.domain, -1, 232));
   s.topic_namespace = r.text_or("namespace", s.topic_namespace);
@@ -545,6 +545,7 @@ void parse_ros2(const YamlReader& r, Ros2Settings& s) {
   s.joint_states_decimation = static_cast<int>(r.integer_or("joint_states_decimation", s.joint_states_decimation, 1, 100000));
   s.decimation = static_cast<int>(r.integer_or("decimation", s.decimation, 1, 100000));
   s.subscribe = r.boolean_or("subscribe", s.subscribe);
+  s.ft_in = r.boolean_or("ft_in", s.ft_in);
   s.max_input_rate_hz = positive_or(r, "max_input_rate_hz", s.max_input_rate_hz, 1000.0);
   s.max_reach_m = non_negative_or(r, "max_reach_m", s.max_reach_m, 10.0);
   if (r.has("discovery")) s.discovery = r.choice("discovery", {"loopback", "network"});

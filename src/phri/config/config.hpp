@@ -46,7 +46,7 @@
 //   gamepad:     enabled, poll_interval_ms, trigger_press, trigger_release    -> GamepadSettings
 //   run:         duration_s, pacing (real_time | lockstep)                    -> RunSettings
 //   ros2:        enabled, domain, namespace, joint_states_decimation, decimation, subscribe,
-//                max_input_rate_hz, max_reach_m, discovery (loopback | network) -> Ros2Settings
+//                max_input_rate_hz, max_reach_m, discovery (loopback | network), ft_in -> Ros2Settings
 //
 // Validation at load: unknown keys, duplicate keys, explicit nulls, wrong types, values outside
 // their physical range and inconsistent pairs are a phri::ConfigError naming the file and the key

@@ -17,6 +17,9 @@ struct Ros2Settings {
   int decimation = 20;
   /// Take /phri/target_pose and /phri/event (false: publish only).
   bool subscribe = true;
+  /// The run's F/T sensor is <namespace>/ft_in (geometry_msgs/WrenchStamped from another machine,
+  /// `phri ft-bridge`), checked by the controller's WrenchSupervisor like the arm's own.
+  bool ft_in = false;
   /// Inputs faster than this are refused (counted), per topic [1/s].
   double max_input_rate_hz = 50.0;
   /// A target farther than this from the base is refused [m]; 0: the arm's reach from its model.

@@ -60,4 +60,14 @@ InputRefusal InputGate::event(std::string_view name, double now_s, Event& out) {
   return InputRefusal::kNone;
 }
 
+InputRefusal InputGate::wrench(const std::array<double, 6>& w) {
+  for (double v : w) {
+    if (!std::isfinite(v)) return refuse(InputRefusal::kNotFinite);
+  }
+  const double force = std::hypot(w[0], w[1], w[2]), moment = std::hypot(w[3], w[4], w[5]);
+  if (!(force <= limits_.max_force_N) || !(moment <= limits_.max_moment_Nm)) return refuse(InputRefusal::kAbsurdWrench);
+  ++accepted_;
+  return InputRefusal::kNone;
+}
+
 }  // namespace phri

@@ -9,6 +9,10 @@
 //                      within max_reach_m of the base; at most max_rate_hz accepted.
 //   /phri/event        std_msgs/String: one of config/event.hpp's names (the gamepad's and the
 //                      dashboard's), at most max_rate_hz accepted.
+//   /phri/ft_in        geometry_msgs/WrenchStamped: finite, |F| <= 1e4 N, |M| <= 1e3 N.m (no F/T
+//                      sensor reads more: garbage); no rate limit (a sensor streams at its rate).
+//                      The rest (range, staleness, frozen values, consistency with the observer)
+//                      is the controller's WrenchSupervisor's, as for any sensor.
 // Refused input changes nothing and is counted by reason (the bridge's /phri/status reports them).
 #include <phri/app/live_channel.hpp>
 #include <phri/config/event.hpp>
@@ -31,13 +35,15 @@ enum class InputRefusal : std::uint8_t {
   kTooFast,            ///< more than max_rate_hz on this topic
   kUnknownEvent,       ///< not an event name
   kQueueFull,          ///< the loop has not taken the previous commands
-  kLast = kQueueFull,
+  kAbsurdWrench,       ///< /phri/ft_in beyond any F/T sensor (|F| > 1e4 N or |M| > 1e3 N.m)
+  kLast = kAbsurdWrench,
 };
 inline constexpr int kInputRefusalCount = static_cast<int>(InputRefusal::kLast) + 1;
 
 constexpr std::string_view to_string(InputRefusal r) {
   constexpr std::array<std::string_view, kInputRefusalCount> names = {
-      "none", "not_finite", "not_unit_quaternion", "out_of_reach", "unknown_frame", "too_fast", "unknown_event", "queue_full"};
+      "none", "not_finite", "not_unit_quaternion", "out_of_reach", "unknown_frame", "too_fast", "unknown_event", "queue_full",
+      "absurd_wrench"};
   const auto i = static_cast<std::size_t>(r);
   return i < names.size() ? names[i] : "unknown";
 }
@@ -48,6 +54,7 @@ struct InputLimits {
   Eigen::Isometry3d base_in_world = Eigen::Isometry3d::Identity();  ///< Model::base_placement()
   double max_reach_m = 1.0;
   double max_rate_hz = 50.0;
+  double max_force_N = 1e4, max_moment_Nm = 1e3;  ///< /phri/ft_in: beyond is garbage
 };
 
 /// A PoseStamped as received (quaternion x, y, z, w as in ROS).
@@ -64,6 +71,8 @@ public:
   /// `now_s`: the bridge's monotonic clock [s]. kNone: `out` holds the target in world axes.
   InputRefusal target(const PoseInput& pose, double now_s, LiveTarget& out);
   InputRefusal event(std::string_view name, double now_s, Event& out);
+  /// Fx, Fy, Fz [N], Mx, My, Mz [N.m].
+  InputRefusal wrench(const std::array<double, 6>& w);
   /// Counts a refusal found outside the gate (kQueueFull).
   void count(InputRefusal r) { ++refused_[static_cast<std::size_t>(r)]; }
 

@@ -28,7 +28,7 @@ using StringMsg = std_msgs_msg_dds__String_;
 
 constexpr std::size_t kTakeBatch = 16;
 constexpr int kMaxTakesPerPass = 16;  // a flood is taken (and refused) 256 samples per millisecond at most
-constexpr double kIdleSleep_s = 1e-3;
+constexpr dds_duration_t kIdleWait = DDS_MSECS(1);  // snapshots are looked for at least this often
 
 // DDS's own code turned into one line naming the call.
 dds_entity_t checked(dds_entity_t e, const char* what) {
@@ -91,7 +91,7 @@ struct Ros2Bridge::Impl {
   void open();
   void close();
   dds_entity_t writer(const dds_topic_descriptor_t* type, const std::string& ros_name, Ros2Topic topic, bool latched = false);
-  dds_entity_t reader(const dds_topic_descriptor_t* type, const std::string& ros_name);
+  dds_entity_t reader(const dds_topic_descriptor_t* type, const std::string& ros_name, bool best_effort = false);
   void prepare_tf();
   void run();
   void publish(const LiveSnapshot& s);
@@ -107,6 +107,7 @@ struct Ros2Bridge::Impl {
   void take_inputs();
   void take_targets(double now_s);
   void take_events(double now_s);
+  void take_wrenches();
   void queue(const LiveCommand& c, std::uint64_t& accepted);
 
   Ros2Settings settings;
@@ -118,12 +119,14 @@ struct Ros2Bridge::Impl {
   LiveChannel input;
   InputGate gate;
 
-  dds_entity_t domain = 0, participant = 0;
+  dds_entity_t domain = 0, participant = 0, waitset = 0;
   std::array<dds_entity_t, kRos2TopicCount> writers{};
   std::array<std::string, kRos2TopicCount> topic_names;
   std::array<std::string, kRos2TopicCount> type_names;
-  dds_entity_t target_reader = 0, event_reader = 0;
-  std::string target_topic, event_topic;
+  dds_entity_t target_reader = 0, event_reader = 0, ft_reader = 0;
+  std::string target_topic, event_topic, ft_topic;
+  TripleBuffer<FtInSample> ft_buffer;
+  FtInSample ft_sample;
 
   // What the messages point into, built once.
   std::vector<std::string> joint_names;
@@ -168,12 +171,19 @@ dds_entity_t Ros2Bridge::Impl::writer(const dds_topic_descriptor_t* type, const 
   return writers[i];
 }
 
-dds_entity_t Ros2Bridge::Impl::reader(const dds_topic_descriptor_t* type, const std::string& ros_name) {
+// RELIABLE readers match what ROS 2 tools publish by default; /ft_in's is BEST_EFFORT, which matches
+// both a sensor's BEST_EFFORT writer (ROS 2's sensor QoS) and a RELIABLE one.
+dds_entity_t Ros2Bridge::Impl::reader(const dds_topic_descriptor_t* type, const std::string& ros_name, bool best_effort) {
   dds_qos_t* qos = ros_qos(false, 10);
+  if (best_effort) dds_qset_reliability(qos, DDS_RELIABILITY_BEST_EFFORT, 0);
   const dds_entity_t t = checked(dds_create_topic(participant, type, dds_topic_name(ros_name).c_str(), nullptr, nullptr), "create topic");
   const dds_entity_t r = dds_create_reader(participant, t, qos, nullptr);
   dds_delete_qos(qos);
-  return checked(r, "create reader");
+  checked(r, "create reader");
+  // The thread wakes as soon as a sample is there (the F/T round trip), else every millisecond.
+  const dds_entity_t any = checked(dds_create_readcondition(r, DDS_ANY_STATE), "create read condition");
+  checked(dds_waitset_attach(waitset, any, r), "attach to waitset");
+  return r;
 }
 
 void Ros2Bridge::Impl::open() {
@@ -183,6 +193,7 @@ void Ros2Bridge::Impl::open() {
     if (domain < 0 && domain != DDS_RETCODE_PRECONDITION_NOT_MET) checked(domain, "create domain");  // exists: reuse it
   }
   participant = checked(dds_create_participant(static_cast<dds_domainid_t>(domain_id), nullptr, nullptr), "create participant");
+  waitset = checked(dds_create_waitset(participant), "create waitset");
   const std::string& ns = settings.topic_namespace;
   writer(&sensor_msgs_msg_dds__JointState__desc, "/joint_states", Ros2Topic::kJointStates);
   writer(&sensor_msgs_msg_dds__JointState__desc, ns + "/joint_commands", Ros2Topic::kJointCommands);
@@ -198,6 +209,10 @@ void Ros2Bridge::Impl::open() {
     event_topic = ns + "/event";
     target_reader = reader(&geometry_msgs_msg_dds__PoseStamped__desc, target_topic);
     event_reader = reader(&std_msgs_msg_dds__String__desc, event_topic);
+  }
+  if (settings.ft_in) {
+    ft_topic = ns + "/ft_in";
+    ft_reader = reader(&geometry_msgs_msg_dds__WrenchStamped__desc, ft_topic, true);
   }
   prepare_tf();
   last_cycle.fill(std::numeric_limits<std::int64_t>::min() / 2);
@@ -416,7 +431,39 @@ void Ros2Bridge::Impl::take_events(double now_s) {
   }
 }
 
+// Every accepted sample goes to the triple buffer; the cycle reads the newest.
+void Ros2Bridge::Impl::take_wrenches() {
+  for (int pass = 0; pass < kMaxTakesPerPass; ++pass) {
+    void* samples[kTakeBatch] = {};
+    dds_sample_info_t infos[kTakeBatch];
+    const dds_return_t n = dds_take(ft_reader, samples, infos, kTakeBatch, kTakeBatch);
+    if (n <= 0) return;
+    for (dds_return_t i = 0; i < n; ++i) {
+      if (!infos[i].valid_data) continue;
+      const auto* m = static_cast<const WrenchStampedMsg*>(samples[i]);
+      const std::array<double, 6> w = {m->wrench.force.x,  m->wrench.force.y,  m->wrench.force.z,
+                                       m->wrench.torque.x, m->wrench.torque.y, m->wrench.torque.z};
+      const InputRefusal r = gate.wrench(w);
+      const std::lock_guard<std::mutex> lock(stats_mutex);
+      if (r != InputRefusal::kNone) {
+        ++stats.refused[static_cast<std::size_t>(r)];
+        continue;
+      }
+      ++stats.wrenches;
+      ft_sample.wrench = w;
+      ++ft_sample.count;
+      ft_sample.received_ns =
+          std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch()).count();
+      ft_sample.stamp_ns = static_cast<std::int64_t>(m->header.stamp.sec) * 1000000000 + m->header.stamp.nanosec;
+      ft_buffer.publish(ft_sample);
+    }
+    dds_return_loan(ft_reader, samples, n);
+    if (static_cast<std::size_t>(n) < kTakeBatch) return;
+  }
+}
+
 void Ros2Bridge::Impl::take_inputs() {
+  if (ft_reader > 0) take_wrenches();
   if (!settings.subscribe) return;
   const double now_s = std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
   take_targets(now_s);
@@ -440,7 +487,7 @@ void Ros2Bridge::Impl::run() {
     take_inputs();
     if (last_pass) break;
     last_pass = stopping;  // one more pass after stop(): the loop's last snapshots go out
-    if (taken == 0) std::this_thread::sleep_for(std::chrono::duration<double>(kIdleSleep_s));
+    if (taken == 0) dds_waitset_wait(waitset, nullptr, 0, kIdleWait);
   }
 }
 
@@ -472,7 +519,9 @@ void Ros2Bridge::stop() {
 
 SnapshotChannel& Ros2Bridge::observer() { return impl_->observer; }
 LiveChannel& Ros2Bridge::input() { return impl_->input; }
+TripleBuffer<FtInSample>& Ros2Bridge::ft_in() { return impl_->ft_buffer; }
 int Ros2Bridge::domain() const { return impl_->domain_id; }
+const Ros2Settings& Ros2Bridge::settings() const { return impl_->settings; }
 
 std::vector<std::string> Ros2Bridge::wire_topics() const {
   std::vector<std::string> out;
@@ -480,6 +529,9 @@ std::vector<std::string> Ros2Bridge::wire_topics() const {
   if (impl_->settings.subscribe) {
     out.push_back(dds_topic_name(impl_->target_topic) + " geometry_msgs::msg::dds_::PoseStamped_ (subscribed)");
     out.push_back(dds_topic_name(impl_->event_topic) + " std_msgs::msg::dds_::String_ (subscribed)");
+  }
+  if (impl_->settings.ft_in) {
+    out.push_back(dds_topic_name(impl_->ft_topic) + " geometry_msgs::msg::dds_::WrenchStamped_ (subscribed, best effort: the F/T source)");
   }
   return out;
 }

@@ -21,12 +21,14 @@
 //   subscribes
 //   <ns>/target_pose                geometry_msgs/PoseStamped     the end-effector target (ros2/input_gate.hpp)
 //   <ns>/event                      std_msgs/String               an event name (config/event.hpp)
+//   <ns>/ft_in (settings.ft_in)     geometry_msgs/WrenchStamped   the F/T sensor of another machine (ft_in_robot.hpp)
 // Stamps are the wall clock (system_clock) at publication; /joint_states every
 // joint_states_decimation cycles, the rest every `decimation` cycles.
 #include <phri/app/live_channel.hpp>
 #include <phri/app/snapshot_channel.hpp>
 #include <phri/config/ros2_settings.hpp>
 #include <phri/model/model.hpp>
+#include <phri/ros2/ft_in_robot.hpp>
 #include <phri/ros2/input_gate.hpp>
 
 #include <array>
@@ -49,6 +51,7 @@ struct Ros2BridgeStats {
   std::uint64_t snapshots = 0;          ///< taken from the loop
   std::uint64_t snapshots_dropped = 0;  ///< the loop found the ring full
   std::uint64_t targets = 0, events = 0;  ///< accepted and queued to the loop
+  std::uint64_t wrenches = 0;             ///< /phri/ft_in samples accepted
   std::array<std::uint64_t, kInputRefusalCount> refused{};
   std::uint64_t refused_total() const;
 };
@@ -67,8 +70,11 @@ public:
 
   SnapshotChannel& observer();  ///< RunOptions::observers
   LiveChannel& input();         ///< RunOptions::inputs
+  /// The newest /phri/ft_in sample (settings.ft_in), for one reader: FtInRobot.
+  TripleBuffer<FtInSample>& ft_in();
 
   int domain() const;
+  const Ros2Settings& settings() const;
   /// "rt/joint_states sensor_msgs::msg::dds_::JointState_" ... (what a DDS tool sees).
   std::vector<std::string> wire_topics() const;
   /// Counts so far (exact once stop() returned).
