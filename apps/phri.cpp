@@ -24,7 +24,6 @@
 // `phri run` exits 0, 3 after a safe hold, and 128 + the signal's number (130 SIGINT, 143 SIGTERM)
 // when a signal ended it early: the run then stops as if its duration had run out, and the log,
 // summary.md and figure are still written (a second signal kills as usual).
-#include "ft_bridge.hpp"
 #include "ft_monitor.hpp"
 #include "kortex_backend.hpp"
 #include "ros2_cli.hpp"
@@ -309,7 +308,7 @@ int run_command(const RunArguments& args) {
   if (args.lockstep) config.run.pacing = phri::LoopClock::Pacing::kLockstep;
   if (args.real_time) config.run.pacing = phri::LoopClock::Pacing::kRealTime;
   if (args.duration_s > 0.0) config.run.duration_s = args.duration_s;
-  apply_ros2_arguments(args.ros2, config.ros2);
+  apply_ros2_arguments(args.ros2, config.ros2, config.run.pacing == phri::LoopClock::Pacing::kLockstep);
   phri::ensure_output_directory(args.out_dir);
   const std::filesystem::path out(args.out_dir);
   config.logging.path = (out / std::filesystem::path(config.logging.path).filename()).string();
@@ -321,10 +320,6 @@ int run_command(const RunArguments& args) {
   const bool real_arm = args.kortex.backend == "kortex";
   if (real_arm && args.lockstep) throw phri::ConfigError("--lockstep", "", "the real arm runs in real time (--backend kortex)");
   if (real_arm) config.run.pacing = phri::LoopClock::Pacing::kRealTime;
-  if (config.ros2.enabled && config.ros2.ft_in && config.run.pacing == phri::LoopClock::Pacing::kLockstep) {
-    throw phri::ConfigError("ros2.ft_in", "", "the F/T sensor from /ft_in needs real-time pacing (--realtime): in lockstep "
-                                              "robot time outruns its samples");
-  }
   phri::Controller cycle(config.controller);
   // What the URDF loader and the plant generator accepted but the user should know (one line each,
   // naming the link): odd inertias, a base inertial ignored, inertias MuJoCo balanced.
@@ -366,8 +361,7 @@ int run_command(const RunArguments& args) {
   options.real_time = config.run.pacing == phri::LoopClock::Pacing::kRealTime;
   options.phases.push_back({0.0, "startup"});
   for (const phri::TimedEvent& e : config.fsm.timeline) options.phases.push_back({e.time_s, std::string(phri::to_string(e.event))});
-  std::unique_ptr<Ros2Run> ros2;
-  if (config.ros2.enabled) ros2 = std::make_unique<Ros2Run>(config.ros2, cycle, options, std::cout);
+  const std::unique_ptr<Ros2Run> ros2 = Ros2Run::start_if_enabled(config.ros2, cycle, options, std::cout);
   phri::RobotInterface& driven = ros2 ? ros2->robot(robot) : robot;
   const phri::RunSummary summary = phri::run_session(driven, cycle, fsm, gamepad.get(), logger ? &*logger : nullptr, options, std::cout);
   if (gamepad) gamepad->stop();
@@ -809,8 +803,7 @@ int main(int argc, char** argv) {
   const CLI::App* tracking = add_torque_tracking_command(*experiment, tracking_args);
   const CLI::App* fuzz = add_safety_fuzz_command(*experiment, fuzz_args);
   const CLI::App* load = add_dashboard_load_command(*experiment, load_args);
-  Ros2LoadArguments ros2_load_args;
-  const CLI::App* ros2_load = add_ros2_load_command(*experiment, ros2_load_args);
+  Ros2Commands ros2_commands(app, *experiment);  // ft-bridge, experiment ros2-load
   auto* friction_alias = experiment->add_subcommand("friction-identification", "Same as 'phri identify-friction'");
   friction_alias->add_option("--out", friction.output_dir, "output folder");
   friction_alias->add_option("--seed", friction.seed, "seed");
@@ -830,8 +823,6 @@ int main(int argc, char** argv) {
   const CLI::App* fit_collision = add_fit_collision_command(app, fit_args);
   FtMonitorArguments ft_args;
   const CLI::App* ft_monitor = add_ft_monitor_command(app, ft_args);
-  FtBridgeArguments ft_bridge_args;
-  const CLI::App* ft_bridge = add_ft_bridge_command(app, ft_bridge_args);
 
   add_shared_checks(app);
   if (const std::string error = command_word_error(app, argc, argv); !error.empty()) return print_error(error.c_str());
@@ -846,8 +837,7 @@ int main(int argc, char** argv) {
     if (info->parsed()) return info_command(info_args);
     if (fit_collision->parsed()) return fit_collision_command(fit_args);
     if (ft_monitor->parsed()) return ft_monitor_command(ft_args);
-    if (ft_bridge->parsed()) return ft_bridge_command(ft_bridge_args);
-    if (ros2_load->parsed()) return ros2_load_command(ros2_load_args);
+    if (ros2_commands.parsed()) return ros2_commands.run();
     if (identify->parsed() || friction_alias->parsed()) return friction_identification_command(friction);
     if (tracking->parsed()) return torque_tracking_command(tracking_args);
     if (fuzz->parsed()) return safety_fuzz_command(fuzz_args);

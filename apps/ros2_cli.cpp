@@ -26,7 +26,10 @@ void add_ros2_options(CLI::App& run, Ros2Arguments& args) {
                "checked like the arm's own; needs --realtime")->needs(ros2);
 }
 
-void apply_ros2_arguments(const Ros2Arguments& args, phri::Ros2Settings& settings) {
+Ros2Commands::Ros2Commands(CLI::App& app, CLI::App& experiment)
+    : ft_bridge_(add_ft_bridge_command(app, ft_bridge_args_)), load_(add_ros2_load_command(experiment, load_args_)) {}
+
+void apply_ros2_arguments(const Ros2Arguments& args, phri::Ros2Settings& settings, bool lockstep) {
   if (args.enabled) settings.enabled = true;
   if (args.domain >= 0) settings.domain = args.domain;
   if (args.ft_in) settings.ft_in = true;
@@ -36,6 +39,10 @@ void apply_ros2_arguments(const Ros2Arguments& args, phri::Ros2Settings& setting
                                                      args.topic_namespace + "'");
     }
     settings.topic_namespace = args.topic_namespace;
+  }
+  if (settings.enabled && settings.ft_in && lockstep) {
+    throw phri::ConfigError("ros2.ft_in", "", "the F/T sensor from " + settings.topic_namespace + "/ft_in needs real-time "
+                                              "pacing (--realtime): in lockstep robot time outruns its samples");
   }
 }
 

@@ -7,6 +7,8 @@
 #include <phri/control/controller.hpp>
 #include <phri/robot/robot_interface.hpp>
 
+#include "ft_bridge.hpp"
+
 #include <CLI/CLI.hpp>
 
 #include <iosfwd>
@@ -21,8 +23,9 @@ struct Ros2Arguments {
 };
 
 void add_ros2_options(CLI::App& run, Ros2Arguments& args);
-/// The command line over the run YAML's `ros2:` (a bad namespace: phri::ConfigError).
-void apply_ros2_arguments(const Ros2Arguments& args, phri::Ros2Settings& settings);
+/// The command line over the run YAML's `ros2:` (phri::ConfigError: a bad namespace, or the F/T
+/// from /ft_in in a `lockstep` run, whose robot time outruns the samples).
+void apply_ros2_arguments(const Ros2Arguments& args, phri::Ros2Settings& settings, bool lockstep);
 
 /// `phri experiment ros2-load` (phri/ros2/ros2_load.hpp).
 struct Ros2LoadArguments {
@@ -35,10 +38,29 @@ struct Ros2LoadArguments {
 CLI::App* add_ros2_load_command(CLI::App& experiment, Ros2LoadArguments& args);
 int ros2_load_command(const Ros2LoadArguments& args);
 
+/// The ROS 2 commands besides `run --ros2`: `phri ft-bridge` and `phri experiment ros2-load`.
+class Ros2Commands {
+public:
+  Ros2Commands(CLI::App& app, CLI::App& experiment);
+  bool parsed() const { return ft_bridge_->parsed() || load_->parsed(); }
+  int run() const { return ft_bridge_->parsed() ? ft_bridge_command(ft_bridge_args_) : ros2_load_command(load_args_); }
+
+private:
+  FtBridgeArguments ft_bridge_args_;
+  Ros2LoadArguments load_args_;
+  CLI::App* ft_bridge_ = nullptr;
+  CLI::App* load_ = nullptr;
+};
+
 /// The bridge of one run: started here (its topics printed), its observer and input added to
 /// `options`; finish() stops it and prints what it published and refused.
 class Ros2Run {
 public:
+  /// A started bridge when settings.enabled, else null.
+  static std::unique_ptr<Ros2Run> start_if_enabled(const phri::Ros2Settings& settings, const phri::Controller& cycle,
+                                                   phri::RunOptions& options, std::ostream& out) {
+    return settings.enabled ? std::make_unique<Ros2Run>(settings, cycle, options, out) : nullptr;
+  }
   Ros2Run(const phri::Ros2Settings& settings, const phri::Controller& cycle, phri::RunOptions& options, std::ostream& out);
   ~Ros2Run();
   Ros2Run(const Ros2Run&) = delete;

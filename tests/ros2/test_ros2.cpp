@@ -1,6 +1,6 @@
 // ctest-labels: unit
 // The ROS 2 bridge (src/phri/ros2/): the checks of its inputs, its status line, and the bridge
-// itself against plain Cyclone DDS readers and writers in this process (domain 42, loopback).
+// itself against plain Cyclone DDS readers and writers in this process (domains 42, 45, 46, loopback).
 // The interop with an independent DDS (Fast DDS) in another process: fastdds_peer.cpp.
 #include <phri/ros2/dds_config.hpp>
 #include <phri/ros2/input_gate.hpp>
@@ -14,11 +14,13 @@
 #include <phri/robot/fake_robot.hpp>
 #include <phri/ros2/ft_in_robot.hpp>
 
+#include "allocation_counter.hpp"
 #include "ros2_messages.h"
 
 #include <dds/dds.h>
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -240,7 +242,14 @@ TEST(Ros2Config, DemoKeysAndRefusals) {
 }
 
 // ------------------------------------------------------------------------------------ the bridge on DDS
-constexpr int kDomain = 42;
+// ctest runs each test in its own process, two at a time: each test its own domain, or they would
+// see each other's topics.
+int test_domain() {
+  const std::string name = ::testing::UnitTest::GetInstance()->current_test_info()->name();
+  if (name == "PublishesSnapshots") return 42;
+  if (name == "TakesCheckedInputs") return 45;
+  return 46;
+}
 
 template <class Done>
 bool wait_until(double timeout_s, Done done) {
@@ -265,12 +274,12 @@ protected:
     model_ = std::make_unique<Model>(Model::from_urdf_file(std::string(PHRI_SOURCE_DIR) + "/robots/kinova_gen3/gen3.urdf"));
     Ros2Settings s;
     s.enabled = true;
-    s.domain = kDomain;
+    s.domain = test_domain();
     s.joint_states_decimation = 1;
     s.decimation = 1;
     s.max_input_rate_hz = 1000.0;
     bridge_ = std::make_unique<Ros2Bridge>(s, *model_, model_->frame_id("end_effector_link"));
-    participant_ = dds_create_participant(kDomain, nullptr, nullptr);
+    participant_ = dds_create_participant(test_domain(), nullptr, nullptr);
     ASSERT_GT(participant_, 0);
     dds_qos_t* qos = reliable_qos();
     joints_ = dds_create_reader(participant_, topic(&sensor_msgs_msg_dds__JointState__desc, "rt/joint_states"), qos, nullptr);
@@ -392,6 +401,53 @@ TEST_F(BridgeOnDds, TakesCheckedInputs) {
   const Ros2BridgeStats st = bridge_->stats();
   EXPECT_EQ(st.refused[static_cast<std::size_t>(InputRefusal::kNotFinite)], 1u);
   EXPECT_EQ(st.refused[static_cast<std::size_t>(InputRefusal::kUnknownEvent)], 1u);
+}
+
+// The control thread's side of the bridge (snapshots out, commands in, the F/T sample) allocates
+// nothing and never waits, while another participant floods /phri/target_pose: the flood is
+// refused at the rate limit on the bridge's thread and the loop's queue only sees what passed.
+TEST_F(BridgeOnDds, ControlSideAllocatesNothingUnderAFlood) {
+  std::atomic<bool> flooding{true};
+  std::atomic<int> sent{0};
+  std::thread flood([&] {
+    geometry_msgs_msg_dds__PoseStamped_ pose{};
+    char world[] = "world";
+    pose.header.frame_id = world;
+    pose.pose.position = {0.4, 0.1, 0.3};
+    pose.pose.orientation = {0.0, 0.0, 0.0, 1.0};
+    while (flooding) {
+      dds_write(target_, &pose);
+      ++sent;
+    }
+  });
+  FakeRobot fake;
+  FtInRobot robot(fake, bridge_->ft_in(), 16);
+  LiveSnapshot s;
+  s.dof = 7;
+  int commands = 0, published = 0;
+  const auto t0 = std::chrono::steady_clock::now();
+  {
+    const test::AllocationCounter count;
+    for (int k = 0; k < 1000; ++k) {  // one second of 1 kHz cycles
+      s.row.cycle = k;
+      published += bridge_->observer().publish(s) ? 1 : 0;
+      for (LiveCommand c; bridge_->input().receive(c);) ++commands;
+      robot.read();
+      std::this_thread::sleep_for(std::chrono::microseconds(1000));
+    }
+    EXPECT_EQ(count.allocations(), 0u);
+  }
+  const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  flooding = false;
+  flood.join();
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  for (LiveCommand c; bridge_->input().receive(c);) ++commands;
+  const Ros2BridgeStats st = bridge_->stats();
+  EXPECT_GT(sent.load(), 10000);
+  EXPECT_GT(st.refused[static_cast<std::size_t>(InputRefusal::kTooFast)], 1000u);
+  EXPECT_LE(commands, 1000.0 * (elapsed + 0.1) + 1);  // max_input_rate_hz = 1000 in this fixture
+  EXPECT_EQ(static_cast<std::uint64_t>(commands), st.targets);
+  EXPECT_GT(published, 900);  // the bridge kept up: at most a few snapshots dropped
 }
 
 }  // namespace
