@@ -105,6 +105,10 @@ Ros2Run::Ros2Run(const phri::Ros2Settings& settings, const phri::Controller& cyc
   out << "phri ros2: DDS domain " << impl_->bridge.domain() << ", " << settings.discovery << " discovery, /joint_states every "
       << settings.joint_states_decimation << " cycles, the rest every " << settings.decimation << "\n";
   for (const std::string& topic : impl_->bridge.wire_topics()) out << "  " << topic << "\n";
+  if (settings.subscribe) {
+    out << "phri ros2: targets within " << impl_->bridge.input_limits().max_reach_m << " m of the base, inputs at most "
+        << settings.max_input_rate_hz << " per second and topic\n";
+  }
   options.observers.push_back(&impl_->bridge.observer());
   if (settings.subscribe) options.inputs.push_back(&impl_->bridge.input());
   impl_->bridge.start();

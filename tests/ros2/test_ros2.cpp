@@ -26,6 +26,7 @@
 #include <limits>
 #include <fstream>
 #include <map>
+#include <random>
 #include <tuple>
 #include <vector>
 #include <memory>
@@ -96,6 +97,33 @@ TEST(InputGate, RateLimitAcceptsExactlyMaxRate) {
   }
   EXPECT_EQ(accepted, 50);  // t = 0, 0.02, ..., 0.98
   EXPECT_EQ(gate.refused(InputRefusal::kTooFast), 100000u - 50u);
+}
+
+// The reach bound against forward kinematics: no configuration of the Gen3 within its joint limits
+// puts the end effector beyond it, and it is not loose by more than the arm's folded-in offsets.
+TEST(InputGate, ReachBoundsForwardKinematics) {
+  const Model model = Model::from_urdf_file(std::string(PHRI_SOURCE_DIR) + "/robots/kinova_gen3/gen3.urdf");
+  const int ee = model.frame_id("end_effector_link");
+  const double reach = arm_reach_m(model, ee);
+  Data data(model);
+  std::mt19937 rng(41);
+  double farthest = 0.0;
+  Eigen::VectorXd q(model.nq());
+  for (int k = 0; k < 20000; ++k) {
+    for (int i = 0; i < model.nq(); ++i) {
+      const Joint& j = model.joint(i);
+      const double lo = j.has_position_limits() ? j.lower : -M_PI, hi = j.has_position_limits() ? j.upper : M_PI;
+      q[i] = std::uniform_real_distribution<double>(lo, hi)(rng);
+    }
+    forward_kinematics(model, data, q);
+    update_frame_placements(model, data);
+    const Eigen::Vector3d p = data.frame_placements[static_cast<std::size_t>(ee)].translation() - model.base_placement().translation();
+    farthest = std::max(farthest, p.norm());
+  }
+  EXPECT_LE(farthest, reach);
+  EXPECT_GT(farthest, 0.8 * reach);  // not loose: stretched out, the Gen3 reaches 1.1865 m of the 1.1878 m bound
+  RecordProperty("reach_m", std::to_string(reach));
+  RecordProperty("farthest_sampled_m", std::to_string(farthest));
 }
 
 TEST(InputGate, EventsByName) {

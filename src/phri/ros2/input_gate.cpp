@@ -4,6 +4,12 @@
 
 namespace phri {
 
+double arm_reach_m(const Model& model, int ee_frame) {
+  double reach = 0.0;
+  for (const Joint& j : model.joints()) reach += j.placement.translation().norm();
+  return reach + model.frame(ee_frame).placement.translation().norm();
+}
+
 std::uint64_t InputGate::refused_total() const {
   std::uint64_t n = 0;
   for (std::size_t i = 1; i < refused_.size(); ++i) n += refused_[i];

@@ -16,6 +16,7 @@
 // Refused input changes nothing and is counted by reason (the bridge's /phri/status reports them).
 #include <phri/app/live_channel.hpp>
 #include <phri/config/event.hpp>
+#include <phri/model/model.hpp>
 
 #include <Eigen/Geometry>
 
@@ -63,6 +64,11 @@ struct PoseInput {
   std::array<double, 3> position{};
   std::array<double, 4> orientation_xyzw{0.0, 0.0, 0.0, 1.0};
 };
+
+/// The arm's reach from its base, bounded from above: the lengths of the joint offsets along the
+/// chain plus the end-effector frame's offset on its link (no configuration puts the end effector
+/// farther from the base than their sum).
+double arm_reach_m(const Model& model, int ee_frame);
 
 class InputGate {
 public:

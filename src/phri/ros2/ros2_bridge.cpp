@@ -84,10 +84,10 @@ struct Ros2Bridge::Impl {
         ee_frame(ee),
         observer(SnapshotChannelSettings{std::min(s.joint_states_decimation, s.decimation), 256}),
         input(LiveChannelSettings{1, 64, 1, 0.5}),
-        gate(input_limits(s, m)),
+        gate(input_limits(s, m, ee)),
         q(Eigen::VectorXd::Zero(m.nq())) {}
 
-  static InputLimits input_limits(const Ros2Settings& s, const Model& m);
+  static InputLimits input_limits(const Ros2Settings& s, const Model& m, int ee_frame);
   void open();
   void close();
   dds_entity_t writer(const dds_topic_descriptor_t* type, const std::string& ros_name, Ros2Topic topic, bool latched = false);
@@ -145,16 +145,12 @@ struct Ros2Bridge::Impl {
   Ros2BridgeStats stats;
 };
 
-InputLimits Ros2Bridge::Impl::input_limits(const Ros2Settings& s, const Model& m) {
+InputLimits Ros2Bridge::Impl::input_limits(const Ros2Settings& s, const Model& m, int ee_frame) {
   InputLimits limits;
   limits.base_frame = m.base_link();
   limits.base_in_world = m.base_placement();
   limits.max_rate_hz = s.max_input_rate_hz;
-  // The arm's reach, bounded from above: the lengths of the joint offsets along the chain (every
-  // point the end effector reaches is closer to the base than their sum) plus the tool's offset.
-  double reach = 0.0;
-  for (const Joint& j : m.joints()) reach += j.placement.translation().norm();
-  limits.max_reach_m = s.max_reach_m > 0.0 ? s.max_reach_m : reach;
+  limits.max_reach_m = s.max_reach_m > 0.0 ? s.max_reach_m : arm_reach_m(m, ee_frame);
   return limits;
 }
 
@@ -521,6 +517,7 @@ SnapshotChannel& Ros2Bridge::observer() { return impl_->observer; }
 LiveChannel& Ros2Bridge::input() { return impl_->input; }
 TripleBuffer<FtInSample>& Ros2Bridge::ft_in() { return impl_->ft_buffer; }
 int Ros2Bridge::domain() const { return impl_->domain_id; }
+const InputLimits& Ros2Bridge::input_limits() const { return impl_->gate.limits(); }
 const Ros2Settings& Ros2Bridge::settings() const { return impl_->settings; }
 
 std::vector<std::string> Ros2Bridge::wire_topics() const {

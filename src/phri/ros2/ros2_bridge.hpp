@@ -75,6 +75,8 @@ public:
 
   int domain() const;
   const Ros2Settings& settings() const;
+  /// What /phri/target_pose is checked against (reach, rate).
+  const InputLimits& input_limits() const;
   /// "rt/joint_states sensor_msgs::msg::dds_::JointState_" ... (what a DDS tool sees).
   std::vector<std::string> wire_topics() const;
   /// Counts so far (exact once stop() returned).
