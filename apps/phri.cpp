@@ -2,6 +2,7 @@
 //   phri run --config FILE [--robot DIR] [--lockstep|--realtime] [--duration S] [--out DIR]
 //            [--dashboard [--port P] [--bind ADDR] [--push-max N]]
 //            [--backend sim|kortex|kortex-emulator [--ip ADDR] [--ft-serial DEV] [--dry-run]]
+//            [--ros2 [--ros-domain N] [--ros-namespace NS]]  (ros2_cli.cpp, docs/ros2.md)
 //                                              a session: simulated arm (or the Gen3 through the
 //                                              Kortex backend, kortex_backend.cpp), FSM, gamepad,
 //                                              log, figure, and the live dashboard in a browser
@@ -16,7 +17,9 @@
 //   phri experiment iso9283 [options]          ISO 9283 pose accuracy and repeatability per loop
 //   phri evaluate [--out DIR] [--quick]        all five of the paper's evaluations and report.md/.html
 //   phri experiment dashboard-load [options]   loop cycle time with vs without the dashboard and its clients
+//   phri experiment ros2-load [options]        loop cycle time with vs without the ROS 2 bridge, F/T round trip (ros2_cli.cpp)
 //   phri ft-monitor [--device DEV | --emulate] the Bota F/T sensor's wrench and counters (apps/ft_monitor.cpp)
+//   phri ft-bridge [--device DEV | --emulate] the Bota F/T sensor published on ROS 2 /phri/ft_in (apps/ft_bridge.cpp)
 // Every bad argument or file, and every failure of a run or an experiment (phri::Error: ConfigError,
 // IoError, ExperimentError), gives one line on stderr naming what is wrong and exit status 2.
 // `phri run` exits 0, 3 after a safe hold, and 128 + the signal's number (130 SIGINT, 143 SIGTERM)
@@ -25,6 +28,7 @@
 #include "exit_status.hpp"
 #include "ft_monitor.hpp"
 #include "kortex_backend.hpp"
+#include "ros2_cli.hpp"
 
 #include <phri/app/sim_backend.hpp>
 #include <phri/app/loop_clock.hpp>
@@ -270,6 +274,7 @@ struct RunArguments {
   std::string out_dir = "out";
   bool figure = true;
   KortexArguments kortex;
+  Ros2Arguments ros2;
 };
 
 // The generated plant's warnings (none for a hand-written MJCF).
@@ -306,6 +311,7 @@ int run_command(const RunArguments& args) {
   if (args.lockstep) config.run.pacing = phri::LoopClock::Pacing::kLockstep;
   if (args.real_time) config.run.pacing = phri::LoopClock::Pacing::kRealTime;
   if (args.duration_s > 0.0) config.run.duration_s = args.duration_s;
+  apply_ros2_arguments(args.ros2, config.ros2, config.run.pacing == phri::LoopClock::Pacing::kLockstep);
   phri::ensure_output_directory(args.out_dir);
   const std::filesystem::path out(args.out_dir);
   config.logging.path = (out / std::filesystem::path(config.logging.path).filename()).string();
@@ -358,10 +364,13 @@ int run_command(const RunArguments& args) {
   options.real_time = config.run.pacing == phri::LoopClock::Pacing::kRealTime;
   options.phases.push_back({0.0, "startup"});
   for (const phri::TimedEvent& e : config.fsm.timeline) options.phases.push_back({e.time_s, std::string(phri::to_string(e.event))});
-  const phri::RunSummary summary = phri::run_session(robot, cycle, fsm, gamepad.get(), logger ? &*logger : nullptr, options, std::cout);
+  const std::unique_ptr<Ros2Run> ros2 = Ros2Run::start_if_enabled(config.ros2, cycle, options, std::cout);
+  phri::RobotInterface& driven = ros2 ? ros2->robot(robot) : robot;
+  const phri::RunSummary summary = phri::run_session(driven, cycle, fsm, gamepad.get(), logger ? &*logger : nullptr, options, std::cout);
   if (gamepad) gamepad->stop();
   if (dashboard) dashboard->stop();
   std::printf("\n");
+  if (ros2) ros2->finish(std::cout);
   if (const std::string report = backend->report(); !report.empty()) std::printf("%s\n", report.c_str());
   phri::print_run_summary(summary, std::cout);
   std::ostringstream md;
@@ -452,6 +461,7 @@ CLI::App* add_run_command(CLI::App& app, RunArguments& args) {
       ->check(CLI::Range(1.0, 1000.0))->needs(dashboard)->capture_default_str();
   run->add_option("--web-root", args.dashboard.web_root, "folder of the dashboard's page (default: web/)")
       ->needs(dashboard)->check(CLI::ExistingDirectory);
+  add_ros2_options(*run, args.ros2);
   return run;
 }
 
@@ -845,6 +855,7 @@ int main(int argc, char** argv) {
   const CLI::App* tracking = add_torque_tracking_command(*experiment, tracking_args);
   const CLI::App* fuzz = add_safety_fuzz_command(*experiment, fuzz_args);
   const CLI::App* load = add_dashboard_load_command(*experiment, load_args);
+  Ros2Commands ros2_commands(app, *experiment);  // ft-bridge, experiment ros2-load
   auto* friction_alias = experiment->add_subcommand("friction-identification", "Same as 'phri identify-friction'");
   friction_alias->add_option("--out", friction.output_dir, "output folder");
   friction_alias->add_option("--seed", friction.seed, "seed");
@@ -876,6 +887,7 @@ int main(int argc, char** argv) {
     if (info->parsed()) return info_command(info_args);
     if (fit_collision->parsed()) return fit_collision_command(fit_args);
     if (ft_monitor->parsed()) return ft_monitor_command(ft_args);
+    if (ros2_commands.parsed()) return ros2_commands.run();
     if (identify->parsed() || friction_alias->parsed()) return friction_identification_command(friction);
     if (tracking->parsed()) return torque_tracking_command(tracking_args);
     if (fuzz->parsed()) return safety_fuzz_command(fuzz_args);

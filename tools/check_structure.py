@@ -36,6 +36,7 @@ MODULE_DEPENDENCIES = {
     "app": ["config", "control", "trajectory", "sim"],
     "experiments": ["app", "control", "sim"],
     "dashboard": ["app"],
+    "ros2": ["app"],
 }
 
 INCLUDE = re.compile(r'^\s*#\s*include\s*[<"]phri/([A-Za-z0-9_]+)/', re.M)

@@ -73,6 +73,7 @@ Fsm::Fsm(const FsmSettings& settings, const Controller& cycle)
       ee_frame_(cycle.end_effector_frame()),
       queue_(settings.queue_capacity),
       gain_queue_(settings.queue_capacity),
+      target_queue_(settings.queue_capacity),
       targets_(model_.nv()),
       after_startup_(settings.first_scenario),
       torque_loop_(settings.torque_loop),
@@ -110,6 +111,36 @@ bool Fsm::post(const GainRequest& request) noexcept {
   if (gain_queue_.try_push(request)) return true;
   ++events_dropped_;
   return false;
+}
+
+bool Fsm::post(const LiveTarget& target) noexcept {
+  if (target_queue_.try_push(target)) return true;
+  ++targets_refused_;
+  return false;
+}
+
+// The latest queued target becomes the end effector's while a pose is held; a move, a brake, the
+// dynamic scenario or the start-up own the reference, so a target then is refused.
+void Fsm::take_targets() {
+  bool any = false;
+  LiveTarget latest;
+  for (LiveTarget t; target_queue_.try_pop(t);) {
+    if (any) ++targets_refused_;  // superseded in the same cycle
+    latest = t;
+    any = true;
+  }
+  if (!any) return;
+  if ((state_ != FsmState::kStatic && state_ != FsmState::kStopped) || motion_ != Motion::kHold) {
+    ++targets_refused_;
+    return;
+  }
+  targets_.has_pose = true;
+  targets_.pose.pose = Eigen::Isometry3d::Identity();
+  targets_.pose.pose.linear() = latest.orientation.normalized().toRotationMatrix();
+  targets_.pose.pose.translation() = latest.position;
+  targets_.pose.velocity.setZero();
+  targets_.pose.acceleration.setZero();
+  ++targets_taken_;
 }
 
 double Fsm::joint_speed(const RobotState& state) const {
@@ -163,6 +194,7 @@ const ControllerTargets& Fsm::update(double t, const RobotState& state, const Co
     }
   }
   run_motion(t, cycle);
+  take_targets();
   finished_ = stop_requested_ && state_ == FsmState::kStopped && !braking() &&
               joint_speed(state) < settings_.rest_speed_rad_s;
   return targets_;

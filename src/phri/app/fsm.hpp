@@ -38,6 +38,7 @@
 // update() allocates nothing and never throws; construction checks the settings (ConfigError).
 #include <phri/control/controller.hpp>
 #include <phri/config/event.hpp>
+#include <phri/app/live_channel.hpp>
 #include <phri/app/live_gain.hpp>
 #include <phri/config/fsm_settings.hpp>
 #include <phri/trajectory/joint_move.hpp>
@@ -73,6 +74,13 @@ public:
   /// Queues a live gain change (the dashboard's sliders) for the next update, which writes it
   /// into the targets; same thread rule and refusal as post(Event).
   bool post(const GainRequest& request) noexcept;
+  /// Queues an end-effector target (the ROS 2 bridge's, checked there); the next update takes the
+  /// latest one while the FSM holds a pose (static or stopped, no move or brake running) and
+  /// refuses it otherwise (counted): the controller's reference governor then moves the target to
+  /// it at a bounded speed. Same thread rule as post(Event).
+  bool post(const LiveTarget& target) noexcept;
+  std::uint64_t targets_taken() const { return targets_taken_; }
+  std::uint64_t targets_refused() const { return targets_refused_; }
   /// Once per period, before controller.step(state, targets, ...). `time_s`: robot time (the
   /// timeline's clock). Returns this period's targets (also targets()).
   const ControllerTargets& update(double time_s, const RobotState& state, const Controller& controller);
@@ -111,6 +119,7 @@ private:
   void hold_when_done(double t, bool done);
   void stream_joint_reference();
   void stream_pose_reference();
+  void take_targets();
   double joint_speed(const RobotState& state) const;
   // Targets as the controller will hold them: the posture given so far in this update, else the
   // controller's; the end effector's governed target of the last cycle.
@@ -125,6 +134,9 @@ private:
   int ee_frame_;
   SpscRing<Event> queue_;
   SpscRing<GainRequest> gain_queue_;
+  SpscRing<LiveTarget> target_queue_;
+  std::uint64_t targets_taken_ = 0;
+  std::uint64_t targets_refused_ = 0;
   ControllerTargets targets_;
   std::size_t next_timed_ = 0;
 

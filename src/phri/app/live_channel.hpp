@@ -17,6 +17,7 @@
 #include <phri/core/spsc_ring.hpp>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 #include <atomic>
 #include <cstdint>
@@ -24,10 +25,18 @@
 
 namespace phri {
 
+/// An end-effector target from outside (the ROS 2 bridge's /phri/target_pose), checked by its
+/// sender (finite, unit quaternion, within reach and rate); the FSM takes it while it holds a pose.
+struct LiveTarget {
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();             ///< world [m]
+  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();  ///< unit
+};
+
 struct LiveCommand {
-  enum class Kind : std::uint8_t { kEvent, kGain, kPush, kRelease, kRun, kPause, kStep };
+  enum class Kind : std::uint8_t { kEvent, kGain, kPush, kRelease, kRun, kPause, kStep, kTarget };
   Kind kind = Kind::kEvent;
   Event event = Event::kStop;  ///< kEvent
+  LiveTarget target;           ///< kTarget
   GainRequest gain;            ///< kGain
   LivePush push;               ///< kPush: replaces the push applied so far
   int steps = 1;               ///< kStep: cycles to run before pausing again

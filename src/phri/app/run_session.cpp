@@ -86,6 +86,7 @@ public:
     std::size_t k = 0;
     for (; k < max_cycles_; ++k) {
       if (live_) take_live_commands();
+      for (LiveChannel* input : options_.inputs) take_input_commands(*input);
       const RobotState& state = robot_.read();
       const double t = state.time_s;
       enter_phases(t, k);
@@ -181,9 +182,18 @@ private:
     if (waited) clock_.start();
   }
 
+  // Events and targets of a further source (RunOptions::inputs); the rest is not theirs to ask.
+  void take_input_commands(LiveChannel& input) {
+    for (LiveCommand c; input.receive(c);) {
+      if (c.kind == LiveCommand::Kind::kEvent) fsm_.post(c.event);
+      if (c.kind == LiveCommand::Kind::kTarget) fsm_.post(c.target);
+    }
+  }
+
   void handle_live(const LiveCommand& c) {
     switch (c.kind) {
       case LiveCommand::Kind::kEvent: fsm_.post(c.event); break;
+      case LiveCommand::Kind::kTarget: fsm_.post(c.target); break;
       case LiveCommand::Kind::kGain: fsm_.post(c.gain); break;
       case LiveCommand::Kind::kPush: start_push(c.push); break;
       case LiveCommand::Kind::kRelease: end_push(); break;

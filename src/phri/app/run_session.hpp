@@ -53,6 +53,11 @@ struct RunOptions {
   /// gets every `decimation`-th cycle's snapshot through its own lock-free ring; a full ring drops
   /// the snapshot, so none can block or slow the cycle. Each must outlive the run.
   std::vector<SnapshotChannel*> observers;
+  /// Further sources of commands besides `live` (the ROS 2 bridge): their events and end-effector
+  /// targets are taken at the start of each cycle like the live front end's; anything else they
+  /// send (pushes, pause) is ignored. Each must outlive the run; feed its snapshots through
+  /// `observers`.
+  std::vector<LiveChannel*> inputs;
   /// A stop asked from outside the loop (apps/phri.cpp: SIGINT, SIGTERM), or null. Loaded once a
   /// cycle (no wait, no allocation); once true, the run ends after that cycle as if its duration had
   /// run out, with RunSummary::interrupted set.

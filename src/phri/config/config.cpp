@@ -534,6 +534,24 @@ void parse_run(const YamlReader& r, RunSettings& s) {
   }
 }
 
+void parse_ros2(const YamlReader& r, Ros2Settings& s) {
+  r.allow_keys({"enabled", "domain", "namespace", "joint_states_decimation", "decimation", "subscribe",
+                "max_input_rate_hz", "max_reach_m", "discovery", "ft_in"});
+  s.enabled = r.boolean_or("enabled", s.enabled);
+  s.domain = static_cast<int>(r.integer_or("domain", s.domain, -1, 232));
+  s.topic_namespace = r.text_or("namespace", s.topic_namespace);
+  if (!valid_ros_namespace(s.topic_namespace)) {
+    throw r.error("namespace", "a ROS 2 namespace such as /phri ('/' then [A-Za-z0-9_] segments), got '" + s.topic_namespace + "'");
+  }
+  s.joint_states_decimation = static_cast<int>(r.integer_or("joint_states_decimation", s.joint_states_decimation, 1, 100000));
+  s.decimation = static_cast<int>(r.integer_or("decimation", s.decimation, 1, 100000));
+  s.subscribe = r.boolean_or("subscribe", s.subscribe);
+  s.ft_in = r.boolean_or("ft_in", s.ft_in);
+  s.max_input_rate_hz = positive_or(r, "max_input_rate_hz", s.max_input_rate_hz, 1000.0);
+  s.max_reach_m = non_negative_or(r, "max_reach_m", s.max_reach_m, 10.0);
+  if (r.has("discovery")) s.discovery = r.choice("discovery", {"loopback", "network"});
+}
+
 // The robot: a bundle's folder (a scalar, or `robot_folder` from the command line), or the map of files.
 std::optional<RobotBundle> parse_robot_section(const YamlReader& root, const std::string& base_dir,
                                                const std::string& robot_folder, ControllerSettings& c) {
@@ -559,7 +577,7 @@ std::optional<RobotBundle> parse_robot_section(const YamlReader& root, const std
 
 Config parse(const YamlReader& root, const std::string& base_dir, const std::string& robot_folder = "") {
   const std::string& source = root.file();
-  root.allow_keys({"robot", "plant", "controller", "low_level", "fsm", "events", "logging", "gamepad", "run"});
+  root.allow_keys({"robot", "plant", "controller", "low_level", "fsm", "events", "logging", "gamepad", "run", "ros2"});
   Config c;
   c.source = source;
 
@@ -605,6 +623,7 @@ Config parse(const YamlReader& root, const std::string& base_dir, const std::str
   c.logging.dof = std::min(dof, kLogMaxJoints);
   if (root.has("gamepad")) parse_gamepad(root.at("gamepad"), c.gamepad);
   if (root.has("run")) parse_run(root.at("run"), c.run);
+  if (root.has("ros2")) parse_ros2(root.at("ros2"), c.ros2);
   if (root.has("events")) c.fsm.timeline = parse_events(root.at("events"), c.run.duration_s, c.controller.offered_loops);
   check_config_against_robot(c);
   return c;

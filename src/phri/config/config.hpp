@@ -45,6 +45,8 @@
 //   logging:     enabled, path, buffer_rows, legend                           -> LoggerSettings
 //   gamepad:     enabled, poll_interval_ms, trigger_press, trigger_release    -> GamepadSettings
 //   run:         duration_s, pacing (real_time | lockstep)                    -> RunSettings
+//   ros2:        enabled, domain, namespace, joint_states_decimation, decimation, subscribe,
+//                max_input_rate_hz, max_reach_m, discovery (loopback | network), ft_in -> Ros2Settings
 //
 // Validation at load: unknown keys, duplicate keys, explicit nulls, wrong types, values outside
 // their physical range and inconsistent pairs are a phri::ConfigError naming the file and the key
@@ -59,6 +61,7 @@
 #include <phri/config/fsm_settings.hpp>
 #include <phri/config/gamepad_settings.hpp>
 #include <phri/config/logger_settings.hpp>
+#include <phri/config/ros2_settings.hpp>
 #include <phri/config/run_settings.hpp>
 #include <phri/config/sim_robot_config.hpp>
 #include <phri/control/controller_settings.hpp>
@@ -85,6 +88,7 @@ struct Config {
   LoggerSettings logging;
   GamepadSettings gamepad;
   RunSettings run;
+  Ros2Settings ros2;
 };
 
 }  // namespace phri
