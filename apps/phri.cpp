@@ -694,6 +694,12 @@ const CLI::App* add_dynamic_tracking_command(CLI::App& experiment, phri::TorqueT
   return dynamic;
 }
 
+const CLI::App* add_dual_compliance_command(CLI::App& experiment, phri::DualComplianceOptions& options) {
+  auto* dual = experiment.add_subcommand("dual-compliance", "Guide the end effector by hand in dual compliance, release");
+  dual->add_option("--out", options.output_dir, "output folder")->capture_default_str();
+  return dual;
+}
+
 struct Iso9283Arguments {
   phri::Iso9283Options options;
   std::vector<std::string> loops;
@@ -861,8 +867,7 @@ int main(int argc, char** argv) {
   friction_alias->add_option("--seed", friction.seed, "seed");
   const CLI::App* drop = add_drop_test_command(*experiment, drop_args);
   const CLI::App* dynamic = add_dynamic_tracking_command(*experiment, dynamic_options);
-  auto* dual = experiment->add_subcommand("dual-compliance", "Guide the end effector by hand in dual compliance, release");
-  dual->add_option("--out", dual_options.output_dir, "output folder")->capture_default_str();
+  const CLI::App* dual = add_dual_compliance_command(*experiment, dual_options);
   Iso9283Arguments iso_args;
   const CLI::App* iso = add_iso9283_command(*experiment, iso_args);
   auto* evaluate = app.add_subcommand("evaluate", "The paper's five evaluations and a report (report.md, report.html)");
