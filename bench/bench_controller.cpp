@@ -7,6 +7,7 @@
 // the same states in the same run, the safety supervisor's plausibility check alone (a second
 // StateSupervisor built like the controller's: supervisor_median_us, the part of the cycle it adds):
 //   build/release/bench/phri_bench --benchmark_filter=ControllerCycle
+// ControllerCyclePowerForceLimit: the same with the power-and-force limit off and on.
 #include <phri/config/robot_bundle.hpp>
 #include <phri/control/controller.hpp>
 #include <phri/control/singular_direction_weight.hpp>
@@ -18,11 +19,13 @@
 
 #include <algorithm>
 #include <chrono>
+#include <functional>
 #include <vector>
 
 namespace {
 
-void ControllerCycle(benchmark::State& state) {
+// The closed-loop run above with `configure` applied to the controller's settings.
+void time_cycles(benchmark::State& state, const std::function<void(phri::ControllerSettings&)>& configure) {
   const std::string root = PHRI_SOURCE_DIR;
   phri::SimRobotConfig plant = phri::SimRobotConfig::from_yaml_file(root + "/configs/plant_gen3.yaml");
   plant.initial_q_rad = {0, 0.58, 3.14, -1.84, 0, 0.85, 1.57};
@@ -46,9 +49,7 @@ void ControllerCycle(benchmark::State& state) {
   phri::ControllerSettings settings;
   phri::RobotBundle::from_folder(root + "/robots/kinova_gen3").apply_to(settings);  // files, frames, end of arm
   settings.initial_compliance = phri::ComplianceMode::kDual;
-  // Arg: the end-effector task's singular-value threshold in thousandths (30: the default; 0: the
-  // paper's task, for the cost of the weight's test in one run).
-  settings.qp.singular_value_threshold = static_cast<double>(state.range(0)) / 1000.0;
+  configure(settings);
   phri::Controller cycle(settings);
   phri::RobotCommand command(robot.dof());
 
@@ -77,7 +78,25 @@ void ControllerCycle(benchmark::State& state) {
   state.counters["supervisor_p99_us"] = phri::percentile(supervisor_micros, 0.99);
   state.counters["implausible"] = static_cast<double>(cycle.supervisor().implausible_samples());
 }
+void ControllerCycle(benchmark::State& state) {
+  // Arg: the end-effector task's singular-value threshold in thousandths (30: the default; 0: the
+  // paper's task, for the cost of the weight's test in one run).
+  time_cycles(state, [&](phri::ControllerSettings& s) { s.qp.singular_value_threshold = state.range(0) / 1000.0; });
+}
 BENCHMARK(ControllerCycle)->Arg(30)->Arg(0)->Iterations(1)->Unit(benchmark::kMillisecond);
+
+// The same run with the power-and-force-limiting constraint (control/power_force_limit.hpp) off
+// (Arg 0) and on (Arg 1, the hand/fingers region of configs/iso_ts_15066_regions.yaml: k 75 N/mm,
+// m_H 0.6 kg, F_QS 140 N, transient x2): its cost, same run.
+void ControllerCyclePowerForceLimit(benchmark::State& state) {
+  time_cycles(state, [&](phri::ControllerSettings& s) {
+    if (state.range(0) == 0) return;
+    phri::PowerForceLimitSettings limit;
+    limit.region = {"hand_fingers", 75e3, 0.6, 140.0, 2.0};
+    s.qp.power_force_limit = limit;
+  });
+}
+BENCHMARK(ControllerCyclePowerForceLimit)->Arg(0)->Arg(1)->Iterations(1)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 
