@@ -1,6 +1,6 @@
 """The report of `phri evaluate`: report.md and a self-contained report.html (figures inline, base64 PNG).
 
-Usage: evaluation_report.py OUTPUT_DIR (quick|full) WALL_SECONDS
+Usage: evaluation_report.py OUTPUT_DIR (quick|full) WALL_SECONDS [PARAMETER_FILE.yaml ...]
 
 Reads what the five evaluations wrote into OUTPUT_DIR (friction_identification/, torque_tracking/,
 drop_test/, sensitivity/*/, dynamic_tracking/, dual_compliance/), draws the figures the experiments
@@ -21,6 +21,7 @@ from drop_test_figure import draw as draw_drop  # noqa: E402
 from drop_test_figure import drop_statistics, fmt, statistics_table  # noqa: E402
 from verdicts import MIN_VALID, claim_paragraph, outcome  # noqa: E402
 from report_common import plt, read_rows, save_figure  # noqa: E402
+from parameter_sources import markdown_table, parameter_rows  # noqa: E402
 
 # The paper's friction model, eq. friction-model: tau_f = Fc sign(qd) + Fv qd.
 PAPER_FRICTION = {"large": (2.15, 2.00), "small": (1.60, 1.36)}
@@ -396,8 +397,21 @@ def validity_header(rep, out, sensitivity):
     rep.p(text)
 
 
+def parameters_section(rep, files):
+    """Every parameter of the plant and drive files with its value and source (parameter_sources.py)."""
+    rep.h(2, "Parameters and their sources")
+    rep.p("Read from the files' own comments: a bracketed tag names a source ([PAPER], [DEMO x] the paper's code, "
+          "[KORTEX], [BOTA], [OURS]), ESTIMATE is our choice argued in the comment, a setting is a switch, name or "
+          "seed; 'no source' is what it says. Protocol parameters of each experiment are stated in its section.")
+    for path in files:
+        rows = parameter_rows(path)
+        lines = markdown_table(os.path.relpath(path), rows).split("\n")
+        rep.p(lines[0])
+        rep.table("\n".join(lines[2:]))
+
+
 def main(argv):
-    if len(argv) != 4:
+    if len(argv) < 4:
         print(__doc__)
         return 2
     out, mode, seconds = argv[1], argv[2], float(argv[3])
@@ -410,6 +424,7 @@ def main(argv):
           "elasticity (plant.elasticity).")
     sensitivity = sensitivity_statistics(out)
     validity_header(rep, out, sensitivity)
+    parameters_section(rep, argv[4:])
     friction_section(rep, out)
     torque_tracking_section(rep, out)
     drop_section(rep, out, sensitivity)

@@ -188,8 +188,11 @@ int run_evaluation_command(const EvaluationOptions& o, std::ostream& out) {
   dual_compliance(o, out);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   out << "== report" << std::endl;
+  // The report lists every parameter of the files the evaluations read, with its source.
   const bool ok = run_figure_script(in_root(o, o.report_script),
-                                    {o.output_dir, o.quick ? "quick" : "full", format_fixed(seconds, 1)}, out);
+                                    {o.output_dir, o.quick ? "quick" : "full", format_fixed(seconds, 1),
+                                     in_root(o, "configs/plant_gen3.yaml"), in_root(o, "robots/kinova_gen3/actuators.yaml")},
+                                    out);
   out << (ok ? "wrote " + output_path(o.output_dir, "report.md") + " and " + output_path(o.output_dir, "report.html")
              : std::string("the report script failed"))
       << std::endl;
