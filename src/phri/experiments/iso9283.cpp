@@ -126,6 +126,7 @@ struct LoopRun {
     if (measuring) {
       if (cycle.status() != CycleStatus::kOk && bad_cycles++ == 0) first_bad = cycle.status();
       if (cycle.low_level().loop() != loop) ++other_loop_cycles;
+      if (cycle.compliance().mode() != ComplianceMode::kStiff) ++other_mode_cycles;
     }
     t += dt;
   }
@@ -168,10 +169,12 @@ struct LoopRun {
     return a;
   }
 
-  // Empty when the run counts: every measured cycle ok and in the loop it names, no refused write.
+  // Empty when the run counts: every measured cycle ok, in stiff mode and in the loop it names, no
+  // refused write.
   std::string invalid_reason() const {
     std::ostringstream why;
     if (other_loop_cycles > 0) why << other_loop_cycles << " cycles not in the " << to_string(loop) << " loop; ";
+    if (other_mode_cycles > 0) why << other_mode_cycles << " cycles not in stiff mode; ";
     if (bad_cycles > 0) why << bad_cycles << " cycles not ok (first: " << to_string(first_bad) << "); ";
     if (refused > 0) why << refused << " refused writes; ";
     std::string text = why.str();
@@ -189,7 +192,7 @@ struct LoopRun {
   Data truth;
   double dt;
   double t = 0.0;
-  long bad_cycles = 0, other_loop_cycles = 0, refused = 0;
+  long bad_cycles = 0, other_loop_cycles = 0, other_mode_cycles = 0, refused = 0;
   CycleStatus first_bad = CycleStatus::kOk;
 };
 

@@ -112,25 +112,28 @@ namespace {
 const Eigen::Isometry3d& placement_of(const Model& model, const Data& data, int body) {
   return body < 0 ? model.base_placement() : data.body_placements[static_cast<std::size_t>(body)];
 }
-}  // namespace
 
-namespace {
 const Eigen::Vector3d kZero = Eigen::Vector3d::Zero();
 
-// The end points of a capsule's axis in the world.
-std::pair<Eigen::Vector3d, Eigen::Vector3d> axis_of(const Model& model, const Data& data, const Capsule& c) {
-  const Eigen::Isometry3d& placement = placement_of(model, data, c.body);
-  return {placement * c.p0, placement * c.p1};
+// Pair k's two capsules and the end points of their axes in the world.
+struct PairAxes {
+  const Capsule& a;
+  const Capsule& b;
+  Eigen::Vector3d a0, a1, b0, b1;
+};
+PairAxes pair_axes(const Model& model, const Data& data, const CollisionModel& collision, int k) {
+  const CapsulePair& pair = collision.pairs()[static_cast<std::size_t>(k)];
+  const Capsule& a = collision.capsules()[static_cast<std::size_t>(pair.first)];
+  const Capsule& b = collision.capsules()[static_cast<std::size_t>(pair.second)];
+  const Eigen::Isometry3d& pa = placement_of(model, data, a.body);
+  const Eigen::Isometry3d& pb = placement_of(model, data, b.body);
+  return {a, b, pa * a.p0, pa * a.p1, pb * b.p0, pb * b.p1};
 }
 
 // Distance, closest points and normal of pair k; with_rate: its velocity too.
 void pair_distance(const Model& model, const Data& data, const CollisionModel& collision, int k, bool with_rate,
                    CollisionData& out) {
-  const CapsulePair& pair = collision.pairs()[static_cast<std::size_t>(k)];
-  const Capsule& a = collision.capsules()[static_cast<std::size_t>(pair.first)];
-  const Capsule& b = collision.capsules()[static_cast<std::size_t>(pair.second)];
-  const auto [a0, a1] = axis_of(model, data, a);
-  const auto [b0, b1] = axis_of(model, data, b);
+  const auto [a, b, a0, a1, b0, b1] = pair_axes(model, data, collision, k);
   const SegmentClosestPoints closest = closest_points_between_segments(a0, a1, b0, b1);
   const Eigen::Vector3d gap = closest.on_first - closest.on_second;
   const double axis_distance = gap.norm();
@@ -172,11 +175,7 @@ void compute_collision_distances(const Model& model, const Data& data, const Col
 
 void compute_collision_pair_derivatives(const Model& model, const Data& data, const CollisionModel& collision, int k,
                                         CollisionData& out) {
-  const CapsulePair& pair = collision.pairs()[static_cast<std::size_t>(k)];
-  const Capsule& a = collision.capsules()[static_cast<std::size_t>(pair.first)];
-  const Capsule& b = collision.capsules()[static_cast<std::size_t>(pair.second)];
-  const auto [a0, a1] = axis_of(model, data, a);
-  const auto [b0, b1] = axis_of(model, data, b);
+  const auto [a, b, a0, a1, b0, b1] = pair_axes(model, data, collision, k);
   const Eigen::Vector3d on_first = out.point_first.col(k), on_second = out.point_second.col(k);
   const Eigen::Vector3d n = out.normal.col(k);
   const Eigen::Vector3d gap = on_first - on_second;
