@@ -126,6 +126,31 @@ TEST(SafetyFuzzClassify, RecoveryTrackerDecisions) {
     EXPECT_NEAR(now, 1.0 + 3.0 + 0.2 / t.return_speed_rad_s, 2e-3);
     EXPECT_EQ(phri::classify(m, t).violations, phri::kViolationNoRecovery);
   }
+  {  // A carried arm 1.2 rad from where the reference comes to rest when the push ends (2 s), the
+     // reference 0.6 rad: both walk back at the leash's speed, 0.6 rad apart, and the arm is back
+     // (1.2 - 0.05) / 0.15 s after the push. By the path's deviation alone the window closed at
+     // 1 + 3 + 0.6 / 0.15 s, before it could be.
+    const double speed = t.return_speed_rad_s;
+    auto rest_distance = [&](double now, double start) { return std::max(0.0, start - speed * (now - 2.0)); };
+    for (const bool walk_back : {false, true}) {
+      phri::RecoveryTracker r(t, 1.0, 0.2);
+      double now = 0.0;
+      for (; now < 20.0 && !r.done(); now += 1e-3) {
+        const double from_path = now < 2.0 ? 0.1 : rest_distance(now, 1.2) - rest_distance(now, 0.6);
+        if (walk_back && now >= 2.0) r.allow_walk_back(now, rest_distance(now, 1.2));
+        r.sample(now, from_path, 0.0, -1.0);
+      }
+      phri::WindowMetrics m;
+      r.finish(m);
+      if (walk_back) {
+        EXPECT_NEAR(m.recovery_time_s, 1.0 + (1.2 - t.recovery_tolerance_rad) / speed, 2e-3);
+        EXPECT_EQ(phri::classify(m, t).violations, 0u);
+      } else {
+        EXPECT_NEAR(now, 1.0 + 3.0 + 0.6 / speed, 2e-3);
+        EXPECT_EQ(phri::classify(m, t).violations, phri::kViolationNoRecovery);
+      }
+    }
+  }
   {  // a safe stop at 0.5 s, at rest 0.3 s later: fine
     phri::RecoveryTracker r(t, 1.0, 0.2);
     for (double now = 0.0; now < 3.0 && !r.done(); now += 1e-3) {
@@ -690,6 +715,39 @@ TEST(SafetyFuzz, MotionAndSwitchWindowsReplayAlone) {
   EXPECT_EQ(phri::safety_fuzz_csv(phri::run_safety_fuzz(o)), phri::safety_fuzz_csv(one));
   o.motion_faults = false;
   EXPECT_EQ(phri::run_safety_fuzz(o).faults(), one.faults_in("rest"));
+}
+
+// Faults in motion that were controller failures, replayed (the command line's --pushes 400):
+// a frozen stamp under a 63 N push in full-body compliance, 1.145x when the brake's prediction
+// aged by the stop's cycles only (the 20 ms on the previous command counted as braking) and
+// started the hold's reference behind the arm; frozen values right after a switch to a torque
+// loop, 1.84x and 1.24x when they were caught after 50 ms of a torque command growing on them;
+// a 5 N.m torque offset in full-body compliance, no_recovery when the window closed before a
+// carried arm could walk back at the leash's speed.
+TEST(SafetyFuzz, FaultsInMotionFormerFailuresReplayedPass) {
+  struct Case {
+    std::uint64_t seed;
+    const char* run;
+  };
+  for (const Case c : {Case{8080, "motion/full_body/kinova_torque_high_velocity/stamp_frozen"},
+                       Case{8080, "switch/full_body/kinova_torque_high_velocity/frozen_values"},
+                       Case{123457, "switch/dual/custom/frozen_values"},
+                       Case{5511, "switch/full_body/kinova_torque_high_velocity/offset_tau_5Nm"}}) {
+    SCOPED_TRACE(c.run);
+    phri::SafetyFuzzOptions o = small_options("");
+    o.seed = c.seed;
+    o.pushes = 400;
+    o.replay = c.run;
+    const phri::SafetyFuzzResult r = phri::run_safety_fuzz(o);
+    ASSERT_EQ(r.records.size(), 2u);
+    const phri::FuzzRecord& fault = r.records[1];
+    EXPECT_EQ(fault.run_id, c.run);
+    EXPECT_FALSE(fault.verdict.invalid);
+    EXPECT_EQ(fault.verdict.violations, 0u) << phri::safety_fuzz_csv(r);
+    std::printf("%s (seed %llu): max |qd| / limit %.3f, safe stop %s, recovered after %.2f s\n", c.run,
+                static_cast<unsigned long long>(c.seed), fault.metrics.max_speed_ratio,
+                fault.metrics.safe_stop ? fault.safe_stop_reason.c_str() : "none", fault.metrics.recovery_time_s);
+  }
 }
 
 }  // namespace

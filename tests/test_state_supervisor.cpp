@@ -321,6 +321,65 @@ TEST(StateSupervisorEdges, ReadingsFrozenForFrozenS) {
   for (long k = 1; k <= 200; ++k) ASSERT_TRUE(fake.check(frozen(k))) << k;
 }
 
+TEST(StateSupervisorEdges, ReadingsFrozenWhileTheTorqueCommandMovesAreCaughtInThreeSamples) {
+  // A torque loop's τ_s follows its command: readings bit-identical while the torque given to the
+  // drives moved by more than frozen_command_Nm (1 N.m) are frozen at the third identical sample,
+  // not 50 ms later; the kinematics then date from the freeze's first (live) sample.
+  auto frozen = [](long k) {
+    phri::RobotState s = at_rest(k);
+    s.tau_sensor_Nm[0] = 5.0;
+    return s;
+  };
+  phri::RobotCommand command(1);
+  command.mode = phri::LowLevelMode::kKinovaTorque;
+  phri::StateSupervisor supervisor(one_joint(), phri::SupervisorSettings{});
+  phri::RobotState live = frozen(1);
+  live.tau_sensor_Nm[0] = 4.0;
+  ASSERT_TRUE(supervisor.check(live));
+  command.tau_Nm[0] = 5.0;
+  supervisor.note_command(command);
+  ASSERT_TRUE(supervisor.check(frozen(2)));  // the freeze's first sample: live until shown otherwise
+  for (long k = 3; k <= 4; ++k) {
+    command.tau_Nm[0] += 0.6;  // 1.2 N.m from the command at the freeze after two more samples
+    supervisor.note_command(command);
+    ASSERT_TRUE(supervisor.check(frozen(k))) << k;
+  }
+  command.tau_Nm[0] += 0.6;
+  supervisor.note_command(command);
+  EXPECT_EQ(verdict(supervisor, frozen(5)), SafetyFault::kFrozenValues);
+  EXPECT_FALSE(supervisor.kinematics_fresh());
+  EXPECT_DOUBLE_EQ(supervisor.kinematic_stamp(), frozen(2).joints.stamp_s);
+  EXPECT_EQ(supervisor.kinematic_sequence(), frozen(2).joints.sequence);
+
+  // The same readings under a command that stays within 1 N.m, or under the robot's position loop:
+  // only the 50 ms test applies.
+  for (const phri::LowLevelMode mode : {phri::LowLevelMode::kKinovaTorque, phri::LowLevelMode::kPosition}) {
+    phri::StateSupervisor steady(one_joint(), phri::SupervisorSettings{});
+    command.mode = mode;
+    command.tau_Nm[0] = 5.0;
+    for (long k = 1; k <= 40; ++k) {
+      command.tau_Nm[0] += mode == phri::LowLevelMode::kPosition ? 1.0 : 0.02;
+      steady.note_command(command);
+      ASSERT_TRUE(steady.check(frozen(k))) << k;
+    }
+  }
+  // A current loop's command counts through K_T G_r (here 10 N.m/A: 0.2 A is 2 N.m).
+  phri::SensorRanges with_drive = one_joint();
+  with_drive.torque_per_amp = Eigen::VectorXd::Constant(1, 10.0);
+  for (Eigen::VectorXd* v : {&with_drive.reflected_inertia, &with_drive.friction_static, &with_drive.friction_coulomb,
+                             &with_drive.friction_viscous, &with_drive.transmission_compliance}) {
+    *v = Eigen::VectorXd::Zero(1);
+  }
+  phri::StateSupervisor current(with_drive, phri::SupervisorSettings{});
+  command.mode = phri::LowLevelMode::kCurrent;
+  command.current_A[0] = 1.0;
+  current.note_command(command);
+  for (long k = 1; k <= 3; ++k) ASSERT_TRUE(current.check(frozen(k))) << k;
+  command.current_A[0] += 0.2;
+  current.note_command(command);
+  EXPECT_EQ(verdict(current, frozen(4)), SafetyFault::kFrozenValues);
+}
+
 TEST(StateSupervisorEdges, SequenceAndStampFreshness) {
   auto after_warmup = [](const phri::RobotState& s) {
     phri::StateSupervisor supervisor(one_joint(), phri::SupervisorSettings{});

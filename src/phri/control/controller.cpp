@@ -461,7 +461,6 @@ void Controller::hold_previous(const RobotState& state, RobotCommand& command) {
 void Controller::safe_stop(bool sample_good, RobotCommand& command) {
   status_ = CycleStatus::kSafeStop;
   const SafetySettings& s = settings_.safety;
-  cycles_since_good_ = supervisor_.kinematics_fresh() ? 0 : cycles_since_good_ + 1;
   brake_state();
   if (safe_stop_cycles_++ == 0) {
     const bool position_loop = have_command_ && low_level_.loop() == LowLevelMode::kPosition;
@@ -523,8 +522,12 @@ void Controller::safe_stop(bool sample_good, RobotCommand& command) {
 
 // The state the brake works on: the measured joints while their part of the sample is plausible
 // (also when only τ_s or the current is wrong); while it is not, a bounded prediction from the last
-// plausible one, decelerating at brake_rate as the brake makes it: q + q̇ (1 - e^(-r t)) / r, within
-// the joint limits. Never a stale velocity repeated for longer than the data lasted.
+// plausible one. Up to the stop the robot ran on the previous torque command (a missing sample, a
+// stalled thread): the arm coasts on at its recent acceleration, its speed within the larger of the
+// drive's limit and its own; from the stop on it decelerates at brake_rate as the brake makes it:
+// q + q̇ (1 - e^(-r t)) / r, within the joint limits. Never a stale velocity repeated for longer than
+// the data lasted, nor a brake assumed before there was one (the hold's reference would start behind
+// the arm and the servo would yank it back).
 void Controller::brake_state() {
   if (!supervisor_.has_kinematics()) return;
   const double rate = settings_.safety.brake_rate;
@@ -535,11 +538,23 @@ void Controller::brake_state() {
       static_cast<double>(static_cast<std::uint32_t>(stop_sequence_ - supervisor_.kinematic_sequence())) * settings_.period_s;
   const double by_clock = std::clamp(std::min(stop_stamp_s_ - supervisor_.kinematic_stamp(), by_sequence), 0.0, 1.0);
   const double age_s = std::max(static_cast<double>(cycles_since_good_) * settings_.period_s, by_clock);
-  const double decay = std::exp(-rate * age_s);
-  brake_q_ = (supervisor_.kinematic_q() + (1.0 - decay) / rate * supervisor_.kinematic_qd())
-                 .cwiseMax(limit_lower_)
-                 .cwiseMin(limit_upper_);
-  brake_qd_ = decay * supervisor_.kinematic_qd();
+  if (supervisor_.kinematics_fresh()) {
+    coast_s_ = 0.0;
+  } else if (safe_stop_cycles_ == 0) {
+    const bool torque_command = have_command_ && low_level_.loop() != LowLevelMode::kPosition;
+    coast_s_ = torque_command ? age_s : 0.0;
+  }
+  const double coast = std::min(coast_s_, age_s);
+  const double decay = std::exp(-rate * (age_s - coast));
+  const Eigen::VectorXd& q = supervisor_.kinematic_q();
+  const Eigen::VectorXd& qd = supervisor_.kinematic_qd();
+  for (int i = 0; i < model_.nv(); ++i) {
+    const double bound = std::max(std::abs(qd[i]), drive_velocity_limit_[i]);
+    const double coasted_qd = std::clamp(qd[i] + coast * acceleration_[i], -bound, bound);
+    const double coasted_q = q[i] + 0.5 * (qd[i] + coasted_qd) * coast;
+    brake_q_[i] = std::clamp(coasted_q + (1.0 - decay) / rate * coasted_qd, limit_lower_[i], limit_upper_[i]);
+    brake_qd_[i] = decay * coasted_qd;
+  }
 }
 
 // The hold's reference within the position loop's following bound of where the arm is (the
@@ -771,6 +786,8 @@ CycleStatus Controller::step(const RobotState& state, const ControllerTargets& t
   const double previous_good_stamp = supervisor_.last_good_time();
   const std::uint32_t previous_good_sequence = supervisor_.last_good().joints.sequence;
   const bool good = supervisor_.check(state);
+  // The brake's prediction ages by the steps without plausible kinematics, the degraded ones too.
+  cycles_since_good_ = supervisor_.kinematics_fresh() ? 0 : cycles_since_good_ + 1;
   // The observer integrates over the time since the last sample it saw (missed ones included): by
   // the stamps and by the sequence, whichever says less (after a re-sync one of them jumped).
   const double by_sequence =
@@ -796,7 +813,6 @@ CycleStatus Controller::step(const RobotState& state, const ControllerTargets& t
     missing_sample(state, command);
     return status_;
   }
-  cycles_since_good_ = 0;
   track_acceleration(state.qd_rad_s, dt);
   q_ = state.q_rad;
   qd_ = state.qd_rad_s;
@@ -825,6 +841,7 @@ CycleStatus Controller::step(const RobotState& state, const ControllerTargets& t
   guarded_tau_ = qp_.desired_torque();
   guard_torque(guarded_tau_);
   low_level_.update(state, guarded_tau_, qp_.desired_acceleration(), command);
+  supervisor_.note_command(command);
   have_command_ = true;
   status_ = qp_status != WholeBodyQpStatus::kOk ? CycleStatus::kQpFallback
             : targets_accepted                 ? CycleStatus::kOk

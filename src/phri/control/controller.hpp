@@ -206,6 +206,7 @@ private:
   long steps_ = 0;                    // step() calls
   double stop_stamp_s_ = 0.0;         // the latest finite joint stamp and sequence (the brake's prediction age)
   std::uint32_t stop_sequence_ = 0;
+  double coast_s_ = 0.0;              // of the brake's prediction age: the arm on the previous command
   long refused_step_ = -2;            // the step of the latest refused write
   long refusals_in_row_ = 0;          // refused writes in consecutive steps
   bool holding_ = false;

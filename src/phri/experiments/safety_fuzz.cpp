@@ -731,6 +731,10 @@ void judge_motion_cycle(Rig& rig, const Shared& s, const MotionScenario& sc, boo
   m.final_deviation_rad = deviation;
   m.final_deviation_joint = rests_where_left ? -1 : joint;
   m.final_speed_rad_s = rig.speed();
+  if (!reference && sc.mode != ComplianceMode::kDual && t >= push_end) {
+    int rest_joint = -1;
+    tracker.allow_walk_back(t, rig.monitor().deviation(rig.q(), sc.q.col(sc.q.cols() - 1), rest_joint));
+  }
   tracker.sample(t, deviation, rig.speed(), rig.safe_stop_time());
 }
 

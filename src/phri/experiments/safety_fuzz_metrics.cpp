@@ -134,6 +134,12 @@ void RecoveryTracker::sample(double t, double deviation, double speed, double sa
   done_ = (recovered_at_ >= 0.0 && settled && since >= min_observation_) || since >= std::max(allowed_s_, t_.recovery_time_s);
 }
 
+void RecoveryTracker::allow_walk_back(double t, double rest_distance_rad) {
+  if (done_ || walk_back_allowed_ || t < end_ || !std::isfinite(rest_distance_rad)) return;
+  walk_back_allowed_ = true;
+  allowed_s_ = std::max(allowed_s_, (t - end_) + t_.recovery_time_s + rest_distance_rad / t_.return_speed_rad_s);
+}
+
 void RecoveryTracker::finish(WindowMetrics& m) const {
   m.recovery_time_s = recovered_at_;
   m.safe_stop = safe_stop_time_ >= 0.0;

@@ -150,6 +150,11 @@ public:
   /// One cycle at robot time t: deviation max_i |q_i - reference_i| (+inf: not at the reference),
   /// speed max_i |q̇_i|, safe_stop_time_s: the safe stop's transition time, < 0 while none.
   void sample(double t, double deviation, double speed, double safe_stop_time_s);
+  /// A carried arm at robot time t (the push over), `rest_distance_rad` (max_i) from where the
+  /// reference comes to rest, walks back at the return leash's speed: the window stays open until it
+  /// can be there (the deviation from the reference's path alone underestimates a walk that starts
+  /// further out). Only the first call at or after the end counts: one deadline, not a moving one.
+  void allow_walk_back(double t, double rest_distance_rad);
   bool done() const { return done_; }
   /// Writes recovery_time_s and the safe-stop fields into `m`.
   void finish(WindowMetrics& m) const;
@@ -159,6 +164,7 @@ private:
   double end_, min_observation_;
   double recovered_at_ = -1.0;  // since the end
   double allowed_s_ = 0.0;      // recovery_time_s plus the walk back
+  bool walk_back_allowed_ = false;
   double safe_stop_time_ = -1.0, rest_after_ = -1.0;
   bool done_ = false;
 };

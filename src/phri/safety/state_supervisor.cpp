@@ -57,7 +57,8 @@ void check_settings(const SensorRanges& r, const SupervisorSettings& s) {
   if (!(s.period_s > 0) || !(s.position_margin_rad >= 0) || !(s.velocity_bound_factor >= 1) ||
       !(s.position_step_factor >= 1) || !(s.position_step_slack_rad >= 0) || !(s.velocity_consistency_rad_s > 0) || !(s.encoder_quantum_rad >= 0) || !(s.torque_range_factor >= 1) ||
       !(s.current_range_factor >= 1) || !(s.max_degraded_s >= s.period_s) || !(s.recovery_samples >= 1) ||
-      !(s.max_fault_budget >= 1) || !(s.fault_budget_decay_per_good >= 0) || !(s.frozen_s >= 0)) {
+      !(s.max_fault_budget >= 1) || !(s.fault_budget_decay_per_good >= 0) || !(s.frozen_s >= 0) ||
+      !(s.frozen_command_samples >= 2) || !(s.frozen_command_Nm > 0) || !std::isfinite(s.frozen_command_Nm)) {
     throw ConfigError(kWhere, "settings", "a bound is out of range (factors >= 1, times >= the period)");
   }
 }
@@ -69,6 +70,7 @@ StateSupervisor::StateSupervisor(const SensorRanges& ranges, const SupervisorSet
   last_good_ = RobotState(n_);
   previous_ = RobotState(n_);
   candidate_q_ = candidate_qd_ = kinematic_q_ = kinematic_qd_ = Eigen::VectorXd::Zero(n_);
+  torque_command_ = freeze_command_ = Eigen::VectorXd::Zero(n_);
   for (ResidualTrack& track : residual_track_) track.resize(n_);
   residual_qd_ = Eigen::VectorXd::Zero(n_);
   residual_tau_[0] = residual_tau_[1] = Eigen::VectorXd::Zero(n_);
@@ -95,6 +97,8 @@ void StateSupervisor::reset() {
   kinematics_fresh_ = resync_ = false;
   escalation_ = SafetyTransition{};
   frozen_since_s_ = -1.0;
+  frozen_samples_ = 0;
+  has_torque_command_ = freeze_command_known_ = false;
   residual_updates_ = 0;
   good_in_row_ = bad_in_row_ = 0;
   fault_budget_ = 0.0;
@@ -227,10 +231,37 @@ bool StateSupervisor::frozen(const RobotState& s) {
                     (!s.current.valid || identical(s.current_A, previous_.current_A));
   if (!same) {
     frozen_since_s_ = -1.0;
+    frozen_samples_ = 0;
     return false;
   }
-  if (frozen_since_s_ < 0.0) frozen_since_s_ = s.joints.stamp_s;
-  return s.joints.stamp_s - frozen_since_s_ >= settings_.frozen_s;
+  if (frozen_since_s_ < 0.0) {
+    frozen_since_s_ = s.joints.stamp_s;
+    freeze_stamp_ = previous_stamp_;
+    freeze_sequence_ = previous_sequence_;
+    freeze_command_known_ = has_torque_command_;
+    if (has_torque_command_) freeze_command_ = torque_command_;
+  }
+  ++frozen_samples_;
+  const bool command_moved = freeze_command_known_ && has_torque_command_ &&
+                             frozen_samples_ >= settings_.frozen_command_samples &&
+                             (torque_command_ - freeze_command_).cwiseAbs().maxCoeff() > settings_.frozen_command_Nm;
+  return command_moved || s.joints.stamp_s - frozen_since_s_ >= settings_.frozen_s;
+}
+
+void StateSupervisor::note_command(const RobotCommand& command) {
+  switch (command.mode) {
+    case LowLevelMode::kKinovaTorque:
+    case LowLevelMode::kKinovaTorqueHighVelocity:
+    case LowLevelMode::kTorque:
+      has_torque_command_ = command.tau_Nm.size() == n_ && command.tau_Nm.allFinite();
+      if (has_torque_command_) torque_command_ = command.tau_Nm;
+      return;
+    case LowLevelMode::kCurrent:
+      has_torque_command_ = command.current_A.size() == n_ && ranges_.torque_per_amp.size() == n_ && command.current_A.allFinite();
+      if (has_torque_command_) torque_command_ = command.current_A.cwiseProduct(ranges_.torque_per_amp);
+      return;
+    case LowLevelMode::kPosition: has_torque_command_ = false; return;
+  }
 }
 
 // The first joint whose τ_s the motor current cannot explain (-1: none, or nothing to compare).
@@ -303,6 +334,10 @@ bool StateSupervisor::check(const RobotState& s) {
       previous_.qd_rad_s = s.qd_rad_s;
       previous_.tau_sensor_Nm = s.tau_sensor_Nm;
       if (s.current_A.size() == n_) previous_.current_A = s.current_A;
+      if (frozen_since_s_ < 0.0) {  // during a freeze previous_ stands for its first, live sample
+        previous_stamp_ = s.joints.stamp_s;
+        previous_sequence_ = s.joints.sequence;
+      }
       has_previous_ = true;
     }
   }
@@ -321,6 +356,11 @@ bool StateSupervisor::check(const RobotState& s) {
     }
   }
   kinematics_fresh_ = kinematics_passed_ && fault != SafetyFault::kFrozenValues;
+  if (fault == SafetyFault::kFrozenValues && has_kinematics_) {
+    // The samples since the freeze began only repeated its first: the kinematics are that old.
+    kinematic_stamp_ = freeze_stamp_;
+    kinematic_sequence_ = freeze_sequence_;
+  }
   if (kinematics_fresh_) {
     if (fault == SafetyFault::kNone) check_gap(s);
     kinematic_q_ = s.q_rad;

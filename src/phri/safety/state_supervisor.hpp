@@ -25,6 +25,7 @@
 // kSafeStop latches until reset(): the controller brakes and hands over to the robot's position
 // hold (Controller::step). Every transition is counted and the latest kept with its reason, its
 // joint and its time, for the log and `phri run`. check() allocates nothing and never throws.
+#include <phri/robot/robot_command.hpp>
 #include <phri/robot/robot_state.hpp>
 
 #include <Eigen/Core>
@@ -176,6 +177,12 @@ struct SupervisorSettings {
   /// [s] q̇, τ_s and current bit-identical for this long while the sequence advances: frozen
   /// values (0: not checked, for noise-free fakes).
   double frozen_s = 0.05;
+  /// The quicker test of frozen values in a torque loop, whose τ_s follows its command: the values
+  /// bit-identical for frozen_command_samples samples while the torque given to the drives moved by
+  /// more than frozen_command_Nm from its value when they stopped changing (a live sensor shows
+  /// such a change; one sample repeated by a slow drive does not trip it). Off with frozen_s = 0.
+  int frozen_command_samples = 3;
+  double frozen_command_Nm = 1.0;
 };
 
 struct SafetyTransition {
@@ -198,6 +205,9 @@ public:
   void report(SafetyFault fault, double t, int joint = -1);
   /// Back to kNormal with no good sample yet (after the operator cleared the cause).
   void reset();
+  /// The command the drives were given, for the next samples (frozen values): its joint torque in
+  /// the torque loops, K_T G_r i in the current loop; none in the robot's position loop.
+  void note_command(const RobotCommand& command);
 
   SupervisorState state() const { return state_; }
   bool safe_stop() const { return state_ == SupervisorState::kSafeStop; }
@@ -275,6 +285,13 @@ private:
   bool header_passed_ = false;       // classify(): its sequence and stamp passed
   SafetyTransition escalation_;
   double frozen_since_s_ = -1.0;     // stamp at which the values stopped changing (-1: changing)
+  int frozen_samples_ = 0;           // identical samples in a row
+  double previous_stamp_ = 0.0;      // of previous_: the last sample before a freeze was live
+  std::uint32_t previous_sequence_ = 0;
+  double freeze_stamp_ = 0.0;        // previous_'s stamp and sequence when the freeze began
+  std::uint32_t freeze_sequence_ = 0;
+  Eigen::VectorXd torque_command_, freeze_command_;  // note_command()'s torque; its value at the freeze
+  bool has_torque_command_ = false, freeze_command_known_ = false;
   // The residual K_T G_r i - τ_s - I_r G_r^2 a_r - τ_f under one hypothesis on the transmission.
   struct ResidualTrack {
     Eigen::VectorXd filtered;           // median of three, then low-passed [N.m]
