@@ -105,6 +105,45 @@ TEST(SafetyFuzzClassify, OperatorPossibleOnlyWhenThePushExceedsTheActuators) {
   EXPECT_TRUE(v.controller_failure());
 }
 
+TEST(SafetyFuzzClassify, AnOverspeedOnAHeldCommandIsNeitherAFailureNorAPass) {
+  const phri::SafetyFuzzThresholds t;  // overspeed above 1.05x
+  // Per plant period: the speed ratio and whether the robot ran on a command not renewed.
+  struct Period {
+    double ratio;
+    bool held;
+  };
+  auto judge = [&](std::initializer_list<Period> periods) {
+    phri::WindowMetrics m;
+    phri::HeldCommandTracker tracker(t.speed_factor);
+    for (const Period& p : periods) {
+      m.max_speed_ratio = std::max(m.max_speed_ratio, p.ratio);
+      tracker.sample(p.ratio, p.held, m);
+    }
+    m.recovery_time_s = 0.0;
+    return phri::classify(m, t);
+  };
+  // Up to 1.6x during a stall, then braked from what it inherited: held, not a failure, not a pass.
+  const phri::FuzzVerdict held = judge({{0.9, false}, {1.3, true}, {1.6, true}, {1.4, false}, {1.1, false}, {0.8, false}});
+  EXPECT_EQ(held.violations, phri::kViolationOverspeed);
+  EXPECT_TRUE(held.held_command);
+  EXPECT_FALSE(held.controller_failure());
+  EXPECT_FALSE(held.passed());
+  // Faster once the controller acts again than anything it inherited: its own.
+  EXPECT_TRUE(judge({{1.3, true}, {1.6, true}, {1.7, false}, {0.8, false}}).controller_failure());
+  // Back within the threshold, then over it again: its own.
+  EXPECT_TRUE(judge({{1.6, true}, {1.0, false}, {1.2, false}}).controller_failure());
+  // An overspeed with no held period at all.
+  EXPECT_TRUE(judge({{0.9, false}, {1.2, false}}).controller_failure());
+  // A held overspeed with another violation (a joint past its limit) stays a failure.
+  phri::WindowMetrics m;
+  phri::HeldCommandTracker tracker(t.speed_factor);
+  m.max_speed_ratio = 1.3;
+  tracker.sample(1.3, true, m);
+  m.min_limit_margin_rad = -0.01;
+  m.recovery_time_s = 0.0;
+  EXPECT_TRUE(phri::classify(m, t).controller_failure());
+}
+
 TEST(SafetyFuzzClassify, RecoveryTrackerDecisions) {
   const phri::SafetyFuzzThresholds t;  // 0.05 rad within 3 s; safe stop at rest (0.01 rad/s) within 1 s
   {  // back at 1.2 s after the end (the deviation falls 0.1 rad/s from 0.17 rad), settled at once
@@ -732,7 +771,10 @@ TEST(SafetyFuzz, FaultsInMotionFormerFailuresReplayedPass) {
   for (const Case c : {Case{8080, "motion/full_body/kinova_torque_high_velocity/stamp_frozen"},
                        Case{8080, "switch/full_body/kinova_torque_high_velocity/frozen_values"},
                        Case{123457, "switch/dual/custom/frozen_values"},
-                       Case{5511, "switch/full_body/kinova_torque_high_velocity/offset_tau_5Nm"}}) {
+                       Case{5511, "switch/full_body/kinova_torque_high_velocity/offset_tau_5Nm"},
+                       // A dead-stop hold at the measured pose while 100 writes were refused slammed
+                       // the servo into the arm (1.155x) once they passed again.
+                       Case{8080, "motion/full_body/kinova_torque_high_velocity/write_refused"}}) {
     SCOPED_TRACE(c.run);
     phri::SafetyFuzzOptions o = small_options("");
     o.seed = c.seed;
@@ -743,11 +785,30 @@ TEST(SafetyFuzz, FaultsInMotionFormerFailuresReplayedPass) {
     const phri::FuzzRecord& fault = r.records[1];
     EXPECT_EQ(fault.run_id, c.run);
     EXPECT_FALSE(fault.verdict.invalid);
-    EXPECT_EQ(fault.verdict.violations, 0u) << phri::safety_fuzz_csv(r);
-    std::printf("%s (seed %llu): max |qd| / limit %.3f, safe stop %s, recovered after %.2f s\n", c.run,
-                static_cast<unsigned long long>(c.seed), fault.metrics.max_speed_ratio,
-                fault.metrics.safe_stop ? fault.safe_stop_reason.c_str() : "none", fault.metrics.recovery_time_s);
+    EXPECT_FALSE(fault.verdict.controller_failure()) << phri::safety_fuzz_csv(r);
+    EXPECT_LE(fault.metrics.max_controlled_speed_ratio, 1.0) << "once the controller acts, within the velocity limit";
+    std::printf("%s (seed %llu): max |qd| / limit %.3f (on a held command %.3f, controlled %.3f), safe stop %s, recovered "
+                "after %.2f s\n",
+                c.run, static_cast<unsigned long long>(c.seed), fault.metrics.max_speed_ratio, fault.metrics.max_held_speed_ratio,
+                fault.metrics.max_controlled_speed_ratio, fault.metrics.safe_stop ? fault.safe_stop_reason.c_str() : "none",
+                fault.metrics.recovery_time_s);
   }
+  // A 98-period stall while a hand pulls the tool at 79 N (dual compliance, custom loop): 1.68x
+  // before the controller runs again, nothing any controller could act on; it then brakes from
+  // there and never goes faster: an overspeed on a held command.
+  phri::SafetyFuzzOptions o = small_options("");
+  o.seed = 5511;
+  o.pushes = 400;
+  o.replay = "motion/dual/custom/stall_random_98";
+  const phri::SafetyFuzzResult r = phri::run_safety_fuzz(o);
+  ASSERT_EQ(r.records.size(), 2u);
+  const phri::FuzzRecord& stall = r.records[1];
+  EXPECT_GT(stall.metrics.max_held_speed_ratio, 1.5);
+  EXPECT_LE(stall.metrics.max_inherited_speed_ratio, stall.metrics.max_held_speed_ratio);
+  EXPECT_LE(stall.metrics.max_controlled_speed_ratio, 1.05);
+  EXPECT_TRUE(stall.verdict.held_command);
+  EXPECT_FALSE(stall.verdict.controller_failure());
+  EXPECT_EQ(r.held_command_windows(), 1);
 }
 
 }  // namespace

@@ -293,6 +293,10 @@ TEST(StateSupervisorEdges, APositionStuckWhileTheVelocitySaysItMoved) {
     const bool beyond = qd > 0.2;
     EXPECT_EQ(verdict(supervisor, stuck), beyond ? SafetyFault::kFrozenValues : SafetyFault::kNone) << qd;
     EXPECT_EQ(supervisor.kinematics_fresh(), !beyond) << "a stuck position is no kinematics for the brake";
+    // The brake's kinematics are the last plausible sample's, dated as it (not from a freeze of
+    // the readings: none began).
+    EXPECT_DOUBLE_EQ(supervisor.kinematic_stamp(), (beyond ? first : stuck).joints.stamp_s);
+    EXPECT_EQ(supervisor.kinematic_sequence(), (beyond ? first : stuck).joints.sequence);
   }
 }
 

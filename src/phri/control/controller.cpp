@@ -581,11 +581,12 @@ bool Controller::answer_refused_write(const RobotState& state, RobotCommand& com
     safe_stop(supervisor_.kinematics_fresh(), command);
     return true;
   }
-  // Refused during the stop: hold where the arm is. The robot's own reading of its joints, when
-  // finite and within the joint range, is the nearest pose it accepts, even in a sample the
-  // supervisor rejected for another signal.
+  // Refused during the stop: hold from where the arm is, braking on from how it moves (a reference
+  // stopped dead would slam the servo into the arm once writes pass again). The robot's own
+  // reading of its joints, when finite and within the joint range, is the nearest pose it
+  // accepts, even in a sample the supervisor rejected for another signal.
   holding_ = true;
-  hold_qd_.setZero();
+  hold_qd_ = brake_qd_;
   hold_q_ = brake_q_;
   if (state.q_rad.size() == model_.nq() && state.q_rad.allFinite() &&
       (state.q_rad.array() >= limit_lower_.array()).all() && (state.q_rad.array() <= limit_upper_.array()).all()) {

@@ -197,22 +197,27 @@ public:
   const RobotState& read() override {
     if (reads_ > 0 && monitor_ != nullptr && metrics_ != nullptr) {
       monitor_->update(plant_.truth().q_rad, plant_.truth().qd_rad_s, *metrics_);
+      if (held_ != nullptr) held_->sample(monitor_->speed_ratio(), true, *metrics_);  // a stalled period
     }
     ++reads_;
     return plant_.read();
   }
   WriteStatus write(const RobotCommand& command) override { return plant_.write(command); }
   // Before each control cycle's read.
-  void begin_cycle(SafetyMonitor* monitor, WindowMetrics* m) {
+  void begin_cycle(SafetyMonitor* monitor, WindowMetrics* m, HeldCommandTracker* held) {
     monitor_ = monitor;
     metrics_ = m;
+    held_ = held;
     reads_ = 0;
   }
+  // The cycle's read ran the plant more than one period: the controller's thread stalled.
+  bool stalled() const { return reads_ > 1; }
 
 private:
   SimRobot& plant_;
   SafetyMonitor* monitor_ = nullptr;
   WindowMetrics* metrics_ = nullptr;
+  HeldCommandTracker* held_ = nullptr;
   long reads_ = 0;
 };
 
@@ -234,8 +239,14 @@ public:
 
   // One control cycle; the checks go into m.
   void step(WindowMetrics& m) {
-    tap_.begin_cycle(&monitor_, &m);
+    tap_.begin_cycle(&monitor_, &m, &held_);
     const RobotState& state = io_.read();
+    // The period this read ran: on a command the controller could not renew (the last of a
+    // stall's, or after a refused write), or one of the two after such a period (the renewed
+    // command is written at the end of the first; the drive's torque follows it within the next).
+    const bool held_period = tap_.stalled() || write_refused_;
+    const bool held = held_period || periods_since_held_ < kRenewedCommandPeriods;
+    periods_since_held_ = held_period ? 0 : periods_since_held_ + 1;
     if (state.fault) m.crashed = true;
     const CycleStatus status = cycle_.step(state, targets_, command_);
     targets_.clear();
@@ -244,17 +255,21 @@ public:
     if (!setpoint_finite(command_)) m.nan_command = true;
     check_intent(m);
     if (trace_.is_open()) write_trace_row(status);
+    write_refused_ = false;
     if (io_.write(command_) != WriteStatus::kOk) {
       const bool injected = io_.fault_active() && io_.fault().kind == FaultKind::kWriteRefused;
       if (!injected) ++m.refused_writes;
       refusal_pending_ = true;
       // Answered in the same cycle (controller.hpp); a second refusal counts as well.
-      if (cycle_.answer_refused_write(state, command_) && io_.write(command_) != WriteStatus::kOk && !injected) {
-        ++m.refused_writes;
+      write_refused_ = true;
+      if (cycle_.answer_refused_write(state, command_)) {
+        write_refused_ = io_.write(command_) != WriteStatus::kOk;
+        if (write_refused_ && !injected) ++m.refused_writes;
       }
     }
     const SimRobot::Truth& truth = robot_->truth();
     monitor_.update(truth.q_rad, truth.qd_rad_s, m);
+    held_.sample(monitor_.speed_ratio(), held, m);
     speed_ = truth.qd_rad_s.cwiseAbs().maxCoeff();
   }
 
@@ -377,6 +392,10 @@ private:
   SafetyMonitor monitor_;
   std::ofstream trace_;
   bool refusal_pending_ = false;
+  HeldCommandTracker held_{s_.o.thresholds.speed_factor};
+  bool write_refused_ = false;  // this cycle's command did not reach the robot
+  static constexpr long kRenewedCommandPeriods = 2;
+  long periods_since_held_ = kRenewedCommandPeriods;  // since a period ran on a command not renewed
   double speed_ = 0.0;
 };
 
@@ -1062,6 +1081,10 @@ long SafetyFuzzResult::controller_failures() const {
 
 long SafetyFuzzResult::invalid_windows() const {
   return std::count_if(records.begin(), records.end(), [](const FuzzRecord& r) { return r.verdict.invalid; });
+}
+
+long SafetyFuzzResult::held_command_windows() const {
+  return std::count_if(records.begin(), records.end(), [](const FuzzRecord& r) { return r.verdict.held_command; });
 }
 
 long SafetyFuzzResult::passes() const {

@@ -165,6 +165,7 @@ struct SafetyFuzzResult {
 
   long controller_failures() const;
   long invalid_windows() const;  ///< windows whose loop or mode under test did not run (never passes)
+  long held_command_windows() const;  ///< overspeeds on a held command (FuzzVerdict::held_command)
   long passes() const;           ///< valid windows without a violation
   long pushes() const;    ///< push windows (random and targeted)
   long faults() const;    ///< fault windows, at rest, in motion and after a loop switch

@@ -38,6 +38,8 @@ FuzzVerdict classify(const WindowMetrics& m, const SafetyFuzzThresholds& t) {
   if (!m.crashed && !m.safe_stop && m.recovery_time_s < 0.0) v.violations |= kViolationNoRecovery;
   if (!m.crashed && m.safe_stop && m.safe_stop_rest_time_s < 0.0) v.violations |= kViolationSafeStopMoving;
   v.operator_possible = m.max_required_torque_ratio > 1.0;
+  v.held_command = v.violations == kViolationOverspeed && m.max_held_speed_ratio > t.speed_factor &&
+                   m.max_controlled_speed_ratio <= t.speed_factor && m.max_inherited_speed_ratio <= m.max_held_speed_ratio;
   v.invalid = m.off_intent_cycles > 0;
   return v;
 }
@@ -108,6 +110,18 @@ double SafetyMonitor::push_torque_ratio(int body, const Eigen::Vector3d& point_l
   const double ratio = required_torque_ratio(gravity, push_torque_, torque_limit_);
   m.max_required_torque_ratio = std::max(m.max_required_torque_ratio, ratio);
   return ratio;
+}
+
+void HeldCommandTracker::sample(double speed_ratio, bool held, WindowMetrics& m) {
+  if (held) {
+    m.max_held_speed_ratio = std::max(m.max_held_speed_ratio, speed_ratio);
+    inheriting_ = speed_ratio > speed_factor_;
+  } else if (inheriting_ && speed_ratio > speed_factor_) {
+    m.max_inherited_speed_ratio = std::max(m.max_inherited_speed_ratio, speed_ratio);
+  } else {
+    inheriting_ = false;
+    m.max_controlled_speed_ratio = std::max(m.max_controlled_speed_ratio, speed_ratio);
+  }
 }
 
 RecoveryTracker::RecoveryTracker(const SafetyFuzzThresholds& thresholds, double end_time_s, double min_observation_s)

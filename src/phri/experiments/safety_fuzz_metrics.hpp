@@ -61,6 +61,14 @@ struct SafetyFuzzThresholds {
 /// What one window (a push or a fault, up to its decision) measured.
 struct WindowMetrics {
   double max_speed_ratio = 0.0;                                            ///< max_i |q̇_i| / v_limit_i
+  /// max_speed_ratio split by who commanded the arm (HeldCommandTracker): held, the plant periods
+  /// run on a command the controller could not renew (its thread stalled, its writes refused: the
+  /// robot keeps its last command) and the period after, in which the renewed command starts to
+  /// act; inherited, the periods after those while the speed is still above the threshold; the
+  /// controlled periods, all others.
+  double max_held_speed_ratio = 0.0;
+  double max_inherited_speed_ratio = 0.0;
+  double max_controlled_speed_ratio = 0.0;
   double min_limit_margin_rad = std::numeric_limits<double>::infinity();   ///< < 0: beyond a limit
   double min_capsule_distance_m = std::numeric_limits<double>::infinity();
   double max_required_torque_ratio = 0.0;  ///< push: max over time and joints of |g - J^T F|_i / τ_limit_i
@@ -87,10 +95,15 @@ struct WindowMetrics {
 struct FuzzVerdict {
   unsigned violations = 0;         ///< FuzzViolation bits
   bool operator_possible = false;  ///< the push exceeded what the actuators can resist
+  /// The only violation is an overspeed reached while the robot ran on a command the controller
+  /// could not renew, never exceeded once it could act again, and back within the threshold
+  /// before any later excess (WindowMetrics::max_held_speed_ratio): no controller acts in a stall
+  /// of its own thread. Reported apart, never a pass.
+  bool held_command = false;
   /// The loop or mode under test did not run (WindowMetrics::off_intent_cycles): the window tested
   /// something else, so it is reported as invalid and never counted as a pass.
   bool invalid = false;
-  bool controller_failure() const { return violations != 0 && !operator_possible; }
+  bool controller_failure() const { return violations != 0 && !operator_possible && !held_command; }
   bool passed() const { return !invalid && violations == 0; }
 };
 
@@ -139,6 +152,19 @@ private:
   Eigen::VectorXd q_;
   Eigen::MatrixXd jacobian_;
   double speed_ratio_ = 0.0, limit_margin_ = 0.0, capsule_distance_ = 0.0;
+};
+
+/// Files each plant period's speed ratio into WindowMetrics' held, inherited or controlled maximum.
+class HeldCommandTracker {
+public:
+  explicit HeldCommandTracker(double speed_factor) : speed_factor_(speed_factor) {}
+  /// One plant period; held: it ran on a command the controller could not renew, or is the period
+  /// after such a one.
+  void sample(double speed_ratio, bool held, WindowMetrics& m);
+
+private:
+  double speed_factor_;
+  bool inheriting_ = false;  // the last held period ended above the threshold, not yet back within it
 };
 
 /// The decision after a push or a fault (see the file comment). Feed it every cycle from the start

@@ -341,6 +341,33 @@ std::vector<const FuzzRecord*> failures_worst_first(const SafetyFuzzResult& resu
   return f;
 }
 
+// Overspeeds on a held command (FuzzVerdict::held_command): not controller failures, never passes.
+void held_command_list(const SafetyFuzzResult& result, const SafetyFuzzOptions& o, std::ostream& s) {
+  std::vector<const FuzzRecord*> held;
+  for (const FuzzRecord& r : result.records) {
+    if (r.verdict.held_command) held.push_back(&r);
+  }
+  if (held.empty()) return;
+  std::sort(held.begin(), held.end(),
+            [](const FuzzRecord* a, const FuzzRecord* b) { return a->metrics.max_speed_ratio > b->metrics.max_speed_ratio; });
+  s << "## Overspeed on a held command\n\n"
+    << held.size() << " windows went over the speed threshold only while the robot ran on a command the controller could "
+       "not renew (its thread stalled, its writes refused: the simulated robot keeps its last command, as most do), and the "
+       "controller, acting again, never exceeded what it inherited and brought the arm back within the threshold. No "
+       "controller acts while its thread is stalled; a robot whose own watchdog stops on missed commands ends these "
+       "earlier. Not controller failures, not passes.\n\n"
+    << "| run | mode | loop | what | max qd/limit held / inherited / controlled | safe stop | replay |\n"
+       "|---|---|---|---|---|---|---|\n";
+  for (const FuzzRecord* r : held) {
+    const WindowMetrics& m = r->metrics;
+    s << "| `" << r->run_id << "` | " << to_string(r->mode) << " | " << to_string(r->loop) << " | " << what(*r) << " | "
+      << number(m.max_held_speed_ratio, 3) << " / " << number(m.max_inherited_speed_ratio, 3) << " / "
+      << number(m.max_controlled_speed_ratio, 3) << " | " << (m.safe_stop ? r->safe_stop_reason : "-") << " | `"
+      << replay_command(*r, o) << "` |\n";
+  }
+  s << "\n";
+}
+
 void failure_list(const SafetyFuzzResult& result, const SafetyFuzzOptions& o, std::ostream& s) {
   const std::vector<const FuzzRecord*> f = failures_worst_first(result);
   constexpr std::size_t kMaxRows = 200;
@@ -372,7 +399,7 @@ std::string safety_fuzz_csv(const SafetyFuzzResult& result) {
        "max_speed_ratio,min_limit_margin_rad,min_capsule_distance_mm,required_torque_ratio,max_deviation_rad,final_deviation_rad,final_deviation_joint,final_speed_rad_s,"
        "recovery_time_s,safe_stop,safe_stop_reason,safe_stop_rest_time_s,refused_writes,unhandled_refusals,nan_command,"
        "crashed,violations,operator_possible,controller_failure,context,fault_kind,push_link,fault_offset_s,error,invalid,"
-       "ran_loop,ran_mode\n";
+       "ran_loop,ran_mode,held_command,max_held_speed_ratio,max_inherited_speed_ratio,max_controlled_speed_ratio\n";
   for (const FuzzRecord& r : result.records) {
     const WindowMetrics& m = r.metrics;
     std::string error = r.error;
@@ -390,7 +417,9 @@ std::string safety_fuzz_csv(const SafetyFuzzResult& result) {
       << (r.verdict.controller_failure() ? 1 : 0) << ',' << r.context << ',' << r.fault_kind << ',' << r.push_link << ','
       << format_fixed(r.fault_offset_s, 3) << ',' << error << ',' << (r.verdict.invalid ? 1 : 0) << ','
       << (m.ran_loop >= 0 ? to_string(static_cast<LowLevelMode>(m.ran_loop)) : std::string_view()) << ','
-      << (m.ran_mode >= 0 ? to_string(static_cast<ComplianceMode>(m.ran_mode)) : std::string_view()) << '\n';
+      << (m.ran_mode >= 0 ? to_string(static_cast<ComplianceMode>(m.ran_mode)) : std::string_view()) << ','
+      << (r.verdict.held_command ? 1 : 0) << ',' << number(m.max_held_speed_ratio, 4) << ','
+      << number(m.max_inherited_speed_ratio, 4) << ',' << number(m.max_controlled_speed_ratio, 4) << '\n';
   }
   return s.str();
 }
@@ -407,8 +436,8 @@ std::string safety_fuzz_report(const SafetyFuzzResult& result, const SafetyFuzzO
     << " fault-free references) on "
     << result.runs << " plant + controller constructions; " << format_fixed(result.simulated_s, 0) << " s simulated in "
     << format_fixed(result.wall_s, 1) << " s of wall time with " << o.jobs << " jobs. **" << result.controller_failures()
-    << " controller failures, " << result.invalid_windows() << " invalid windows, " << result.skipped_rows
-    << " rows skipped.**" << (o.replay.empty() ? "" : " Replay of `" + o.replay + "` only.") << "\n\n"
+    << " controller failures, " << result.invalid_windows() << " invalid windows, " << result.held_command_windows()
+    << " overspeeds on a held command, " << result.skipped_rows << " rows skipped.**" << (o.replay.empty() ? "" : " Replay of `" + o.replay + "` only.") << "\n\n"
     << "Violations, on the plant's true state: a joint beyond its URDF limit; |qd| above " << t.speed_factor
     << " x its velocity limit; a self-collision capsule pair below " << format_fixed(1e3 * t.collision_distance_m, 0)
     << " mm; a non-finite command; a crash or a diverged plant; a refused write (unhandled: no safe stop the next cycle); "
@@ -426,6 +455,7 @@ std::string safety_fuzz_report(const SafetyFuzzResult& result, const SafetyFuzzO
   fault_kind_table(result, s);
   no_recovery_table(result, s);
   margins(result, s);
+  held_command_list(result, o, s);
   failure_list(result, o, s);
   return s.str();
 }
@@ -451,6 +481,14 @@ int run_safety_fuzz_command(const SafetyFuzzOptions& options, bool fail_on_viola
     if (n > 0) summary << ", " << violation_name(i) << " " << n;
   }
   summary << "\n";
+  if (const long held = r.held_command_windows(); held > 0) {
+    const auto w = std::max_element(r.records.begin(), r.records.end(), [](const FuzzRecord& a, const FuzzRecord& b) {
+      return (a.verdict.held_command ? a.metrics.max_speed_ratio : 0.0) < (b.verdict.held_command ? b.metrics.max_speed_ratio : 0.0);
+    });
+    summary << "overspeed on a held command (the robot ran on a command the controller could not renew; not a controller failure, "
+               "not a pass): "
+            << held << ", worst " << number(w->metrics.max_speed_ratio, 3) << "x (" << w->run_id << ")\n";
+  }
   if (r.faults() > 0) {
     summary << "fault windows failed:";
     for (const char* context : {"rest", "motion", "switch"}) {

@@ -356,7 +356,7 @@ bool StateSupervisor::check(const RobotState& s) {
     }
   }
   kinematics_fresh_ = kinematics_passed_ && fault != SafetyFault::kFrozenValues;
-  if (fault == SafetyFault::kFrozenValues && has_kinematics_) {
+  if (fault == SafetyFault::kFrozenValues && frozen_since_s_ >= 0.0 && has_kinematics_) {
     // The samples since the freeze began only repeated its first: the kinematics are that old.
     kinematic_stamp_ = freeze_stamp_;
     kinematic_sequence_ = freeze_sequence_;
