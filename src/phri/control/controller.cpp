@@ -476,6 +476,7 @@ void Controller::safe_stop(bool sample_good, RobotCommand& command) {
     hold_q_ = supervisor_.has_kinematics() ? brake_q_ : q_;
     hold_qd_.setZero();
     if (holding_ && have_command_ && !position_loop && supervisor_.has_kinematics()) hold_qd_ = brake_qd_;
+    hold_on_prediction_ = !position_loop && !supervisor_.kinematics_fresh();
     stop_entry_tau_ = guarded_tau_;
     // In the position loop the reference brakes from where it is (kept within the following
     // error of the measured pose, LowLevelController): a jump to the measured pose, or a reference
@@ -486,6 +487,13 @@ void Controller::safe_stop(bool sample_good, RobotCommand& command) {
     }
   }
   if (holding_) {
+    // A hold begun on the brake's prediction starts again from the arm's measured state as soon as
+    // there is one (after a stall, the prediction knew nothing of the hand that pulled meanwhile).
+    if (hold_on_prediction_ && supervisor_.kinematics_fresh()) {
+      hold_q_ = brake_q_;
+      hold_qd_ = brake_qd_;
+      hold_on_prediction_ = false;
+    }
     brake_reference();
     keep_hold_acceptable();
     low_level_.hold(hold_q_, command);
@@ -531,13 +539,7 @@ void Controller::safe_stop(bool sample_good, RobotCommand& command) {
 void Controller::brake_state() {
   if (!supervisor_.has_kinematics()) return;
   const double rate = settings_.safety.brake_rate;
-  // Cycles since the data, or the robot's time since it when longer (a stalled control thread runs
-  // no cycles): by the stamps and by the sequence, whichever says less (one of them may have jumped;
-  // an age too long would put the hold's reference ahead of the arm).
-  const double by_sequence =
-      static_cast<double>(static_cast<std::uint32_t>(stop_sequence_ - supervisor_.kinematic_sequence())) * settings_.period_s;
-  const double by_clock = std::clamp(std::min(stop_stamp_s_ - supervisor_.kinematic_stamp(), by_sequence), 0.0, 1.0);
-  const double age_s = std::max(static_cast<double>(cycles_since_good_) * settings_.period_s, by_clock);
+  const double age_s = kinematics_age_s();
   if (supervisor_.kinematics_fresh()) {
     coast_s_ = 0.0;
   } else if (safe_stop_cycles_ == 0) {
@@ -555,6 +557,16 @@ void Controller::brake_state() {
     brake_q_[i] = std::clamp(coasted_q + (1.0 - decay) / rate * coasted_qd, limit_lower_[i], limit_upper_[i]);
     brake_qd_[i] = decay * coasted_qd;
   }
+}
+
+// Steps since the last plausible kinematics, or the robot's time since them when longer (a
+// stalled control thread runs no steps): by the stamps and by the sequence, whichever says less
+// (one of them may have jumped; an age too long would put the hold's reference ahead of the arm).
+double Controller::kinematics_age_s() const {
+  const double by_sequence =
+      static_cast<double>(static_cast<std::uint32_t>(stop_sequence_ - supervisor_.kinematic_sequence())) * settings_.period_s;
+  const double by_clock = std::clamp(std::min(stop_stamp_s_ - supervisor_.kinematic_stamp(), by_sequence), 0.0, 1.0);
+  return std::max(static_cast<double>(cycles_since_good_) * settings_.period_s, by_clock);
 }
 
 // The hold's reference within the position loop's following bound of where the arm is (the
@@ -588,6 +600,7 @@ bool Controller::answer_refused_write(const RobotState& state, RobotCommand& com
   holding_ = true;
   hold_qd_ = brake_qd_;
   hold_q_ = brake_q_;
+  hold_on_prediction_ = !supervisor_.kinematics_fresh();
   if (state.q_rad.size() == model_.nq() && state.q_rad.allFinite() &&
       (state.q_rad.array() >= limit_lower_.array()).all() && (state.q_rad.array() <= limit_upper_.array()).all()) {
     hold_q_ = state.q_rad;
@@ -596,16 +609,20 @@ bool Controller::answer_refused_write(const RobotState& state, RobotCommand& com
   return true;
 }
 
-// A sample the supervisor did not pass. Near the velocity limit the torque loops' command is a
-// brake the velocity guard shaped from the measured speed; repeated blind it is not one (a hand
-// pulling at the tool took the arm from 0.9x to 1.2x its limit within the 20 ms budget). A missing
-// sample stops at once where the last velocity, carried on at the recent acceleration over the
-// budget, reaches the limit; elsewhere the previous command stands in (hold_previous()).
+// A sample the supervisor did not pass. At the velocity guard (velocity_guard_fraction of the
+// drive's limit, where the QP's velocity bound holds the arm against a hand) the torque loops'
+// command is a balance against that hand, shaped from the measured speed; repeated blind it is no
+// brake (a hand pulling at the tool took the arm from 0.9x to 1.2x its limit within the 20 ms
+// budget). A missing sample stops at once where the last velocity, carried on at the recent
+// acceleration over the budget, reaches the guard; elsewhere, and after a gap already beyond the
+// budget (a stall: the next samples re-synchronise and the supervisor's stop brakes on them), the
+// previous command stands in (hold_previous()).
 void Controller::missing_sample(const RobotState& state, RobotCommand& command) {
+  const double budget = supervisor_.settings().max_degraded_s;
   if (settings_.safety.stop_missed_at_speed && have_command_ && low_level_.loop() != LowLevelMode::kPosition &&
-      supervisor_.has_kinematics() &&
-      ((supervisor_.kinematic_qd() + supervisor_.settings().max_degraded_s * acceleration_).cwiseAbs().array() >
-       drive_velocity_limit_.array()).any()) {
+      supervisor_.has_kinematics() && kinematics_age_s() <= budget &&
+      ((supervisor_.kinematic_qd() + budget * acceleration_).cwiseAbs().array() >=
+       settings_.safety.velocity_guard_fraction * drive_velocity_limit_.array()).any()) {
     supervisor_.report(SafetyFault::kMissedAtSpeed, state.time_s);
     safe_stop(false, command);
     return;

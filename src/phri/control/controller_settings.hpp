@@ -69,10 +69,12 @@ struct SafetySettings {
   /// faults after a few missed 1 kHz frames, so a few cycles is all the robot gives.
   int max_hold_refusals = 5;
   /// A missing sample in a torque loop where the last velocity, carried on at the recent
-  /// acceleration over max_degraded_s, reaches the velocity limit: a safe stop at once
-  /// (missed_at_speed) instead of the previous command for the degraded budget. Off by default:
-  /// it stops a link that loses single frames while the arm moves fast (the Kortex link's loss
-  /// budget rides through 0.3 %), and its hold entry at speed is a torque step (docs/safety.md).
+  /// acceleration over max_degraded_s, reaches the velocity guard (velocity_guard_fraction of the
+  /// drive's limit): a safe stop at once (missed_at_speed) instead of the previous command for the
+  /// degraded budget. Off by default: on a Kinova arm the hold's entry at speed goes through the
+  /// actuators' mode switch, a torque step (107 N.m at 1.9 rad/s through the Kortex emulator,
+  /// KortexSession.PacketLossOfOnePercent...), and a damping brake instead lets a hand pull the arm
+  /// to 3.4x (safety fuzz, seed 90210). On, the fuzz's five overspeeds of that seed are gone.
   bool stop_missed_at_speed = false;
   /// Velocity guard of the torque loops, the last line behind the QP's velocity constraint: above
   /// guard_fraction x the drive's velocity limit, damping rate x (M_ii + I_r) x the excess, scaled

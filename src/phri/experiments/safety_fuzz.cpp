@@ -795,11 +795,11 @@ void motion_run(const Shared& s, const std::string& id, MotionScenario& sc, cons
     const double push_start = rig.time();
     const ExternalForce force = start_motion_push(rig, s, sc);
     const double push_end = push_start + sc.push.duration_s;
-    // The window's end in plant time (the reference's: the push's).
-    const double fault_end = reference ? push_end
-                                       : push_start + static_cast<double>(spec.start_cycle - push_cycle + fault_cycles +
-                                                                          stall_periods(spec)) * s.dt;
-    RecoveryTracker tracker(th, fault_end, reference ? s.o.min_pause_s : s.o.fault_observation_s);
+    // The window's end in plant time: the push's, or the fault's when later (the fault-free run gets
+    // its time after the push, so does a fault that ended while the hand still pushed).
+    const long fault_end_cycle = reference ? 0 : spec.start_cycle - push_cycle + fault_cycles + stall_periods(spec);
+    const double window_end = std::max(push_end, push_start + static_cast<double>(fault_end_cycle) * s.dt);
+    RecoveryTracker tracker(th, window_end, reference ? s.o.min_pause_s : s.o.fault_observation_s);
     const long switch_cycle = sc.with_switch ? push_cycle + sc.switch_offset : -1;
     bool fault_seen = false;
     auto go_on = [&]() {

@@ -443,8 +443,9 @@ std::string safety_fuzz_report(const SafetyFuzzResult& result, const SafetyFuzzO
     << " mm; a non-finite command; a crash or a diverged plant; a refused write (unhandled: no safe stop the next cycle); "
        "not back within "
     << t.recovery_tolerance_rad << " rad of the reference (held pose; fault-free path; dual compliance: at rest) within "
-    << t.recovery_time_s << " s plus the walk back (the largest deviation after the end / " << t.return_speed_rad_s
-    << " rad/s, the controller's return leash), and not in a safe stop; a safe stop still moving (max abs(qd) >= " << t.rest_speed_rad_s
+    << t.recovery_time_s << " s of the end (a fault during a push: the later of its end and the push's) plus the walk back "
+       "(the largest deviation after the end, or a carried arm's distance from where the reference rests, / "
+    << t.return_speed_rad_s << " rad/s, the controller's return leash), and not in a safe stop; a safe stop still moving (max abs(qd) >= " << t.rest_speed_rad_s
     << " rad/s) " << t.safe_stop_rest_time_s
     << " s after it began. Operator-possible: the push needed more than a joint's torque limit to hold the arm "
        "(|g(q) - J_p^T F|_i > tau_limit_i, controller model, true q).\n\n";
