@@ -476,7 +476,6 @@ void Controller::safe_stop(bool sample_good, RobotCommand& command) {
     hold_q_ = supervisor_.has_kinematics() ? brake_q_ : q_;
     hold_qd_.setZero();
     if (holding_ && have_command_ && !position_loop && supervisor_.has_kinematics()) hold_qd_ = brake_qd_;
-    hold_on_prediction_ = !position_loop && !supervisor_.kinematics_fresh();
     stop_entry_tau_ = guarded_tau_;
     // In the position loop the reference brakes from where it is (kept within the following
     // error of the measured pose, LowLevelController): a jump to the measured pose, or a reference
@@ -487,13 +486,6 @@ void Controller::safe_stop(bool sample_good, RobotCommand& command) {
     }
   }
   if (holding_) {
-    // A hold begun on the brake's prediction starts again from the arm's measured state as soon as
-    // there is one (after a stall, the prediction knew nothing of the hand that pulled meanwhile).
-    if (hold_on_prediction_ && supervisor_.kinematics_fresh()) {
-      hold_q_ = brake_q_;
-      hold_qd_ = brake_qd_;
-      hold_on_prediction_ = false;
-    }
     brake_reference();
     keep_hold_acceptable();
     low_level_.hold(hold_q_, command);
@@ -600,7 +592,6 @@ bool Controller::answer_refused_write(const RobotState& state, RobotCommand& com
   holding_ = true;
   hold_qd_ = brake_qd_;
   hold_q_ = brake_q_;
-  hold_on_prediction_ = !supervisor_.kinematics_fresh();
   if (state.q_rad.size() == model_.nq() && state.q_rad.allFinite() &&
       (state.q_rad.array() >= limit_lower_.array()).all() && (state.q_rad.array() <= limit_upper_.array()).all()) {
     hold_q_ = state.q_rad;

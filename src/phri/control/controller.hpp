@@ -211,7 +211,6 @@ private:
   long refused_step_ = -2;            // the step of the latest refused write
   long refusals_in_row_ = 0;          // refused writes in consecutive steps
   bool holding_ = false;
-  bool hold_on_prediction_ = false;  // the hold's reference was set from the brake's prediction
   bool brake_against_push_ = false;  // the safe stop's brake resists tau_ext (after a QP failure)
   Eigen::VectorXd hold_q_, hold_qd_;  // the safe stop's held reference, braking to rest (position loop)
   Eigen::VectorXd acceleration_;      // q̈ of the latest good samples, low-passed [rad/s^2]
