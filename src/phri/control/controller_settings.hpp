@@ -74,7 +74,8 @@ struct SafetySettings {
   /// degraded budget. Off by default: on a Kinova arm the hold's entry at speed goes through the
   /// actuators' mode switch, a torque step (107 N.m at 1.9 rad/s through the Kortex emulator,
   /// KortexSession.PacketLossOfOnePercent...), and a damping brake instead lets a hand pull the arm
-  /// to 3.4x (safety fuzz, seed 90210). On, the fuzz's five overspeeds of that seed are gone.
+  /// to 3.4x (safety fuzz, seed 90210). On, the five overspeeds of that seed were gone (replays, with
+  /// a hold that also re-seeded from the first plausible sample, since removed: docs/safety.md).
   bool stop_missed_at_speed = false;
   /// Velocity guard of the torque loops, the last line behind the QP's velocity constraint: above
   /// guard_fraction x the drive's velocity limit, damping rate x (M_ii + I_r) x the excess, scaled
