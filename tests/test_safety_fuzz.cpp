@@ -45,6 +45,15 @@ phri::SafetyFuzzOptions small_options(const std::string& out) {
   return o;
 }
 
+// One window of the command line's protocol replayed alone (`--seed seed --pushes pushes --replay run`).
+phri::SafetyFuzzResult replay(std::uint64_t seed, int pushes, const char* run) {
+  phri::SafetyFuzzOptions o = small_options("");
+  o.seed = seed;
+  o.pushes = pushes;
+  o.replay = run;
+  return phri::run_safety_fuzz(o);
+}
+
 std::size_t count_lines(const std::string& path) {
   std::ifstream f(path);
   std::size_t n = 0;
@@ -776,11 +785,7 @@ TEST(SafetyFuzz, FaultsInMotionFormerFailuresReplayedPass) {
                        // the servo into the arm (1.155x) once they passed again.
                        Case{8080, "motion/full_body/kinova_torque_high_velocity/write_refused"}}) {
     SCOPED_TRACE(c.run);
-    phri::SafetyFuzzOptions o = small_options("");
-    o.seed = c.seed;
-    o.pushes = 400;
-    o.replay = c.run;
-    const phri::SafetyFuzzResult r = phri::run_safety_fuzz(o);
+    const phri::SafetyFuzzResult r = replay(c.seed, 400, c.run);
     ASSERT_EQ(r.records.size(), 2u);
     const phri::FuzzRecord& fault = r.records[1];
     EXPECT_EQ(fault.run_id, c.run);
@@ -796,11 +801,7 @@ TEST(SafetyFuzz, FaultsInMotionFormerFailuresReplayedPass) {
   // A 98-period stall while a hand pulls the tool at 79 N (dual compliance, custom loop): 1.68x
   // before the controller runs again, nothing any controller could act on; it then brakes from
   // there and never goes faster: an overspeed on a held command.
-  phri::SafetyFuzzOptions o = small_options("");
-  o.seed = 5511;
-  o.pushes = 400;
-  o.replay = "motion/dual/custom/stall_random_98";
-  const phri::SafetyFuzzResult r = phri::run_safety_fuzz(o);
+  const phri::SafetyFuzzResult r = replay(5511, 400, "motion/dual/custom/stall_random_98");
   ASSERT_EQ(r.records.size(), 2u);
   const phri::FuzzRecord& stall = r.records[1];
   EXPECT_GT(stall.metrics.max_held_speed_ratio, 1.5);
@@ -872,11 +873,7 @@ TEST(SafetyFuzz, FormerFailuresReplayedPass) {
                        // posture target, which the push's window was judged from (no_recovery, 0.122 rad).
                        Case{20261127, "push/full_body/custom/16"}}) {
     SCOPED_TRACE(c.run);
-    phri::SafetyFuzzOptions o = small_options("");
-    o.seed = c.seed;
-    o.pushes = 3000;
-    o.replay = c.run;
-    const phri::SafetyFuzzResult r = phri::run_safety_fuzz(o);
+    const phri::SafetyFuzzResult r = replay(c.seed, 3000, c.run);
     ASSERT_FALSE(r.records.empty());
     double worst_speed = 0.0, worst_margin = 1e9;
     for (const phri::FuzzRecord& x : r.records) {
