@@ -776,6 +776,7 @@ TEST(SafetyFuzz, FaultsInMotionFormerFailuresReplayedPass) {
   struct Case {
     std::uint64_t seed;
     const char* run;
+    int pushes = 400;
   };
   for (const Case c : {Case{8080, "motion/full_body/kinova_torque_high_velocity/stamp_frozen"},
                        Case{8080, "switch/full_body/kinova_torque_high_velocity/frozen_values"},
@@ -783,9 +784,13 @@ TEST(SafetyFuzz, FaultsInMotionFormerFailuresReplayedPass) {
                        Case{5511, "switch/full_body/kinova_torque_high_velocity/offset_tau_5Nm"},
                        // A dead-stop hold at the measured pose while 100 writes were refused slammed
                        // the servo into the arm (1.155x) once they passed again.
-                       Case{8080, "motion/full_body/kinova_torque_high_velocity/write_refused"}}) {
+                       Case{8080, "motion/full_body/kinova_torque_high_velocity/write_refused"},
+                       // Carried 1.5 rad, the arm walked back ahead of the reference's own walk and
+                       // rested on the pose before the push; judged against the reference's path
+                       // alone, still 0.13 rad away when the window closed: no_recovery.
+                       Case{111, "switch/full_body/custom/offset_tau_5Nm", 3000}}) {
     SCOPED_TRACE(c.run);
-    const phri::SafetyFuzzResult r = replay(c.seed, 400, c.run);
+    const phri::SafetyFuzzResult r = replay(c.seed, c.pushes, c.run);
     ASSERT_EQ(r.records.size(), 2u);
     const phri::FuzzRecord& fault = r.records[1];
     EXPECT_EQ(fault.run_id, c.run);

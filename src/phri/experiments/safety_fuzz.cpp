@@ -747,14 +747,22 @@ void judge_motion_cycle(Rig& rig, const Shared& s, const MotionScenario& sc, boo
   const bool rests_where_left = sc.mode == ComplianceMode::kDual && t >= push_end && rig.speed() < th.rest_speed_rad_s;
   const double deviation = rests_where_left ? 0.0 : from_reference;
   if (!reference || t >= push_end) m.max_deviation_rad = std::max(m.max_deviation_rad, deviation);
-  m.final_deviation_rad = deviation;
-  m.final_deviation_joint = rests_where_left ? -1 : joint;
-  m.final_speed_rad_s = rig.speed();
+  double recovery_deviation = deviation;
   if (!reference && sc.mode != ComplianceMode::kDual && t >= push_end) {
     int rest_joint = -1;
-    tracker.allow_walk_back(t, rig.monitor().deviation(rig.q(), sc.q.col(sc.q.cols() - 1), rest_joint));
+    const double from_rest = rig.monitor().deviation(rig.q(), sc.q.col(sc.q.cols() - 1), rest_joint);
+    tracker.allow_walk_back(t, from_rest);
+    // A carried arm that walks back faster than the reference is back once it is where the
+    // reference comes to rest, though the reference's path has not got there yet.
+    if (from_rest < recovery_deviation) {
+      recovery_deviation = from_rest;
+      joint = rest_joint;
+    }
   }
-  tracker.sample(t, deviation, rig.speed(), rig.safe_stop_time());
+  m.final_deviation_rad = recovery_deviation;
+  m.final_deviation_joint = rests_where_left ? -1 : joint;
+  m.final_speed_rad_s = rig.speed();
+  tracker.sample(t, recovery_deviation, rig.speed(), rig.safe_stop_time());
 }
 
 // The reference run's path, cut to the plant cycles it ran, is ready for the faulted runs.

@@ -442,7 +442,7 @@ std::string safety_fuzz_report(const SafetyFuzzResult& result, const SafetyFuzzO
     << " x its velocity limit; a self-collision capsule pair below " << format_fixed(1e3 * t.collision_distance_m, 0)
     << " mm; a non-finite command; a crash or a diverged plant; a refused write (unhandled: no safe stop the next cycle); "
        "not back within "
-    << t.recovery_tolerance_rad << " rad of the reference (held pose; fault-free path; dual compliance: at rest) within "
+    << t.recovery_tolerance_rad << " rad of the reference (held pose; fault-free path, or where it comes to rest after a push; dual compliance: at rest) within "
     << t.recovery_time_s << " s of the end (a fault during a push: the later of its end and the push's) plus the walk back "
        "(the largest deviation after the end, or a carried arm's distance from where the reference rests, / "
     << t.return_speed_rad_s << " rad/s, the controller's return leash), and not in a safe stop; a safe stop still moving (max abs(qd) >= " << t.rest_speed_rad_s
