@@ -475,7 +475,7 @@ void Controller::safe_stop(bool sample_good, RobotCommand& command) {
     brake_against_push_ = !holding_ && reason == SafetyFault::kQpFailure;
     hold_q_ = supervisor_.has_kinematics() ? brake_q_ : q_;
     hold_qd_.setZero();
-    if (holding_ && have_command_ && !position_loop && supervisor_.has_kinematics()) hold_qd_ = brake_qd_;
+    if (holding_ && have_command_ && !position_loop && supervisor_.has_kinematics()) hold_from_brake_speed();
     stop_entry_tau_ = guarded_tau_;
     // In the position loop the reference brakes from where it is (kept within the following
     // error of the measured pose, LowLevelController): a jump to the measured pose, or a reference
@@ -590,7 +590,7 @@ bool Controller::answer_refused_write(const RobotState& state, RobotCommand& com
   // reading of its joints, when finite and within the joint range, is the nearest pose it
   // accepts, even in a sample the supervisor rejected for another signal.
   holding_ = true;
-  hold_qd_ = brake_qd_;
+  hold_from_brake_speed();
   hold_q_ = brake_q_;
   if (state.q_rad.size() == model_.nq() && state.q_rad.allFinite() &&
       (state.q_rad.array() >= limit_lower_.array()).all() && (state.q_rad.array() <= limit_upper_.array()).all()) {
@@ -630,6 +630,14 @@ void Controller::track_acceleration(const Eigen::VectorXd& qd, double dt) {
     filtered_qd_[i] += alpha * (qd[i] - filtered_qd_[i]);
     acceleration_[i] = (filtered_qd_[i] - previous) / dt;
   }
+}
+
+// The held reference moves on at the brake's speed, never faster than the drive's limit: a hand
+// that took the arm past it while the robot ran on a refused or stale command is braked by the
+// servo from there (a reference moving at the arm's 1.43x lagged behind the servo's damping, which
+// pulled the arm forward again once writes passed).
+void Controller::hold_from_brake_speed() {
+  hold_qd_ = brake_qd_.cwiseMax(-drive_velocity_limit_).cwiseMin(drive_velocity_limit_);
 }
 
 // The held reference's velocity decays at brake_rate (as the torque loops' brake), the reference

@@ -163,6 +163,7 @@ private:
   void shape_tasks();
   void guard_torque(Eigen::VectorXd& tau);
   void brake_reference();
+  void hold_from_brake_speed();
   void check_qp(WholeBodyQpStatus qp_status, double t);
 
   ControllerSettings settings_;
