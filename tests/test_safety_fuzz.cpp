@@ -821,6 +821,22 @@ TEST(SafetyFuzz, FaultsInMotionFormerFailuresReplayedPass) {
   EXPECT_EQ(r.held_command_windows(), 1);
 }
 
+// Four windows of seed 31 put their fault on the very sample that carried the switch request; the
+// controller does not switch on a bad sample, so they ran the position loop and were invalid. A
+// fault after a switch now starts after the sample the reference switched on.
+TEST(SafetyFuzz, AFaultAfterASwitchHitsTheLoopItNames) {
+  for (const char* run : {"switch/full_body/kinova_torque/sequence_jump_1e6", "switch/stiff/custom/spike_q_0.5rad"}) {
+    SCOPED_TRACE(run);
+    const phri::SafetyFuzzResult r = replay(31, 3000, run);
+    ASSERT_EQ(r.records.size(), 2u);
+    const phri::FuzzRecord& fault = r.records[1];
+    EXPECT_EQ(fault.fault_offset_s, 0.0) << "the draw this case is about: no delay after the switch";
+    EXPECT_FALSE(fault.verdict.invalid) << phri::safety_fuzz_csv(r);
+    EXPECT_EQ(fault.metrics.off_intent_cycles, 0);
+    EXPECT_FALSE(fault.verdict.controller_failure()) << phri::safety_fuzz_csv(r);
+  }
+}
+
 }  // namespace
 
 namespace {

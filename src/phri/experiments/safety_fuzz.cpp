@@ -323,6 +323,7 @@ public:
   double time() const { return robot_->state().time_s; }
   long cycles() const { return io_.cycles(); }  ///< control cycles (reads the controller saw)
   long plant_cycles() const { return static_cast<long>(robot_->state().cycle); }  ///< periods the plant ran
+  LowLevelMode running_loop() const { return cycle_.low_level().loop(); }
   void request_loop(LowLevelMode loop) {  ///< at the next step
     targets_.low_level_mode = loop;
     expected_loop_ = loop;
@@ -663,9 +664,10 @@ struct MotionScenario {
   PushSpec push;
   long switch_offset = 0;    // cycles after the push began
   // Filled by the reference run: the plant's true q after each read (column = plant cycle - 1),
-  // from the push on, and the control cycle the push began at.
+  // from the push on, the control cycle the push began at and the one the switch took effect in.
   Eigen::MatrixXd q;
   long push_cycle = -1;
+  long switched_cycle = -1;
   bool ready = false;
 
   const char* context() const { return with_switch ? "switch" : "motion"; }
@@ -716,7 +718,11 @@ FuzzRecord motion_record(const Shared& s, const std::string& id, const MotionSce
   describe_fault(r, *fault, fault_cycles);
   r.fault_offset_s = static_cast<double>(offset) * s.dt;
   spec = fault->spec;
-  spec.start_cycle = sc.push_cycle + (sc.with_switch ? sc.switch_offset : 0) + offset;
+  // After a switch: from the sample after the one the reference switched on (a bad sample with the
+  // request keeps the position loop, and the window would not test the loop it names). A reference
+  // that never switched leaves the request's cycle: its windows are invalid, and reported so.
+  const long after_switch = sc.switched_cycle >= 0 ? sc.switched_cycle + 1 : sc.push_cycle + sc.switch_offset;
+  spec.start_cycle = (sc.with_switch ? after_switch : sc.push_cycle) + offset;
   spec.cycles = fault_cycles;
   return r;
 }
@@ -819,8 +825,12 @@ void motion_run(const Shared& s, const std::string& id, MotionScenario& sc, cons
       // A faulted run is the reference until its fault: judged from the fault's first cycle on.
       const bool judged = reference || rig.cycles() >= spec.start_cycle;
       WindowMetrics& cycle_metrics = judged ? m : warm;
+      const long cycle = rig.cycles();
       rig.step(cycle_metrics);
       const double t = rig.time();
+      if (reference && switch_cycle >= 0 && sc.switched_cycle < 0 && cycle >= switch_cycle && rig.running_loop() == sc.loop) {
+        sc.switched_cycle = cycle;
+      }
       if (reference) {
         if (rig.plant_cycles() > sc.q.cols()) sc.q.conservativeResize(Eigen::NoChange, sc.q.cols() + 1000);
         sc.q.col(rig.plant_cycles() - 1) = rig.q();

@@ -31,7 +31,8 @@
 //    after the fault, indexed by the plant's cycle (a stall skips ahead). And after a loop switch:
 //    the run stays in the position loop through the warm-up, the push begins, 0.1-0.5 s into it the
 //    controller is switched to the loop under test on the moving arm, and each fault starts 0-50 ms
-//    after the switch (a "switch-reference" per pair; no such windows for the position loop).
+//    after the sample the reference switched on (a "switch-reference" per pair; no such windows
+//    for the position loop).
 //    In dual compliance an arm at rest after the hand let go counts as back (it keeps the pose it is
 //    pushed to), as for the pushes.
 // 3. Every cycle, on the plant's truth: joint limits, |q̇| > 1.05 x its limit, capsule distances,
@@ -146,7 +147,7 @@ struct FuzzRecord {
   std::string fault_kind;    ///< the decorator's FaultKind (to_string)
   std::string context;       ///< fault or its reference: "rest", "motion" or "switch"; pushes: empty
   std::string push_link;     ///< motion / switch: the link (or tool) the push lands on
-  double fault_offset_s = 0.0;  ///< motion: after the push began; switch: after the loop switch
+  double fault_offset_s = 0.0;  ///< motion: after the push began; switch: after the sample the switch took effect on
   WindowMetrics metrics;
   FuzzVerdict verdict;
   std::string safe_stop_reason;
