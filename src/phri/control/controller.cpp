@@ -604,14 +604,18 @@ bool Controller::answer_refused_write(const RobotState& state, RobotCommand& com
 // drive's limit, where the QP's velocity bound holds the arm against a hand) the torque loops'
 // command is a balance against that hand, shaped from the measured speed; repeated blind it is no
 // brake (a hand pulling at the tool took the arm from 0.9x to 1.2x its limit within the 20 ms
-// budget). A missing sample stops at once where the last velocity, carried on at the recent
-// acceleration over the budget, reaches the guard; elsewhere, and after a gap already beyond the
-// budget (a stall: the next samples re-synchronise and the supervisor's stop brakes on them), the
-// previous command stands in (hold_previous()).
+// budget). A sample whose joints are plausible (its torque or current is not) stops at once where
+// their velocity, carried on at the recent acceleration over the budget, reaches the guard: the
+// hold then brakes from the measured state (a hand on the tool took a wrist joint from 0.83x to
+// 1.08x in the 20 ms of an infinite torque reading). A missing sample does the same with
+// stop_missed_at_speed. Elsewhere, and after a gap already beyond the budget (a stall: the next
+// samples re-synchronise and the supervisor's stop brakes on them), the previous command stands in
+// (hold_previous()).
 void Controller::missing_sample(const RobotState& state, RobotCommand& command) {
   const double budget = supervisor_.settings().max_degraded_s;
-  if (settings_.safety.stop_missed_at_speed && have_command_ && low_level_.loop() != LowLevelMode::kPosition &&
-      supervisor_.has_kinematics() && kinematics_age_s() <= budget &&
+  const bool judge_speed =
+      supervisor_.kinematics_fresh() || (settings_.safety.stop_missed_at_speed && kinematics_age_s() <= budget);
+  if (judge_speed && have_command_ && low_level_.loop() != LowLevelMode::kPosition && supervisor_.has_kinematics() &&
       ((supervisor_.kinematic_qd() + budget * acceleration_).cwiseAbs().array() >=
        settings_.safety.velocity_guard_fraction * drive_velocity_limit_.array()).any()) {
     supervisor_.report(SafetyFault::kMissedAtSpeed, state.time_s);

@@ -76,6 +76,8 @@ struct SafetySettings {
   /// KortexSession.PacketLossOfOnePercent...), and a damping brake instead lets a hand pull the arm
   /// to 3.4x (safety fuzz, seed 90210). On, the five overspeeds of that seed were gone (replays, with
   /// a hold that also re-seeded from the first plausible sample, since removed: docs/safety.md).
+  /// (A sample whose joints are plausible, only its torque or current not, always stops so: the
+  /// hold brakes from the measured state, Controller::missing_sample.)
   bool stop_missed_at_speed = false;
   /// Velocity guard of the torque loops, the last line behind the QP's velocity constraint: above
   /// guard_fraction x the drive's velocity limit, damping rate x (M_ii + I_r) x the excess, scaled

@@ -771,6 +771,16 @@ void judge_motion_cycle(Rig& rig, const Shared& s, const MotionScenario& sc, boo
   tracker.sample(t, recovery_deviation, rig.speed(), rig.safe_stop_time());
 }
 
+// The reference run's cycle (`cycle`: the control cycle before it): the plant's true q into the
+// path, and the cycle the loop switch requested at `switch_cycle` (-1: none) took effect in.
+void record_reference_cycle(const Rig& rig, MotionScenario& sc, long cycle, long switch_cycle) {
+  if (switch_cycle >= 0 && sc.switched_cycle < 0 && cycle >= switch_cycle && rig.running_loop() == sc.loop) {
+    sc.switched_cycle = cycle;
+  }
+  if (rig.plant_cycles() > sc.q.cols()) sc.q.conservativeResize(Eigen::NoChange, sc.q.cols() + 1000);
+  sc.q.col(rig.plant_cycles() - 1) = rig.q();
+}
+
 // The reference run's path, cut to the plant cycles it ran, is ready for the faulted runs.
 void keep_reference_path(MotionScenario& sc, long plant_cycles) {
   sc.q.conservativeResize(Eigen::NoChange, std::min<long>(sc.q.cols(), plant_cycles));
@@ -828,13 +838,7 @@ void motion_run(const Shared& s, const std::string& id, MotionScenario& sc, cons
       const long cycle = rig.cycles();
       rig.step(cycle_metrics);
       const double t = rig.time();
-      if (reference && switch_cycle >= 0 && sc.switched_cycle < 0 && cycle >= switch_cycle && rig.running_loop() == sc.loop) {
-        sc.switched_cycle = cycle;
-      }
-      if (reference) {
-        if (rig.plant_cycles() > sc.q.cols()) sc.q.conservativeResize(Eigen::NoChange, sc.q.cols() + 1000);
-        sc.q.col(rig.plant_cycles() - 1) = rig.q();
-      }
+      if (reference) record_reference_cycle(rig, sc, cycle, switch_cycle);
       const double scale = force.scale_at(t - 0.5 * s.dt);
       if (scale > 0.0) {
         rig.monitor().push_torque_ratio(sc.push.body, sc.push.point_local, scale * sc.push.force_N, sc.push.local_frame,
