@@ -305,6 +305,25 @@ void print_run_line(const RunArguments& args, const phri::Config& config) {
                                          : "end-effector wrench estimated from the observer's tau_ext (no F/T sensor; least squares through J_ee)");
 }
 
+// The run's log, when enabled; its legend names the links of the power-and-force-limiting columns.
+void open_run_log(phri::Config& config, const phri::Controller& cycle, std::optional<phri::Logger>& logger) {
+  if (!config.logging_enabled) return;
+  if (config.body_regions && cycle.collision() != nullptr) {
+    config.logging.pfl_links = phri::PowerForceLimitMonitor::monitored_links(*cycle.collision());
+  }
+  logger.emplace(config.logging);
+}
+
+// The summary on stdout and in <out>/summary.md.
+void write_run_summary(const phri::RunSummary& summary, const std::string& config_path, const std::filesystem::path& out) {
+  phri::print_run_summary(summary, std::cout);
+  std::ostringstream md;
+  md << "# phri run: " << config_path << "\n\n";
+  phri::print_run_summary(summary, md);
+  phri::write_text_file((out / "summary.md").string(), md.str());
+  std::printf("\nwrote %s\n", (out / "summary.md").c_str());
+}
+
 // `phri run`: loads the configuration, runs the session, writes the log, summary and figure.
 int run_command(const RunArguments& args) {
   phri::Config config = phri::Config::from_yaml_file(args.config_path, args.robot_folder);
@@ -345,7 +364,7 @@ int run_command(const RunArguments& args) {
     gamepad->start();
   }
   std::optional<phri::Logger> logger;
-  if (config.logging_enabled) logger.emplace(config.logging);
+  open_run_log(config, cycle, logger);
   phri::LiveChannel live;
   std::unique_ptr<phri::DashboardServer> dashboard;
   if (args.dashboard.enabled) dashboard = start_dashboard(args.dashboard, config, cycle, live);
@@ -354,6 +373,7 @@ int run_command(const RunArguments& args) {
   if (dashboard || backend->brake_on_interrupt()) options.live = &live;
   options.pushes = backend->pushes();
   options.ground_truth = backend->ground_truth();
+  if (config.body_regions) options.body_regions = &*config.body_regions;
   // Until the files are written. On the arm, Ctrl-C brakes to rest first (InterruptToStop replaces
   // the SIGINT handler); SIGTERM ends the loop there too, then the backend's exit sequence.
   const StopOnSignals stop_on_signals;
@@ -372,12 +392,7 @@ int run_command(const RunArguments& args) {
   std::printf("\n");
   if (ros2) ros2->finish(std::cout);
   if (const std::string report = backend->report(); !report.empty()) std::printf("%s\n", report.c_str());
-  phri::print_run_summary(summary, std::cout);
-  std::ostringstream md;
-  md << "# phri run: " << args.config_path << "\n\n";
-  phri::print_run_summary(summary, md);
-  phri::write_text_file((out / "summary.md").string(), md.str());
-  std::printf("\nwrote %s\n", (out / "summary.md").c_str());
+  write_run_summary(summary, args.config_path, out);
   if (logger) {
     const phri::LoggerStats stats = logger->close();
     std::printf("%s\n", logger->summary().c_str());

@@ -92,7 +92,7 @@ void ControllerCyclePowerForceLimit(benchmark::State& state) {
   time_cycles(state, [&](phri::ControllerSettings& s) {
     if (state.range(0) == 0) return;
     phri::PowerForceLimitSettings limit;
-    limit.region = {"hand_fingers", 75e3, 0.6, 140.0, 2.0};
+    limit.regions.region = {"hand_fingers", 75e3, 0.6, 140.0, 2.0};
     s.qp.power_force_limit = limit;
   });
 }

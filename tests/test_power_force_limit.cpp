@@ -98,7 +98,7 @@ double drive_far(bool limited, phri::LowLevelMode loop = phri::LowLevelMode::kCu
   phri::SimRobot robot(config);
   phri::ControllerSettings settings = phri::test::gen3_controller_settings(phri::ComplianceMode::kStiff, loop);
   phri::PowerForceLimitSettings pfl;
-  pfl.region = slow_region();
+  pfl.regions.region = slow_region();
   if (limited) settings.qp.power_force_limit = pfl;
   phri::Controller cycle(settings);
   // The same figures on the plant's true state, through a probe of its own.
@@ -138,7 +138,7 @@ TEST(PowerForceLimit, TheQpHoldsEachPointWithinItsPermissibleSpeedWhenItsAcceler
   phri::WholeBodyQpSettings settings;
   settings.end_effector_frame = "end_effector_link";
   phri::PowerForceLimitSettings limit;
-  limit.region = slow_region();
+  limit.regions.region = slow_region();
   settings.power_force_limit = limit;
   phri::WholeBodyQp qp(model, &capsules, settings);
   Eigen::VectorXd q(7), qd = Eigen::VectorXd::Zero(7);
@@ -197,7 +197,7 @@ TEST(PowerForceLimit, TheRunYamlNamesARegionOfTheShippedFile) {
   const phri::Config config = phri::Config::from_yaml_string(
       force_table_with("{regions_file: iso_ts_15066_regions.yaml, region: hand_fingers}"), "test.yaml", kRoot + "/configs");
   ASSERT_TRUE(config.controller.qp.power_force_limit);
-  const phri::BodyRegion& hand = config.controller.qp.power_force_limit->region;
+  const phri::BodyRegion& hand = config.controller.qp.power_force_limit->regions.region;
   EXPECT_EQ(hand.name, "hand_fingers");
   EXPECT_EQ(hand.stiffness_N_per_m, 75000.0);
   EXPECT_EQ(hand.mass_kg, 0.6);
@@ -209,6 +209,91 @@ TEST(PowerForceLimit, TheRunYamlNamesARegionOfTheShippedFile) {
   } catch (const phri::ConfigError& e) {
     EXPECT_NE(std::string(e.what()).find("controller.qp.power_force_limit.region: no region 'elbow'"), std::string::npos)
         << e.what();
+  }
+}
+
+// The monitor's figures per link: the faster capsule end point's speed against central
+// differences of the forward kinematics, its reflected mass against reflected_mass() along that
+// motion, v_max and the energy against their closed forms; each link's region as the map names it.
+TEST(PowerForceLimitMonitor, EachLinkHasItsFasterEndPointsFiguresAndItsOwnRegion) {
+  const std::string gen3 = kRoot + "/robots/kinova_gen3/";
+  const phri::Model model = phri::Model::from_urdf_file(gen3 + "gen3.urdf");
+  const phri::CollisionModel capsules = phri::CollisionModel::from_yaml_file(gen3 + "collision.yaml", model);
+  phri::BodyRegionMap regions;
+  regions.region = {"lower_arm_wrist", 40000.0, 2.0, 160.0, 2.0};
+  regions.links.emplace_back("end_effector_link", phri::BodyRegion{"hand_fingers", 75000.0, 0.6, 140.0, 2.0});
+  const Eigen::VectorXd rotor = Eigen::VectorXd::Constant(7, 0.2);
+  phri::PowerForceLimitMonitor monitor(model, capsules, rotor, regions);
+  const std::vector<std::string> links = phri::PowerForceLimitMonitor::monitored_links(capsules);
+  ASSERT_EQ(monitor.num_links(), static_cast<int>(links.size()));
+  ASSERT_EQ(links.size(), capsules.capsules().size() - 1) << "every capsule but the base's";
+  Eigen::VectorXd q(7), qd(7);
+  q << 0.2, 0.6, 3.0, -1.8, 0.3, 0.9, 1.5;
+  qd << 0.4, -0.3, 0.5, 0.6, -0.8, 0.7, 1.1;
+  phri::Data data(model);
+  phri::compute_all_terms(model, data, q, qd);
+  monitor.update(model, data);
+  Eigen::MatrixXd inertia = data.mass_matrix;
+  inertia.diagonal() += rotor;
+  const Eigen::LLT<Eigen::MatrixXd> llt(inertia);
+  auto world = [&](const Eigen::VectorXd& at, int body, const Eigen::Vector3d& local) {
+    phri::Data d(model);
+    phri::forward_kinematics(model, d, at);
+    return Eigen::Vector3d(d.body_placements[static_cast<std::size_t>(body)] * local);
+  };
+  const double h = 1e-6;
+  double worst = 0.0;
+  int index = 0;
+  for (const phri::Capsule& c : capsules.capsules()) {
+    if (c.body < 0) continue;
+    SCOPED_TRACE(c.link);
+    const phri::ContactPointState& s = monitor.link(index);
+    EXPECT_EQ(monitor.link_name(index), c.link);
+    EXPECT_EQ(monitor.region(index).name, c.link == "end_effector_link" ? "hand_fingers" : "lower_arm_wrist");
+    Eigen::Vector3d v[2];
+    int k = 0;
+    for (const Eigen::Vector3d& local : {c.p0, c.p1}) {
+      v[k++] = (world(q + h * qd, c.body, local) - world(q - h * qd, c.body, local)) / (2 * h);
+    }
+    const int fast = v[1].norm() > v[0].norm() ? 1 : 0;
+    EXPECT_NEAR(s.speed_m_s, v[fast].norm(), 1e-6);
+    Eigen::MatrixXd j(3, 7);
+    phri::body_point_linear_jacobian(model, data, c.body, world(q, c.body, fast ? c.p1 : c.p0), j);
+    Eigen::VectorXd scratch(7), solved(7);
+    const double m_u = phri::reflected_mass(j, llt, v[fast].normalized(), scratch, solved);
+    EXPECT_NEAR(s.reflected_mass_kg, m_u, 1e-9 * m_u);
+    const phri::BodyRegion& r = monitor.region(index);
+    const double mu = 1.0 / (1.0 / r.mass_kg + 1.0 / m_u);
+    EXPECT_NEAR(s.permissible_speed_m_s, r.transient_force_N() / std::sqrt(mu * r.stiffness_N_per_m), 1e-9);
+    EXPECT_NEAR(s.energy_J, 0.5 * mu * s.speed_m_s * s.speed_m_s, 1e-9 * s.energy_J);
+    worst = std::max(worst, s.ratio());
+    ++index;
+  }
+  EXPECT_GT(worst, 0.0);
+  EXPECT_EQ(monitor.link(monitor.worst_link()).ratio(), worst);
+}
+
+TEST(PowerForceLimitMonitor, TheRunYamlMapsLinksToRegionsAndTheConstraintsMapIsTheDefault) {
+  const std::string file = "regions_file: iso_ts_15066_regions.yaml";
+  phri::Config config = phri::Config::from_yaml_string(
+      force_table_with("{" + file + ", region: chest, links: {forearm_link: upper_arm_elbow}}"), "test.yaml", kRoot + "/configs");
+  ASSERT_TRUE(config.body_regions) << "the constraint's regions when there is no body_regions block";
+  EXPECT_EQ(config.body_regions->region.name, "chest");
+  EXPECT_EQ(config.body_regions->for_link("forearm_link").name, "upper_arm_elbow");
+  EXPECT_EQ(config.body_regions->for_link("bracelet_link").name, "chest");
+  std::string text = force_table_with("{" + file + ", region: chest}");
+  text += "body_regions: {" + file + ", region: face, links: {end_effector_link: hand_fingers}}\n";
+  config = phri::Config::from_yaml_string(text, "test.yaml", kRoot + "/configs");
+  ASSERT_TRUE(config.body_regions);
+  EXPECT_EQ(config.body_regions->region.name, "face");
+  EXPECT_EQ(config.body_regions->for_link("end_effector_link").name, "hand_fingers");
+  EXPECT_EQ(config.controller.qp.power_force_limit->regions.region.name, "chest");
+  try {
+    phri::Config::from_yaml_string(force_table_with("{" + file + ", region: chest, links: {forearm_link: elbow}}"), "test.yaml",
+                                   kRoot + "/configs");
+    ADD_FAILURE() << "an unknown region is an error";
+  } catch (const phri::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("links.forearm_link: no region 'elbow'"), std::string::npos) << e.what();
   }
 }
 

@@ -15,6 +15,7 @@
 #include <phri/app/run_session.hpp>
 #include <phri/config/fsm_settings.hpp>
 #include <phri/control/controller.hpp>
+#include <phri/control/power_force_limit.hpp>
 #include <phri/robot/actuator_table.hpp>
 #include <phri/robot/fake_robot.hpp>
 
@@ -28,6 +29,7 @@
 #include <cstdio>
 #include <fstream>
 #include <functional>
+#include <iterator>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -345,6 +347,57 @@ TEST(RunSession, RealTimePacingRunsTheSameCyclesNoFasterThanTheClock) {
 
 }  // namespace
 
+// With body regions, every cycle's power-and-force-limiting figures: the log's pfl_ columns name
+// the link closest to its permissible speed, the summary keeps each link's worst and its time above
+// 1; the start-up's motion moves every link but the first at least a little.
+TEST(RunSession, BodyRegionsGiveEachLinksPowerAndForceLimitingFiguresInTheLogAndTheSummary) {
+  phri::LoggerSettings log_settings;
+  log_settings.path = phri::test::temp_path("phri_test_run_session", "pfl.csv");
+  log_settings.dof = 7;
+  log_settings.pfl_links = phri::PowerForceLimitMonitor::monitored_links(*Session().controller_.collision());
+  phri::BodyRegionMap regions;
+  regions.region = {"test_slow", 75000.0, 0.6, 2.0, 2.0};  // v_max of a few cm/s: the start-up exceeds it
+  regions.links.emplace_back("end_effector_link", phri::BodyRegion{"hand_fingers", 75000.0, 0.6, 140.0, 2.0});
+  Session session;
+  phri::Logger logger(log_settings);
+  phri::RunOptions options;
+  options.duration_s = 1.0;
+  options.status_line = false;
+  options.body_regions = &regions;
+  const phri::RunSummary s =
+      phri::run_session(session.robot_, session.controller_, session.fsm_, nullptr, &logger, options, session.out_);
+  logger.close();
+  ASSERT_EQ(s.contact.size(), log_settings.pfl_links.size());
+  EXPECT_FALSE(s.contact_true_state) << "a fake robot has no ground truth";
+  double worst = 0.0;
+  for (std::size_t i = 0; i < s.contact.size(); ++i) {
+    const phri::ContactLinkSummary& c = s.contact[i];
+    EXPECT_EQ(c.link, log_settings.pfl_links[i]);
+    EXPECT_EQ(c.region, c.link == "end_effector_link" ? "hand_fingers" : "test_slow");
+    EXPECT_GE(c.max_speed_m_s, c.speed_at_max_m_s);
+    if (c.max_ratio > 0.0) {
+      EXPECT_NEAR(c.max_ratio, c.speed_at_max_m_s / c.permissible_speed_at_max_m_s, 1e-12);
+    }
+    EXPECT_LE(c.time_above_s, s.simulated_s + 1e-9);
+    worst = std::max(worst, c.max_ratio);
+  }
+  EXPECT_GT(worst, 1.0) << "the test region's v_max is below the start-up's speeds";
+  std::ostringstream text;
+  phri::print_run_summary(s, text);
+  EXPECT_NE(text.str().find("Power and force limiting (ISO/TS 15066 transient contact, the measured state): worst v / v_max"),
+            std::string::npos)
+      << text.str();
+  // The log: the worst link each cycle, its ratio as speed / v_max; the legend names the links.
+  std::ifstream in(log_settings.path);
+  std::string header;
+  std::getline(in, header);
+  EXPECT_NE(header.find(",pfl_ratio,pfl_link,pfl_speed_m_s,pfl_reflected_mass_kg,pfl_permissible_speed_m_s,pfl_energy_J,"),
+            std::string::npos);
+  std::ifstream legend(phri::Logger::legend_path_for(log_settings.path));
+  const std::string legend_text((std::istreambuf_iterator<char>(legend)), std::istreambuf_iterator<char>());
+  EXPECT_NE(legend_text.find("pfl_link:\n  -1: none\n  0: " + log_settings.pfl_links[0] + "\n"), std::string::npos) << legend_text;
+}
+
 // With a ground truth (a simulated arm's true link-side joints), the summary's EE errors are
 // target - the true end effector and the QP's own task error stays beside them, labelled. Here the
 // "truth" is the fake arm's q with joint 2 off by 0.01 rad, an error the QP (on the measured q)
@@ -357,6 +410,7 @@ TEST(RunSession, AGroundTruthMeasuresTheTrueEndEffectorBesideTheQpTaskError) {
       q[1] += 0.01;
       return q;
     }
+    const Eigen::VectorXd& true_joint_velocities() const override { return robot.state().qd_rad_s; }
     const phri::FakeRobot& robot;
     mutable Eigen::VectorXd q;
   };

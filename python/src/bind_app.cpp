@@ -74,7 +74,8 @@ void bind_logger(py::module_& m) {
       .def_property_readonly("path", &Logger::path)
       .def_property_readonly("legend_path", &Logger::legend_path)
       .def_static("header", &Logger::header, py::arg("dof"), "The CSV header line for `dof` joints.")
-      .def_static("legend_yaml", &Logger::legend_yaml, "The legend of the integer columns, as YAML.");
+      .def_static("legend_yaml", &Logger::legend_yaml, py::arg("pfl_links") = std::vector<std::string>{},
+                  "The legend of the integer columns, as YAML (`pfl_links`: the pfl_link column's link names).");
 }
 
 void bind_config(py::module_& m) {

@@ -72,7 +72,7 @@ std::string Logger::header(int dof) {
   return v.out;
 }
 
-std::string Logger::legend_yaml() {
+std::string Logger::legend_yaml(const std::vector<std::string>& pfl_links) {
   std::string out =
       "# Integer codes of the phri log's columns (phri::Logger). Units of the other columns: see\n"
       "# src/phri/config/log_row.hpp (SI: s, rad, rad/s, N.m, A, m, N).\n";
@@ -106,6 +106,8 @@ std::string Logger::legend_yaml() {
                                           WholeBodyQpStatus::kInvalidInput});
   legend_entry(out, "qp_status", {QpStatus::kOptimal, QpStatus::kInfeasible, QpStatus::kIterationLimit,
                                   QpStatus::kInvalidInput, QpStatus::kNumericalError});
+  out += "pfl_link:\n  -1: none\n";
+  for (std::size_t i = 0; i < pfl_links.size(); ++i) out += "  " + std::to_string(i) + ": " + pfl_links[i] + "\n";
   return out;
 }
 
@@ -143,7 +145,7 @@ Logger::Logger(const LoggerSettings& settings)
       std::fclose(file_);
       throw ConfigError(legend_path_, "", std::string("cannot create the log legend: ") + std::strerror(errno));
     }
-    const std::string text = legend_yaml();
+    const std::string text = legend_yaml(settings.pfl_links);
     std::fwrite(text.data(), 1, text.size(), legend);
     std::fclose(legend);
   }

@@ -75,7 +75,8 @@ public:
   /// The CSV header line (no newline) for `dof` joints.
   static std::string header(int dof);
   /// The legend of the integer columns, as YAML.
-  static std::string legend_yaml();
+  /// `pfl_links`: the names of the pfl_link column's indices (LoggerSettings::pfl_links).
+  static std::string legend_yaml(const std::vector<std::string>& pfl_links = {});
   /// Sidecar name: "a/run.csv" -> "a/run.legend.yaml".
   static std::string legend_path_for(const std::string& csv_path);
 

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <numbers>
+#include <optional>
 #include <ostream>
 #include <string>
 #include <string_view>
@@ -72,9 +73,19 @@ public:
         pushes_(options.pushes),
         ground_truth_(options.ground_truth),
         truth_data_(cycle.model()),
+        contact_data_(cycle.model()),
         observers_(options.observers) {
     if (live_) observers_.push_back(&live_->snapshots());
     if (live_ && pushes_) push_targets_ = push_targets(cycle.model(), *pushes_);
+    if (options.body_regions != nullptr && cycle.collision() != nullptr) {
+      Eigen::VectorXd rotor(cycle.model().nv());
+      for (int i = 0; i < rotor.size(); ++i) rotor[i] = cycle.actuators()[i].reflected_inertia_kgm2;
+      contact_.emplace(cycle.model(), *cycle.collision(), rotor, *options.body_regions);
+      for (int i = 0; i < contact_->num_links(); ++i) {
+        summary_.contact.push_back({contact_->link_name(i), contact_->region(i).name});
+      }
+      summary_.contact_true_state = has_true_state();
+    }
   }
 
   RunSummary run() {
@@ -144,9 +155,11 @@ private:
         ++summary_.refused_writes;
       }
     }
+    monitor_contact(state);
     if (logger_ || !observers_.empty()) {
       fill_log_row(row_, state, cycle_, fsm_);
       row_.cycle_time_s = 1e-6 * us;
+      fill_contact_columns();
     }
     if (logger_) logger_->push(row_);
     return status;
@@ -245,6 +258,49 @@ private:
     snapshot_.posture_stiffness = compliance.posture_stiffness();
     snapshot_.overruns = clock_.overruns();
     return snapshot_;
+  }
+
+  bool has_true_state() const {
+    const auto n = static_cast<Eigen::Index>(cycle_.model().nq());
+    return ground_truth_ != nullptr && ground_truth_->true_joint_positions().size() == n &&
+           ground_truth_->true_joint_velocities().size() == n;
+  }
+
+  // The power-and-force-limiting figures of every monitored link this cycle, on the plant's true
+  // state when known (the state a person would meet), into the run's per-link maxima.
+  void monitor_contact(const RobotState& state) {
+    if (!contact_) return;
+    const bool truth = has_true_state();
+    const Eigen::VectorXd& q = truth ? ground_truth_->true_joint_positions() : state.q_rad;
+    const Eigen::VectorXd& qd = truth ? ground_truth_->true_joint_velocities() : state.qd_rad_s;
+    if (q.size() != cycle_.model().nq() || qd.size() != cycle_.model().nv() || !q.allFinite() || !qd.allFinite()) return;
+    compute_all_terms(cycle_.model(), contact_data_, q, qd);
+    contact_->update(cycle_.model(), contact_data_);
+    for (int i = 0; i < contact_->num_links(); ++i) {
+      const ContactPointState& p = contact_->link(i);
+      ContactLinkSummary& s = summary_.contact[static_cast<std::size_t>(i)];
+      if (p.ratio() > s.max_ratio) {
+        s.max_ratio = p.ratio();
+        s.speed_at_max_m_s = p.speed_m_s;
+        s.reflected_mass_at_max_kg = p.reflected_mass_kg;
+        s.permissible_speed_at_max_m_s = p.permissible_speed_m_s;
+      }
+      s.max_speed_m_s = std::max(s.max_speed_m_s, p.speed_m_s);
+      s.max_energy_J = std::max(s.max_energy_J, p.energy_J);
+      if (p.ratio() > 1.0) s.time_above_s += period_;
+    }
+  }
+
+  void fill_contact_columns() {
+    const int worst = contact_ ? contact_->worst_link() : -1;
+    row_.pfl_link = worst;
+    const ContactPointState none;
+    const ContactPointState& p = worst >= 0 ? contact_->link(worst) : none;
+    row_.pfl_ratio = p.ratio();
+    row_.pfl_speed_m_s = p.speed_m_s;
+    row_.pfl_reflected_mass_kg = p.reflected_mass_kg;
+    row_.pfl_permissible_speed_m_s = p.permissible_speed_m_s;
+    row_.pfl_energy_J = p.energy_J;
   }
 
   // Target - the true end effector (forward kinematics of the plant's link-side joints) [mm, deg];
@@ -411,6 +467,8 @@ private:
   PushInput* pushes_;
   const GroundTruth* ground_truth_;
   Data truth_data_;  // forward kinematics of the true joints, sized once
+  Data contact_data_;  // the power-and-force-limiting figures' state (true or measured), sized once
+  std::optional<PowerForceLimitMonitor> contact_;
   std::vector<SnapshotChannel*> observers_;  // options.observers and the live front end's; sized before the loop
   std::vector<int> push_targets_;
   double push_start_s_ = 0.0, push_end_s_ = 0.0;
@@ -453,6 +511,32 @@ void print_run_summary(const RunSummary& s, std::ostream& out) {
                   p.ee_orientation_error_max_deg, p.ee_orientation_error_rms_deg, p.qp_task_position_error_max_mm,
                   p.qp_task_position_error_rms_mm, p.wrench_norm_max, p.compliance_switches, p.loop_switches,
                   p.cycle_median_us, p.cycle_p999_us);
+    out << line;
+  }
+  print_contact_summary(s, out);
+}
+
+void print_contact_summary(const RunSummary& s, std::ostream& out) {
+  if (s.contact.empty()) {
+    out << "\nPower and force limiting (ISO/TS 15066): not measured (no body_regions in the configuration, or no capsules)\n";
+    return;
+  }
+  const auto worst = std::max_element(s.contact.begin(), s.contact.end(),
+                                      [](const ContactLinkSummary& a, const ContactLinkSummary& b) { return a.max_ratio < b.max_ratio; });
+  char line[400];
+  std::snprintf(line, sizeof line,
+                "\nPower and force limiting (ISO/TS 15066 transient contact, %s): worst v / v_max %.2f on %s (%s), %.3f s above 1 "
+                "on that link\n",
+                s.contact_true_state ? "the plant's true state" : "the measured state", worst->max_ratio, worst->link.c_str(),
+                worst->region.c_str(), worst->time_above_s);
+  out << line;
+  out << "| link | region | max v / v_max | speed there m/s | reflected mass there kg | v_max there m/s | max speed m/s | "
+         "max energy J | time above 1 s |\n";
+  out << "|---|---|---|---|---|---|---|---|---|\n";
+  for (const ContactLinkSummary& c : s.contact) {
+    std::snprintf(line, sizeof line, "| %s | %s | %.3f | %.3f | %.2f | %.3f | %.3f | %.4f | %.3f |\n", c.link.c_str(),
+                  c.region.c_str(), c.max_ratio, c.speed_at_max_m_s, c.reflected_mass_at_max_kg, c.permissible_speed_at_max_m_s,
+                  c.max_speed_m_s, c.max_energy_J, c.time_above_s);
     out << line;
   }
 }

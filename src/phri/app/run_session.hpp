@@ -62,6 +62,23 @@ struct RunOptions {
   /// cycle (no wait, no allocation); once true, the run ends after that cycle as if its duration had
   /// run out, with RunSummary::interrupted set.
   const std::atomic<bool>* stop_requested = nullptr;
+  /// The body regions each link may meet (Config::body_regions), or null. Given, and the robot has
+  /// capsules, every cycle's power-and-force-limiting figures (control/power_force_limit.hpp:
+  /// PowerForceLimitMonitor) go into the log's pfl_ columns and the summary, on the ground truth's
+  /// state when there is one, else on the measured state.
+  const BodyRegionMap* body_regions = nullptr;
+};
+
+/// One link's power-and-force-limiting figures over the run (ISO/TS 15066 transient contact).
+struct ContactLinkSummary {
+  std::string link, region;
+  double max_ratio = 0.0;                 ///< largest v / v_max
+  double speed_at_max_m_s = 0.0;          ///< the speed, reflected mass and v_max of that cycle
+  double reflected_mass_at_max_kg = 0.0;
+  double permissible_speed_at_max_m_s = 0.0;
+  double max_speed_m_s = 0.0;
+  double max_energy_J = 0.0;              ///< largest 1/2 mu v^2
+  double time_above_s = 0.0;              ///< robot time with v / v_max > 1
 };
 
 struct PhaseSummary {
@@ -93,6 +110,9 @@ struct RunSummary {
   std::string safe_hold_reason;
   bool interrupted = false;              ///< ended by RunOptions::stop_requested before its duration
   std::vector<PhaseSummary> phases;
+  /// Per link with a capsule (RunOptions::body_regions); empty: no body regions configured.
+  std::vector<ContactLinkSummary> contact;
+  bool contact_true_state = false;       ///< measured on the plant's true state (a ground truth)
 };
 
 /// Runs the loop for options.duration_s of robot time (or until the FSM has stopped and the arm
@@ -100,7 +120,10 @@ struct RunSummary {
 RunSummary run_session(RobotInterface& robot, Controller& cycle, Fsm& fsm, Gamepad* gamepad, Logger* logger,
                        const RunOptions& options, std::ostream& out);
 
-/// The end-of-run report: cycle statistics and the per-phase table (markdown).
+/// The end-of-run report: cycle statistics, the per-phase table and the power-and-force-limiting
+/// table (markdown).
 void print_run_summary(const RunSummary& summary, std::ostream& out);
+/// The power-and-force-limiting table alone (a line when nothing was measured).
+void print_contact_summary(const RunSummary& summary, std::ostream& out);
 
 }  // namespace phri

@@ -268,8 +268,9 @@ Eigen::VectorXd parse_torque_limits(const YamlReader& q, const ActuatorTable& dr
   return limits;
 }
 
-// A body region of a regions file (configs/iso_ts_15066_regions.yaml's form), by name.
-BodyRegion load_body_region(const std::string& file, const std::string& name, const YamlReader& at) {
+// A body region of a regions file (configs/iso_ts_15066_regions.yaml's form), by name; an unknown
+// name is an error at `key` of `at`.
+BodyRegion load_body_region(const std::string& file, const std::string& name, const YamlReader& at, std::string_view key) {
   const YamlReader root = YamlReader::load_file(file);
   root.allow_keys({"regions"});
   const YamlReader list = root.at("regions");
@@ -289,14 +290,28 @@ BodyRegion load_body_region(const std::string& file, const std::string& name, co
     region.transient_factor = r.number_or("transient_factor", 2.0, 1.0, 10.0);
     return region;
   }
-  throw at.error("region", "no region '" + name + "' in " + file + " (" + known + ")");
+  throw at.error(key, "no region '" + name + "' in " + file + " (" + known + ")");
 }
 
-// controller.qp.power_force_limit: {regions_file, region, gain} (control/power_force_limit.hpp).
+// {regions_file, region, links: {link: region}}: the region any link may meet and the named
+// links' own (control/power_force_limit.hpp, BodyRegionMap); `keys`: the block's allowed keys.
+BodyRegionMap parse_body_regions(const YamlReader& p, const std::string& base_dir, std::initializer_list<std::string_view> keys) {
+  p.allow_keys(keys);
+  const std::string file = input_file(p, "regions_file", base_dir, false);
+  BodyRegionMap map;
+  map.region = load_body_region(file, p.text("region"), p, "region");
+  if (p.has("links")) {
+    const YamlReader links = p.at("links");
+    links.expect_map();
+    for (const std::string& link : links.keys()) map.links.emplace_back(link, load_body_region(file, links.text(link), links, link));
+  }
+  return map;
+}
+
+// controller.qp.power_force_limit: {regions_file, region, links, gain} (control/power_force_limit.hpp).
 PowerForceLimitSettings parse_power_force_limit(const YamlReader& p, const std::string& base_dir) {
-  p.allow_keys({"regions_file", "region", "gain"});
   PowerForceLimitSettings s;
-  s.region = load_body_region(input_file(p, "regions_file", base_dir, false), p.text("region"), p);
+  s.regions = parse_body_regions(p, base_dir, {"regions_file", "region", "links", "gain"});
   s.gain = p.number_or("gain", s.gain, 1.0, 1e3);
   return s;
 }
@@ -577,7 +592,8 @@ std::optional<RobotBundle> parse_robot_section(const YamlReader& root, const std
 
 Config parse(const YamlReader& root, const std::string& base_dir, const std::string& robot_folder = "") {
   const std::string& source = root.file();
-  root.allow_keys({"robot", "plant", "controller", "low_level", "fsm", "events", "logging", "gamepad", "run", "ros2"});
+  root.allow_keys({"robot", "plant", "controller", "low_level", "fsm", "events", "logging", "gamepad", "run", "ros2",
+                   "body_regions"});
   Config c;
   c.source = source;
 
@@ -624,6 +640,11 @@ Config parse(const YamlReader& root, const std::string& base_dir, const std::str
   if (root.has("gamepad")) parse_gamepad(root.at("gamepad"), c.gamepad);
   if (root.has("run")) parse_run(root.at("run"), c.run);
   if (root.has("ros2")) parse_ros2(root.at("ros2"), c.ros2);
+  if (root.has("body_regions")) {
+    c.body_regions = parse_body_regions(root.at("body_regions"), base_dir, {"regions_file", "region", "links"});
+  } else if (c.controller.qp.power_force_limit) {
+    c.body_regions = c.controller.qp.power_force_limit->regions;
+  }
   if (root.has("events")) c.fsm.timeline = parse_events(root.at("events"), c.run.duration_s, c.controller.offered_loops);
   check_config_against_robot(c);
   return c;

@@ -89,6 +89,10 @@ struct Config {
   GamepadSettings gamepad;
   RunSettings run;
   Ros2Settings ros2;
+  /// The body regions each link may meet (ISO/TS 15066), for the run's power-and-force-limiting
+  /// figures (log, summary): `body_regions`, else the QP constraint's
+  /// (controller.qp.power_force_limit); empty: none configured, no figures.
+  std::optional<BodyRegionMap> body_regions;
 };
 
 }  // namespace phri

@@ -5,6 +5,7 @@
 
 #include <cstddef>
 #include <string>
+#include <vector>
 
 namespace phri {
 
@@ -26,6 +27,8 @@ struct LoggerSettings {
   std::size_t capacity_rows = 16384;  ///< ring size (rounded up to a power of two), <= log_ring_max_rows()
   bool write_legend = true;           ///< write the <path>.legend.yaml sidecar
   int writer_sleep_ms = 2;            ///< writer's pause when the ring is empty
+  /// The links of the pfl_link column, in index order (the legend names them; the run fills it).
+  std::vector<std::string> pfl_links;
 };
 
 }  // namespace phri

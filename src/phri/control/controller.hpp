@@ -102,6 +102,8 @@ public:
   const WrenchEstimator& wrench() const { return wrench_; }
   const LowLevelController& low_level() const { return low_level_; }
   const ActuatorTable& actuators() const { return actuators_; }
+  /// The self-collision capsules, or null when the robot has none.
+  const CollisionModel* collision() const { return collision_ ? &*collision_ : nullptr; }
   const StateSupervisor& supervisor() const { return supervisor_; }
   /// The F/T wrench's plausibility; once dropped() the F/T is not used for the rest of the run.
   const WrenchSupervisor& wrench_supervisor() const { return wrench_supervisor_; }

@@ -19,6 +19,8 @@
 #include <Eigen/Cholesky>
 
 #include <string>
+#include <string_view>
+#include <utility>
 #include <vector>
 
 namespace phri {
@@ -33,6 +35,17 @@ struct BodyRegion {
   double transient_force_N() const { return transient_factor * quasi_static_force_N; }
 };
 
+/// Which region each link may meet: `region` for any link, `links` for the named ones (a
+/// workcell's data: who works where, at which height).
+struct BodyRegionMap {
+  BodyRegion region;
+  std::vector<std::pair<std::string, BodyRegion>> links;
+  const BodyRegion& for_link(std::string_view link) const;
+};
+
+/// Throws ConfigError unless k, m_H and F_QS are > 0 and finite and the transient factor >= 1.
+void check_body_region(const BodyRegion& region);
+
 /// mu = (1/m_H + 1/m_R)^-1.
 double reduced_mass(double robot_kg, double human_kg);
 /// v_max = F_T / sqrt(mu k) for a robot mass m_R meeting `region` [m/s].
@@ -43,7 +56,7 @@ double reflected_mass(const Eigen::Ref<const Eigen::MatrixXd>& linear_jacobian, 
                       const Eigen::Vector3d& direction, Eigen::VectorXd& scratch, Eigen::VectorXd& solved);
 
 struct PowerForceLimitSettings {
-  BodyRegion region;          ///< the region every monitored point may meet
+  BodyRegionMap regions;      ///< the region each monitored link may meet
   double gain = 50.0;         ///< [1/s] as the velocity limit's
   double min_speed_m_s = 1e-3;  ///< below: the point's direction is undefined and its row left out
 };
@@ -57,6 +70,14 @@ struct ContactPointState {
   /// 1/2 mu v^2 with the region's mass [J].
   double energy_J = 0.0;
 };
+
+/// The point's figures from its velocity and, when it moves (|v| >= min_speed), its reflected mass
+/// along the motion; `direction` is then v / |v| and `jacobian` its 3 x nv linear Jacobian. False
+/// (figures zero) when it does not move. `inertia`: the factor of M + I_r; no allocation.
+bool contact_point_figures(const Model& model, const Data& data, const Eigen::LLT<Eigen::MatrixXd>& inertia, int body,
+                           const Eigen::Vector3d& local, const BodyRegion& region, double min_speed_m_s,
+                           ContactPointState& state, Eigen::Vector3d& direction, Eigen::MatrixXd& jacobian,
+                           Eigen::VectorXd& scratch, Eigen::VectorXd& solved);
 
 class PowerForceLimitConstraint final : public Constraint {
 public:
@@ -79,6 +100,7 @@ private:
   struct Point {
     int body;
     Eigen::Vector3d local;
+    BodyRegion region;
   };
   PowerForceLimitSettings settings_;
   std::vector<Point> points_;
@@ -87,6 +109,45 @@ private:
   Eigen::MatrixXd inertia_;        // M + I_r
   Eigen::LLT<Eigen::MatrixXd> inertia_llt_;
   Eigen::MatrixXd jacobian_;       // 3 x nv
+  Eigen::VectorXd scratch_, solved_;
+};
+
+/// The same figures on every link with a capsule, each cycle, for the run's log and summary
+/// (changes nothing the arm does; the constraint above is what enforces them). A link's figures
+/// are those of its faster capsule end point (a rigid body's fastest point of a segment is an end).
+class PowerForceLimitMonitor {
+public:
+  /// rotor_inertia: as the constraint's. Throws ConfigError on a region out of range.
+  PowerForceLimitMonitor(const Model& model, const CollisionModel& capsules, const Eigen::VectorXd& rotor_inertia,
+                         const BodyRegionMap& regions);
+
+  /// The links it monitors, in index order: those with a capsule, but the base's (it does not move).
+  static std::vector<std::string> monitored_links(const CollisionModel& capsules);
+
+  /// data: after compute_all_terms (placements, velocities, M) of the state to judge. No allocation.
+  void update(const Model& model, const Data& data);
+
+  int num_links() const { return static_cast<int>(links_.size()); }
+  const std::string& link_name(int i) const { return links_[static_cast<std::size_t>(i)].name; }
+  const BodyRegion& region(int i) const { return links_[static_cast<std::size_t>(i)].region; }
+  const ContactPointState& link(int i) const { return states_[static_cast<std::size_t>(i)]; }
+  /// The link with the largest v / v_max this cycle (-1 before the first update or with no link).
+  int worst_link() const { return worst_; }
+
+private:
+  struct Link {
+    std::string name;
+    int body;
+    Eigen::Vector3d p0, p1;
+    BodyRegion region;
+  };
+  std::vector<Link> links_;
+  std::vector<ContactPointState> states_;
+  int worst_ = -1;
+  Eigen::VectorXd rotor_inertia_;
+  Eigen::MatrixXd inertia_;
+  Eigen::LLT<Eigen::MatrixXd> inertia_llt_;
+  Eigen::MatrixXd jacobian_;
   Eigen::VectorXd scratch_, solved_;
 };
 

@@ -125,6 +125,7 @@ public:
 
   // ---- GroundTruth: truth().q_rad, the link side of the joints.
   const Eigen::VectorXd& true_joint_positions() const override { return truth_.q_rad; }
+  const Eigen::VectorXd& true_joint_velocities() const override { return truth_.qd_rad_s; }
 
   /// MuJoCo model and data, read-only (viewers, tests comparing with MuJoCo's own quantities).
   const mjModel_* mujoco_model() const { return m_.get(); }
