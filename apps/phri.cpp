@@ -212,6 +212,7 @@ std::unique_ptr<phri::DashboardServer> start_dashboard(const DashboardArguments&
   settings.push_max_N = args.push_max_N;
   settings.web_root = dashboard_web_root(args.web_root);
   if (config.logging_enabled) settings.log_path = config.logging.path;
+  settings.body_regions = config.body_regions;
   if (args.bind != "127.0.0.1" && args.bind != "localhost") {
     std::fprintf(stderr, "phri: warning: the dashboard listens on %s, not only on this machine: whoever reaches it with "
                  "the token moves the arm\n", args.bind.c_str());

@@ -15,6 +15,7 @@
 #include <phri/control/controller.hpp>
 #include <phri/dashboard/dashboard_request.hpp>
 #include <phri/dashboard/dashboard_server.hpp>
+#include <phri/dashboard/state_encoder.hpp>
 #include <phri/dashboard/stream_clients.hpp>
 #include <phri/sim/sim_robot.hpp>
 
@@ -23,6 +24,7 @@
 
 #include <gtest/gtest.h>
 #include <httplib.h>
+#include <nlohmann/json.hpp>
 
 #include <chrono>
 #include <sstream>
@@ -47,6 +49,39 @@ int queued(phri::LiveChannel& channel) {
 }
 
 // ---------------------------------------------------------------- request checks (no server)
+
+// With body regions, the model lists each monitored link and the region it may meet, and each
+// frame carries their v / v_max (the page's bars); without, neither.
+TEST(DashboardEncoder, BodyRegionsGiveTheModelItsLinksAndEachFrameTheirRatios) {
+  const phri::Controller cycle(phri::test::gen3_controller_settings());
+  ASSERT_NE(cycle.collision(), nullptr);
+  phri::StateEncoderSettings settings;
+  settings.end_effector_frame = cycle.settings().end_effector_frame;
+  phri::LiveSnapshot snapshot;
+  snapshot.dof = 7;
+  {
+    phri::StateEncoder plain(cycle.model(), cycle.collision(), settings);
+    EXPECT_TRUE(nlohmann::json::parse(plain.model_json())["contact"].empty());
+    EXPECT_TRUE(nlohmann::json::parse(plain.frame_json(snapshot))["contact_ratio"].empty());
+  }
+  phri::BodyRegionMap regions;
+  regions.region = {"lower_arm_wrist", 40000.0, 2.0, 160.0, 2.0};
+  regions.links.emplace_back("end_effector_link", phri::BodyRegion{"hand_fingers", 75000.0, 0.6, 140.0, 2.0});
+  settings.body_regions = regions;
+  phri::StateEncoder encoder(cycle.model(), cycle.collision(), settings);
+  const nlohmann::json contact = nlohmann::json::parse(encoder.model_json())["contact"];
+  const std::vector<std::string> links = phri::PowerForceLimitMonitor::monitored_links(*cycle.collision());
+  ASSERT_EQ(contact.size(), links.size());
+  for (std::size_t i = 0; i < links.size(); ++i) {
+    EXPECT_EQ(contact[i]["link"], links[i]);
+    EXPECT_EQ(contact[i]["region"], links[i] == "end_effector_link" ? "hand_fingers" : "lower_arm_wrist");
+  }
+  snapshot.contact_links = static_cast<int>(links.size());
+  for (int i = 0; i < snapshot.contact_links; ++i) snapshot.contact_ratio[static_cast<std::size_t>(i)] = 0.125 * i;
+  const nlohmann::json ratio = nlohmann::json::parse(encoder.frame_json(snapshot))["contact_ratio"];
+  ASSERT_EQ(ratio.size(), links.size());
+  for (std::size_t i = 0; i < links.size(); ++i) EXPECT_EQ(ratio[i].get<double>(), 0.125 * static_cast<double>(i));
+}
 
 TEST(DashboardRequest, AcceptsEveryEventByNameAndRefusesUnknownOnes) {
   const phri::DashboardRequestLimits limits;

@@ -334,6 +334,31 @@ function buildPlots(model) {
   ], { scales: { y: { range: [-0.2, 2.2] } } });
 }
 
+// One bar per monitored link, full scale 1.5 (the dashed mark: v = v_max of the link's region).
+const CONTACT_FULL_SCALE = 1.5;
+function buildContact(model) {
+  const contact = model.contact || [];
+  $('contact-title').hidden = contact.length === 0;
+  for (const c of contact) {
+    const row = document.createElement('div');
+    row.className = 'contact-row';
+    row.title = `${c.link} may meet: ${c.region} (ISO/TS 15066 transient contact)`;
+    row.innerHTML = `<span>${c.link}</span><div class="contact-bar"><div></div></div><span>-</span>`;
+    $('contact').appendChild(row);
+  }
+}
+
+function showContact(f) {
+  const rows = $('contact').children;
+  (f.contact_ratio || []).forEach((ratio, i) => {
+    if (i >= rows.length) return;
+    const bar = rows[i].children[1].firstChild;
+    bar.style.width = `${Math.min(100, (100 * ratio) / CONTACT_FULL_SCALE)}%`;
+    bar.style.background = `hsl(${Math.max(0, 120 * (1 - ratio))}, 70%, 45%)`;  // green -> red at v_max
+    rows[i].children[2].textContent = ratio.toFixed(2);
+  });
+}
+
 function record(f) {
   for (const p of plots) {
     p.data[0].push(f.t);
@@ -382,6 +407,7 @@ function connect() {
     showArm(f);
     showStatus(f);
     showGains(f.gains);
+    showContact(f);
     redraw(performance.now());
   };
   stream.onerror = () => { $('status').textContent = 'stream lost: is phri still running? (retrying)'; };
@@ -399,6 +425,7 @@ async function main() {
   buildSliders(model);
   buildArm(model);
   buildPlots(model);
+  buildContact(model);
   resize();
   connect();
 }

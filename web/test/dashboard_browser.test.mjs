@@ -6,7 +6,8 @@
 //      records the switch (compliance_mode column);
 //   3. dragging the end-effector link pushes the arm: the streamed end effector moves, the push
 //      shown never exceeds the cap;
-//   4. moving the stiffness slider applies the new gain (streamed and logged stiffness_scale).
+//   4. moving the stiffness slider applies the new gain (streamed and logged stiffness_scale);
+//   5. the power-and-force-limiting bars show one number per monitored link.
 // Screenshots go to --out (dashboard_*.png). Exit 77 (ctest: skipped) when chromium is absent.
 //
 //   node web/test/dashboard_browser.test.mjs --phri build/release/phri --config configs/dashboard.yaml --out DIR
@@ -148,6 +149,15 @@ try {
   check(/pushing .*: \d+(\.\d)? N/.test(shown), `the page shows the push: "${shown}"`);
   check(pushed[0] > 5 && pushed[0] <= 100 + 1e-6, `the stream shows the push, at most the 100 N cap (max ${pushed[0].toFixed(1)} N)`);
   check(pushed[1] > 0.02, `dragging the end effector moved it ${(1e3 * pushed[1]).toFixed(0)} mm (> 20 mm)`);
+  // 5. a bar per monitored link, its number the streamed v / v_max (the push moved the arm).
+  const bars = await page.evaluate(() => ({
+    rows: [...document.querySelectorAll('#contact .contact-row')].map((r) => r.children[2].textContent),
+    links: window.phri.model.contact.length,
+    streamed: window.phri.last.contact_ratio,
+  }));
+  check(bars.links > 0 && bars.rows.length === bars.links && bars.streamed.length === bars.links &&
+        bars.rows.every((text, i) => text === bars.streamed[i].toFixed(2)),
+        `a power-and-force-limiting bar per link (${bars.rows.length} of ${bars.links}: ${bars.rows.join(' ')})`);
   await waitFor(page, () => window.phri.last.push === null, 'letting go ends the push', 3000);
 
   // 4. The stiffness slider: drag its thumb to about 60 % of the range.

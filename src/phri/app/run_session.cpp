@@ -257,6 +257,8 @@ private:
     snapshot_.posture_gamma_override = compliance.posture_gamma_override();
     snapshot_.posture_stiffness = compliance.posture_stiffness();
     snapshot_.overruns = clock_.overruns();
+    snapshot_.contact_links = contact_ ? std::min(contact_->num_links(), kLiveMaxContactLinks) : 0;
+    for (int i = 0; i < snapshot_.contact_links; ++i) snapshot_.contact_ratio[static_cast<std::size_t>(i)] = contact_->link(i).ratio();
     return snapshot_;
   }
 

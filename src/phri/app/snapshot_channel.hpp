@@ -11,6 +11,7 @@
 
 #include <Eigen/Core>
 
+#include <array>
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
@@ -24,6 +25,9 @@ struct LivePush {
   Eigen::Vector3d force_world = Eigen::Vector3d::Zero();  ///< [N], world axes
 };
 
+/// Most links whose power-and-force-limiting ratio a snapshot carries.
+inline constexpr int kLiveMaxContactLinks = 16;
+
 struct LiveSnapshot {
   LogRow row;     ///< the cycle as logged (cycle_time_s included)
   int dof = 0;
@@ -32,6 +36,9 @@ struct LiveSnapshot {
   double ee_gamma_override = -1.0, posture_gamma_override = -1.0;  ///< -1: the mode decides
   double posture_stiffness = 0.0;
   std::uint64_t overruns = 0;  ///< of the real-time period so far
+  /// v / v_max of each monitored link (RunOptions::body_regions; PowerForceLimitMonitor's order).
+  std::array<double, kLiveMaxContactLinks> contact_ratio{};
+  int contact_links = 0;
 };
 
 struct SnapshotChannelSettings {

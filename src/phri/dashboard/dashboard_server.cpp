@@ -134,6 +134,7 @@ struct DashboardServer::Impl {
     e.touch_threshold = controller.settings().compliance.touch_threshold;
     e.release_threshold = controller.settings().compliance.release_threshold;
     e.end_effector_frame = controller.settings().end_effector_frame;
+    e.body_regions = s.body_regions;
     return e;
   }
 

@@ -22,6 +22,7 @@
 //   POST /api/event | gain | push | release | run | pause | step
 // The number of simultaneous streams is capped (max_streams, 503 beyond): each holds one thread.
 #include <phri/app/live_channel.hpp>
+#include <phri/control/power_force_limit.hpp>
 #include <phri/dashboard/dashboard_request.hpp>
 
 #include <atomic>
@@ -29,6 +30,7 @@
 #include <cstdint>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 
@@ -45,6 +47,8 @@ struct DashboardSettings {
   int max_streams = 32;        ///< simultaneous event streams
   double frame_rate_hz = 60.0; ///< most frames a second sent to the streams
   std::string token;           ///< empty: a random one
+  /// The run's body regions (Config::body_regions): the page's power-and-force-limiting bars.
+  std::optional<BodyRegionMap> body_regions;
 };
 
 struct DashboardStats {

@@ -97,6 +97,13 @@ std::string StateEncoder::model_json() const {
             {"push_max_N", settings_.push_max_N},
             {"touch_threshold", settings_.touch_threshold},
             {"release_threshold", settings_.release_threshold}};
+  json contact = json::array();
+  if (settings_.body_regions && collision_) {
+    for (const std::string& link : PowerForceLimitMonitor::monitored_links(*collision_)) {
+      contact.push_back({{"link", link}, {"region", settings_.body_regions->for_link(link).name}});
+    }
+  }
+  j["contact"] = contact;
   return j.dump();
 }
 
@@ -125,6 +132,7 @@ std::string StateEncoder::frame_json(const LiveSnapshot& s) {
             {"ft", std::string(to_string(static_cast<WrenchStatus>(r.ft_status)))}, {"ft_code", r.ft_status},
             {"event", r.event >= 0 ? json(std::string(to_string(static_cast<Event>(r.event)))) : json(nullptr)},
             {"cycle_us", 1e6 * r.cycle_time_s}, {"overruns", s.overruns}, {"bodies", bodies}};
+  j["contact_ratio"] = std::vector<double>(s.contact_ratio.begin(), s.contact_ratio.begin() + std::clamp(s.contact_links, 0, kLiveMaxContactLinks));
   j["gains"] = {{"stiffness_scale", r.stiffness_scale}, {"ee_gamma", s.ee_gamma_override},
                 {"posture_gamma", s.posture_gamma_override}, {"posture_stiffness", s.posture_stiffness}};
   j["push"] = nullptr;

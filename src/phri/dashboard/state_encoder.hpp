@@ -10,8 +10,11 @@
 // position [m], quaternion w x y z), err_pos_mm, err_ori_deg, wrench (6), wrench_norm, mode,
 // touched, loop, fsm, safety, event, cycle_us, overruns, gains (stiffness_scale, ee_gamma,
 // posture_gamma, posture_stiffness), bodies ([x y z qw qx qy qz] per model body), push (null or
-// {body, point, force, magnitude}), collision (null or {first, second, distance_mm, a, b}).
+// {body, point, force, magnitude}), collision (null or {first, second, distance_mm, a, b}),
+// contact_ratio (v / v_max per link of the model's `contact` list: [{link, region}], empty without
+// body regions).
 #include <phri/app/live_channel.hpp>
+#include <phri/control/power_force_limit.hpp>
 #include <phri/model/collision_model.hpp>
 #include <phri/model/data.hpp>
 #include <phri/model/model.hpp>
@@ -27,6 +30,9 @@ struct StateEncoderSettings {
   double release_threshold = 4.0;
   /// The arm's end-effector frame: no default (the dashboard server sets the controller's).
   std::string end_effector_frame;
+  /// The body regions the links may meet (Config::body_regions), or none: the page then draws no
+  /// power-and-force-limiting bars.
+  std::optional<BodyRegionMap> body_regions;
 };
 
 class StateEncoder {
