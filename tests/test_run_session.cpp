@@ -391,7 +391,7 @@ TEST(RunSession, BodyRegionsGiveEachLinksPowerAndForceLimitingFiguresInTheLogAnd
   std::ifstream in(log_settings.path);
   std::string header;
   std::getline(in, header);
-  EXPECT_NE(header.find(",pfl_ratio,pfl_link,pfl_speed_m_s,pfl_reflected_mass_kg,pfl_permissible_speed_m_s,pfl_energy_J,"),
+  EXPECT_NE(header.find(",pfl_ratio,pfl_link,pfl_speed_m_s,pfl_reflected_mass_kg,pfl_permissible_speed_m_s,pfl_energy_j,"),
             std::string::npos);
   std::ifstream legend(phri::Logger::legend_path_for(log_settings.path));
   const std::string legend_text((std::istreambuf_iterator<char>(legend)), std::istreambuf_iterator<char>());

@@ -33,7 +33,8 @@ URDF = "robots/kinova_gen3/gen3.urdf"
 ACTUATORS = "robots/kinova_gen3/actuators.yaml"
 COLLISION = "robots/kinova_gen3/collision.yaml"
 MJCF = "robots/kinova_gen3/gen3_plant.xml"
-FILES = [DEMO, PLANT, URDF, ACTUATORS, COLLISION, MJCF]
+REGIONS = "configs/iso_ts_15066_regions.yaml"
+FILES = [DEMO, PLANT, URDF, ACTUATORS, COLLISION, MJCF, REGIONS]
 
 # A folded posture within the joint limits whose wrist sits on the base (capsules interpenetrate).
 FOLDED = [0.0, 2.2, 0.0, 2.5, 0.0, 2.0, 0.0]

@@ -302,7 +302,7 @@ private:
     row_.pfl_speed_m_s = p.speed_m_s;
     row_.pfl_reflected_mass_kg = p.reflected_mass_kg;
     row_.pfl_permissible_speed_m_s = p.permissible_speed_m_s;
-    row_.pfl_energy_J = p.energy_J;
+    row_.pfl_energy_j = p.energy_J;
   }
 
   // Target - the true end effector (forward kinematics of the plant's link-side joints) [mm, deg];

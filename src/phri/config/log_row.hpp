@@ -27,7 +27,7 @@
 //   pfl_ratio, pfl_link                   power and force limiting (ISO/TS 15066), the link whose capsule point
 //                                         is closest to its permissible speed: v / v_max and the link's index
 //                                         (the sidecar legend names them; -1: no body regions configured)
-//   pfl_speed_m_s, pfl_reflected_mass_kg, pfl_permissible_speed_m_s, pfl_energy_J
+//   pfl_speed_m_s, pfl_reflected_mass_kg, pfl_permissible_speed_m_s, pfl_energy_j
 //                                         that point's speed, reflected mass along its motion, v_max and
 //                                         1/2 mu v^2 (the plant's true state on a simulated arm)
 //   cycle_time_s                          wall-clock time of the cycle's computation [s]
@@ -70,7 +70,7 @@ struct LogRow {
   double stiffness_scale = 1.0;
   double pfl_ratio = 0.0;
   std::int32_t pfl_link = -1;
-  double pfl_speed_m_s = 0.0, pfl_reflected_mass_kg = 0.0, pfl_permissible_speed_m_s = 0.0, pfl_energy_J = 0.0;
+  double pfl_speed_m_s = 0.0, pfl_reflected_mass_kg = 0.0, pfl_permissible_speed_m_s = 0.0, pfl_energy_j = 0.0;
   double cycle_time_s = 0.0;
 };
 
@@ -122,7 +122,7 @@ void visit_log_columns(const LogRow& r, int dof, Visitor&& v) {
   v.number("pfl_speed_m_s", r.pfl_speed_m_s);
   v.number("pfl_reflected_mass_kg", r.pfl_reflected_mass_kg);
   v.number("pfl_permissible_speed_m_s", r.pfl_permissible_speed_m_s);
-  v.number("pfl_energy_J", r.pfl_energy_J);
+  v.number("pfl_energy_j", r.pfl_energy_j);
   v.number("cycle_time_s", r.cycle_time_s);
 }
 

@@ -39,10 +39,12 @@ void StreamClients::visit_loop(int count, double gap_s) {
     client.set_connection_timeout(3, 0);  // httplib waits 300 s by default
     client.set_write_timeout(3, 0);
     int frames = 0;
+    const auto deadline = start + std::chrono::duration<double>(settings_.visit_timeout_s);
     client.Get(path, [&](const char* data, std::size_t size) {
       const std::string_view chunk(data, size);
       for (std::size_t at = chunk.find("data:"); at != std::string_view::npos; at = chunk.find("data:", at + 5)) ++frames;
-      return frames < settings_.frames_per_visit;  // false: leave (the connection is closed)
+      // false: leave (the connection is closed)
+      return frames < settings_.frames_per_visit && std::chrono::steady_clock::now() < deadline;
     });
     if (frames >= settings_.frames_per_visit) {
       ++served_;

@@ -19,6 +19,9 @@ struct StreamClientsSettings {
   int threads = 10;           ///< connections at once, at most
   int frames_per_visit = 3;   ///< frames read before leaving
   double spread_s = 5.0;      ///< the connections are spread over about this long
+  /// A visit that has not read its frames by then leaves, failed: the server's keep-alive pings
+  /// would hold it open for ever once the loop stops publishing (the read timeout never fires).
+  double visit_timeout_s = 5.0;
 };
 
 class StreamClients {
