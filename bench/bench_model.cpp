@@ -1,6 +1,8 @@
 // Rigid-body algorithms on the Kinova Gen3 (7 DoF). Run:
 //   build/release/bench/phri_bench --benchmark_filter=Model --benchmark_repetitions=10 --benchmark_report_aggregates_only=true
+#include <phri/control/power_force_limit.hpp>
 #include <phri/model/algorithms.hpp>
+#include <phri/model/collision_model.hpp>
 #include <phri/model/model.hpp>
 
 #include <benchmark/benchmark.h>
@@ -99,5 +101,23 @@ void ModelAllTogetherPlusRnea(benchmark::State& state) {
   }
 }
 BENCHMARK(ModelAllTogetherPlusRnea);
+
+// What a run adds per cycle with body_regions (app/run_session.cpp, outside the controller's timed
+// step): the terms of the judged state, then every monitored link's power-and-force-limiting figures.
+void PowerForceLimitMonitorCycle(benchmark::State& state) {
+  Gen3 g;
+  const phri::CollisionModel capsules =
+      phri::CollisionModel::from_yaml_file(std::string(PHRI_SOURCE_DIR) + "/robots/kinova_gen3/collision.yaml", g.model);
+  phri::BodyRegionMap regions;
+  regions.region = {"lower_arm_wrist", 40000.0, 2.0, 160.0, 2.0};
+  phri::PowerForceLimitMonitor monitor(g.model, capsules, Eigen::VectorXd::Constant(7, 0.3), regions);
+  for (auto _ : state) {
+    phri::compute_all_terms(g.model, g.data, g.q, g.qd);
+    monitor.update(g.model, g.data);
+    benchmark::DoNotOptimize(monitor.worst_link());
+  }
+  state.counters["links"] = monitor.num_links();
+}
+BENCHMARK(PowerForceLimitMonitorCycle);
 
 }  // namespace
