@@ -207,7 +207,7 @@ void fault_table(const SafetyFuzzResult& result, std::ostream& s) {
 
 // Every fault kind (catalogue entry) at rest, in motion and after a loop switch: windows, controller
 // failures, safe stops; then the same by the decorator's kind.
-void fault_kind_table(const SafetyFuzzResult& result, std::ostream& s) {
+void fault_kind_table(const SafetyFuzzResult& result, const SafetyFuzzOptions& o, std::ostream& s) {
   struct Cell {
     long windows = 0, failures = 0, safe_stops = 0;
   };
@@ -240,7 +240,8 @@ void fault_kind_table(const SafetyFuzzResult& result, std::ostream& s) {
   };
   s << "## Sensor faults by kind, at rest and in motion\n\nController failures / windows (safe stops) per fault, at rest ("
     << failures[0] << " / " << totals[0] << "), during a push (" << failures[1] << " / " << totals[1]
-    << ") and 0-50 ms after a loop switch on a pushed arm (" << failures[2] << " / " << totals[2] << ").\n\n"
+    << ") and 0-" << format_fixed(1e3 * o.motion.max_switch_delay_s, 0)
+    << " ms after the sample a loop switch took effect on, on a pushed arm (" << failures[2] << " / " << totals[2] << ").\n\n"
     << "| fault | kind | at rest | in motion | after a loop switch | categories |\n|---|---|---|---|---|---|\n";
   for (const auto& [name, row] : by_name) {
     s << "| " << name << " | " << kind_of[name];
@@ -453,7 +454,7 @@ std::string safety_fuzz_report(const SafetyFuzzResult& result, const SafetyFuzzO
   validity_section(result, s);
   category_table(result, s);
   fault_table(result, s);
-  fault_kind_table(result, s);
+  fault_kind_table(result, o, s);
   no_recovery_table(result, s);
   margins(result, s);
   held_command_list(result, o, s);
