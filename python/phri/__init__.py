@@ -68,6 +68,8 @@ def run(config: Union[str, _os.PathLike[str]], duration_s: Optional[float] = Non
     config.logging.path = str(out / _pathlib.Path(config.logging.path).name)  # edits config in place
     robot = SimRobot(config.plant)
     controller = Controller(config.controller)
+    if config.body_regions is not None:
+        config.logging.pfl_links = contact_links(controller)
     fsm = Fsm(config.fsm, controller)
     logger = Logger(config.logging) if config.logging_enabled else None
     options = RunOptions()
@@ -75,7 +77,7 @@ def run(config: Union[str, _os.PathLike[str]], duration_s: Optional[float] = Non
     options.real_time = real_time
     options.status_line = status_line
     options.phases = [PhaseMark(0.0, "startup")] + [PhaseMark(e.time_s, e.event.name) for e in config.fsm.timeline]
-    summary = run_session(robot, controller, fsm, logger, options)
+    summary = run_session(robot, controller, fsm, logger, options, config.body_regions)
     if logger is not None:
         logger.close()
     return RunResult(summary, config.logging.path if logger is not None else "")

@@ -7,6 +7,8 @@
 #include <phri/app/loop_clock.hpp>
 #include <phri/config/config.hpp>
 #include <phri/app/run_session.hpp>
+#include <phri/control/power_force_limit.hpp>
+#include <phri/robot/ground_truth.hpp>
 
 #include <sstream>
 
@@ -60,7 +62,8 @@ void bind_logger(py::module_& m) {
       .def_readwrite("path", &LoggerSettings::path)
       .def_readwrite("dof", &LoggerSettings::dof)
       .def_readwrite("capacity_rows", &LoggerSettings::capacity_rows)
-      .def_readwrite("write_legend", &LoggerSettings::write_legend);
+      .def_readwrite("write_legend", &LoggerSettings::write_legend)
+      .def_readwrite("pfl_links", &LoggerSettings::pfl_links, "The links of the pfl_link column (the legend names them).");
   py::class_<LoggerStats>(m, "LoggerStats", "What the logger wrote and dropped.")
       .def_readonly("pushed", &LoggerStats::pushed)
       .def_readonly("dropped", &LoggerStats::dropped)
@@ -86,6 +89,17 @@ void bind_config(py::module_& m) {
       .def(py::init<>())
       .def_readwrite("duration_s", &RunSettings::duration_s)
       .def_readwrite("pacing", &RunSettings::pacing);
+  py::class_<BodyRegion>(m, "BodyRegion", "An ISO/TS 15066 body region: k [N/m], m_H [kg], F_QS [N], transient factor.")
+      .def_readwrite("name", &BodyRegion::name)
+      .def_readwrite("stiffness_N_per_m", &BodyRegion::stiffness_N_per_m)
+      .def_readwrite("mass_kg", &BodyRegion::mass_kg)
+      .def_readwrite("quasi_static_force_N", &BodyRegion::quasi_static_force_N)
+      .def_readwrite("transient_factor", &BodyRegion::transient_factor);
+  py::class_<BodyRegionMap>(m, "BodyRegionMap", "The region each link may meet: `region`, or its own in `links`.")
+      .def_readwrite("region", &BodyRegionMap::region)
+      .def_readwrite("links", &BodyRegionMap::links)
+      .def("for_link", &BodyRegionMap::for_link, py::arg("link"), py::return_value_policy::copy,
+           "The region the named link may meet (its own, else `region`).");
   py::class_<Config>(m, "Config", "ONE YAML per run (configs/demo.yaml documents every key), as the settings of each piece.")
       .def_static("from_yaml_file", [](const std::string& path, const std::string& robot) { return Config::from_yaml_file(path, robot); },
                   py::arg("path"), py::arg("robot") = std::string(),
@@ -97,7 +111,8 @@ void bind_config(py::module_& m) {
       .def_readwrite("fsm", &Config::fsm)
       .def_readwrite("logging_enabled", &Config::logging_enabled)
       .def_readwrite("logging", &Config::logging)
-      .def_readwrite("run", &Config::run);
+      .def_readwrite("run", &Config::run)
+      .def_readwrite("body_regions", &Config::body_regions, "The body regions the run is measured against, or None.");
 }
 
 void bind_run_session(py::module_& m) {
@@ -122,6 +137,16 @@ void bind_run_session(py::module_& m) {
       .def_readonly("qp_task_position_error_rms_mm", &PhaseSummary::qp_task_position_error_rms_mm)
       .def_readonly("wrench_norm_max", &PhaseSummary::wrench_norm_max)
       .def_readonly("cycle_median_us", &PhaseSummary::cycle_median_us);
+  py::class_<ContactLinkSummary>(m, "ContactLinkSummary", "One link's power-and-force-limiting figures over a run.")
+      .def_readonly("link", &ContactLinkSummary::link)
+      .def_readonly("region", &ContactLinkSummary::region)
+      .def_readonly("max_ratio", &ContactLinkSummary::max_ratio)
+      .def_readonly("speed_at_max_m_s", &ContactLinkSummary::speed_at_max_m_s)
+      .def_readonly("reflected_mass_at_max_kg", &ContactLinkSummary::reflected_mass_at_max_kg)
+      .def_readonly("permissible_speed_at_max_m_s", &ContactLinkSummary::permissible_speed_at_max_m_s)
+      .def_readonly("max_speed_m_s", &ContactLinkSummary::max_speed_m_s)
+      .def_readonly("max_energy_J", &ContactLinkSummary::max_energy_J)
+      .def_readonly("time_above_s", &ContactLinkSummary::time_above_s);
   py::class_<RunSummary>(m, "RunSummary", "What run_session measured.")
       .def_readonly("cycles", &RunSummary::cycles)
       .def_readonly("simulated_s", &RunSummary::simulated_s)
@@ -132,16 +157,27 @@ void bind_run_session(py::module_& m) {
       .def_readonly("refused_writes", &RunSummary::refused_writes)
       .def_readonly("safe_hold", &RunSummary::safe_hold)
       .def_readonly("safe_hold_reason", &RunSummary::safe_hold_reason)
-      .def_readonly("phases", &RunSummary::phases);
+      .def_readonly("phases", &RunSummary::phases)
+      .def_readonly("contact", &RunSummary::contact, "Per link with a capsule (empty: no body regions).")
+      .def_readonly("contact_true_state", &RunSummary::contact_true_state);
   m.def("run_session",
-        [](RobotInterface& robot, Controller& controller, Fsm& fsm, Logger* logger, const RunOptions& options) {
+        [](RobotInterface& robot, Controller& controller, Fsm& fsm, Logger* logger, const RunOptions& options,
+           const std::optional<BodyRegionMap>& body_regions) {
           PythonStream out;
+          RunOptions run = options;
+          if (body_regions) run.body_regions = &*body_regions;
+          if (run.ground_truth == nullptr) run.ground_truth = dynamic_cast<const GroundTruth*>(&robot);
           const py::gil_scoped_release release;
-          return run_session(robot, controller, fsm, nullptr, logger, options, out);
+          return run_session(robot, controller, fsm, nullptr, logger, run, out);
         },
         py::arg("robot"), py::arg("controller"), py::arg("fsm"), py::arg("logger") = nullptr, py::arg("options") = RunOptions{},
+        py::arg("body_regions") = std::nullopt,
         "The `phri run` loop (read, FSM, step, write, log) for options.duration_s of robot time, GIL released; "
-        "progress lines go to sys.stdout.");
+        "progress lines go to sys.stdout. A simulated robot is the summary's ground truth; with body_regions, "
+        "the power-and-force-limiting figures (log pfl_ columns, summary.contact).");
+  m.def("contact_links", [](const Controller& controller) {
+        return controller.collision() ? PowerForceLimitMonitor::monitored_links(*controller.collision()) : std::vector<std::string>{};
+      }, py::arg("controller"), "The links the power-and-force-limiting figures cover (those with a capsule, but the base).");
   m.def("run_summary_text", [](const RunSummary& summary) {
         std::ostringstream text;
         print_run_summary(summary, text);

@@ -44,6 +44,24 @@ def test_a_session_log_opens_with_its_codes_as_enums(tmp_path):
     assert phri.LowLevelMode(int(log["low_level_loop"][0])) == phri.LowLevelMode.position
 
 
+def test_a_session_measures_power_and_force_limiting_on_the_plants_true_state(tmp_path):
+    result = phri.run(DEMO_YAML, duration_s=0.5, out_dir=tmp_path)
+    config = phri.Config.from_yaml_file(DEMO_YAML)
+    links = [c.link for c in result.summary.contact]
+    assert links and result.summary.contact_true_state
+    for c in result.summary.contact:
+        assert c.region == config.body_regions.for_link(c.link).name
+        if c.max_ratio > 0:
+            assert c.max_ratio == pytest.approx(c.speed_at_max_m_s / c.permissible_speed_at_max_m_s, rel=1e-12)
+    log = result.log()
+    worst = log["pfl_link"]
+    assert worst.min() >= 0 and worst.max() < len(links)
+    # The logged worst link's ratio is its speed over its v_max, and none of the summary's links went faster.
+    moving = log["pfl_permissible_speed_m_s"] > 0
+    assert np.allclose(log["pfl_ratio"][moving], log["pfl_speed_m_s"][moving] / log["pfl_permissible_speed_m_s"][moving])
+    assert log["pfl_ratio"].max() == pytest.approx(max(c.max_ratio for c in result.summary.contact), rel=1e-12)
+
+
 def test_a_bad_cell_names_its_line_and_column(tmp_path):
     path = tmp_path / "bad.csv"
     path.write_text("time_s,cycle\n0.001,1\n0.002,two\n")
