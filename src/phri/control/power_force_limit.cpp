@@ -16,11 +16,15 @@ const BodyRegion& BodyRegionMap::for_link(std::string_view link) const {
   return region;
 }
 
-void check_body_region(const BodyRegion& r) {
-  if (!(r.stiffness_N_per_m > 0 && r.mass_kg > 0 && r.quasi_static_force_N > 0 && r.transient_factor >= 1 &&
-        std::isfinite(r.stiffness_N_per_m + r.mass_kg + r.quasi_static_force_N + r.transient_factor))) {
-    throw ConfigError("PowerForceLimitSettings", "region", "'" + r.name + "': k, m_H and F_QS must be > 0, the transient factor >= 1");
-  }
+void check_body_regions(const BodyRegionMap& map) {
+  auto check = [](const BodyRegion& r) {
+    if (!(r.stiffness_N_per_m > 0 && r.mass_kg > 0 && r.quasi_static_force_N > 0 && r.transient_factor >= 1 &&
+          std::isfinite(r.stiffness_N_per_m + r.mass_kg + r.quasi_static_force_N + r.transient_factor))) {
+      throw ConfigError("PowerForceLimitSettings", "region", "'" + r.name + "': k, m_H and F_QS must be > 0, the transient factor >= 1");
+    }
+  };
+  check(map.region);
+  for (const auto& named : map.links) check(named.second);
 }
 
 double reduced_mass(double robot_kg, double human_kg) { return 1.0 / (1.0 / human_kg + 1.0 / robot_kg); }
@@ -67,8 +71,7 @@ PowerForceLimitConstraint::PowerForceLimitConstraint(const Model& model, const C
       jacobian_(Eigen::MatrixXd::Zero(3, model.nv())),
       scratch_(Eigen::VectorXd::Zero(model.nv())),
       solved_(Eigen::VectorXd::Zero(model.nv())) {
-  check_body_region(settings.regions.region);
-  for (const auto& named : settings.regions.links) check_body_region(named.second);
+  check_body_regions(settings.regions);
   if (!(settings.gain > 0) || !(settings.min_speed_m_s > 0)) throw ConfigError("PowerForceLimitSettings", "gain", "must be > 0");
   if (rotor_inertia_.size() != model.nv()) throw ConfigError("PowerForceLimitSettings", "rotor_inertia", "one value per joint");
   for (const Capsule& c : capsules.capsules()) {
@@ -119,8 +122,7 @@ PowerForceLimitMonitor::PowerForceLimitMonitor(const Model& model, const Collisi
       jacobian_(Eigen::MatrixXd::Zero(3, model.nv())),
       scratch_(Eigen::VectorXd::Zero(model.nv())),
       solved_(Eigen::VectorXd::Zero(model.nv())) {
-  check_body_region(regions.region);
-  for (const auto& named : regions.links) check_body_region(named.second);
+  check_body_regions(regions);
   if (rotor_inertia_.size() != model.nv()) throw ConfigError("PowerForceLimitMonitor", "rotor_inertia", "one value per joint");
   for (const Capsule& c : capsules.capsules()) {
     if (c.body < 0) continue;  // the base does not move

@@ -43,8 +43,9 @@ struct BodyRegionMap {
   const BodyRegion& for_link(std::string_view link) const;
 };
 
-/// Throws ConfigError unless k, m_H and F_QS are > 0 and finite and the transient factor >= 1.
-void check_body_region(const BodyRegion& region);
+/// Throws ConfigError unless every region's k, m_H and F_QS are > 0 and finite and its transient
+/// factor >= 1.
+void check_body_regions(const BodyRegionMap& map);
 
 /// mu = (1/m_H + 1/m_R)^-1.
 double reduced_mass(double robot_kg, double human_kg);
