@@ -15,6 +15,7 @@
 //   phri experiment dynamic-tracking [options] the dynamic scenario with the four low-level loops
 //   phri experiment dual-compliance [options]  guiding the end effector by hand, release, drift
 //   phri experiment iso9283 [options]          ISO 9283 pose accuracy and repeatability per loop
+//   phri experiment collision [options]        the tool hits a body region: ISO/TS 15066 forces
 //   phri evaluate [--out DIR] [--quick]        all five of the paper's evaluations and report.md/.html
 //   phri experiment dashboard-load [options]   loop cycle time with vs without the dashboard and its clients
 //   phri experiment ros2-load [options]        loop cycle time with vs without the ROS 2 bridge, F/T round trip (ros2_cli.cpp)
@@ -43,6 +44,7 @@
 #include <phri/sim/mujoco_handles.hpp>
 #include <phri/sim/urdf_plant.hpp>
 #include <phri/core/version.hpp>
+#include <phri/experiments/collision.hpp>
 #include <phri/experiments/drop_test.hpp>
 #include <phri/experiments/dual_compliance.hpp>
 #include <phri/experiments/evaluation.hpp>
@@ -756,6 +758,51 @@ int iso9283_command(Iso9283Arguments args) {
   return phri::run_iso9283_command(o, std::cout);
 }
 
+struct CollisionArguments {
+  phri::CollisionOptions options;
+  std::vector<std::string> loops, modes;
+};
+
+const CLI::App* add_collision_command(CLI::App& experiment, CollisionArguments& args) {
+  auto* collision = experiment.add_subcommand("collision", "The tool hits a body region: peak and clamping forces (ISO/TS 15066)");
+  phri::CollisionOptions& o = args.options;
+  collision->add_option("--out", o.output_dir, "output folder")->capture_default_str();
+  collision->add_option("--regions", o.regions, "body regions met, by name in the regions file")->capture_default_str();
+  collision->add_option("--regions-file", o.regions_file, "the body regions (k, m_H, F_QS)")->capture_default_str();
+  collision->add_option("--speeds", o.speeds_m_s, "point-to-point peak speeds [m/s]")
+      ->check(CLI::Range(0.01, 3.0))
+      ->capture_default_str();
+  collision->add_flag("!--no-dynamic", o.dynamic, "leave out the dynamic scenario");
+  collision->add_option("--modes", args.modes, "compliance modes (default: null_space full_body dual)")
+      ->check(CLI::IsMember({"stiff", "null_space", "full_body", "dual"}));
+  collision->add_option("--loops", args.loops, "low-level loops (default: position custom kinova_torque_high_velocity)")
+      ->check(CLI::IsMember({"position", "custom", "kinova_torque", "kinova_torque_high_velocity"}));
+  collision->add_option("--window", o.contact_window_s, "measured after the first touch [s]")
+      ->check(CLI::Range(0.3, 10.0))
+      ->capture_default_str();
+  collision->add_option("--seed", o.seed, "plant seed (model mismatch, noise)")->capture_default_str();
+  collision->add_option("--jobs", o.jobs, "threads")->check(CLI::Range(1, 64))->capture_default_str();
+  return collision;
+}
+
+int collision_command(CollisionArguments args) {
+  phri::CollisionOptions& o = args.options;
+  for (std::string* path : {&o.plant_config_path, &o.urdf_path, &o.actuators_path, &o.collision_path, &o.regions_file,
+                            &o.figure_script}) {
+    *path = locate(*path);
+  }
+  if (!args.loops.empty()) {
+    o.loops.clear();
+    for (const std::string& name : args.loops) o.loops.push_back(*phri::low_level_mode_from_string(name));
+  }
+  if (!args.modes.empty()) {
+    o.modes.clear();
+    for (const std::string& name : args.modes) o.modes.push_back(*phri::compliance_mode_from_string(name));
+  }
+  phri::ensure_output_directory(o.output_dir);
+  return phri::run_collision_command(o, std::cout);
+}
+
 // `phri evaluate`: the files are found from the working directory, else from the source tree.
 int evaluate_command(phri::EvaluationOptions e) {
   const std::string probe = locate("configs/plant_gen3.yaml");
@@ -886,6 +933,8 @@ int main(int argc, char** argv) {
   const CLI::App* dual = add_dual_compliance_command(*experiment, dual_options);
   Iso9283Arguments iso_args;
   const CLI::App* iso = add_iso9283_command(*experiment, iso_args);
+  CollisionArguments collision_args;
+  const CLI::App* collision = add_collision_command(*experiment, collision_args);
   auto* evaluate = app.add_subcommand("evaluate", "The paper's five evaluations and a report (report.md, report.html)");
   evaluate->add_option("--out", evaluation.output_dir, "output folder")->capture_default_str();
   evaluate->add_flag("--quick", evaluation.quick, "short protocols (a smoke test; not the paper's numbers)");
@@ -916,6 +965,7 @@ int main(int argc, char** argv) {
     if (dynamic->parsed()) return dynamic_tracking_command(dynamic_options);
     if (dual->parsed()) return dual_compliance_command(dual_options);
     if (iso->parsed()) return iso9283_command(iso_args);
+    if (collision->parsed()) return collision_command(collision_args);
     if (evaluate->parsed()) return evaluate_command(evaluation);
     if (load->parsed()) {
       load_args.config_path = locate(load_args.config_path);

@@ -652,6 +652,10 @@ Config parse(const YamlReader& root, const std::string& base_dir, const std::str
 
 }  // namespace
 
+BodyRegion body_region_from_file(const std::string& file, const std::string& name) {
+  return load_body_region(file, name, YamlReader::load_file(file), "regions");
+}
+
 Config Config::from_yaml_file(const std::string& path) {
   return parse(YamlReader::load_file(path), std::filesystem::path(path).parent_path().string());
 }

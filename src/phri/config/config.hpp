@@ -95,4 +95,8 @@ struct Config {
   std::optional<BodyRegionMap> body_regions;
 };
 
+/// The region `name` of a regions file (configs/iso_ts_15066_regions.yaml's form); ConfigError
+/// naming the file's regions when it has none of that name.
+BodyRegion body_region_from_file(const std::string& file, const std::string& name);
+
 }  // namespace phri

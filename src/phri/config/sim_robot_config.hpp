@@ -30,6 +30,14 @@
 
 namespace phri {
 
+/// The standard's body-region model as the simulator builds it (sim/body_region_surrogate.hpp).
+struct BodyRegionSurrogateSettings {
+  double mass_kg = 0.6;                ///< m_H
+  double stiffness_N_per_m = 75000.0;  ///< k
+  double damping_Ns_per_m = 0.0;       ///< c (the standard's model has none)
+  bool backed_by_wall = false;         ///< the mass cannot move: clamping (quasi-static contact)
+};
+
 struct SimRobotConfig : RobotDescription {
   static SimRobotConfig from_yaml_file(const std::string& path);
   /// `base_dir` resolves relative file names; `source_name` stands for the file in errors.
@@ -151,6 +159,16 @@ struct SimRobotConfig : RobotDescription {
     /// in the paper's protocol where the weight is let go by hand).
     bool held_by_hand = false;
   } drop_test;
+
+  /// A body region in the robot's way (sim/body_region_surrogate.hpp: the standard's mass m_H
+  /// behind a spring k), met by the tool's box; `phri experiment collision` places it.
+  struct Surrogate {
+    bool enabled = false;
+    BodyRegionSurrogateSettings region;
+    Eigen::Vector3d face_m = Eigen::Vector3d::Zero();   ///< centre of its face at rest (world)
+    Eigen::Vector3d normal = Eigen::Vector3d::UnitX();  ///< out of the face, toward the robot (world, unit)
+    double face_radius_m = 0.1;                      ///< the face is a disc of this radius
+  } surrogate;
 
   struct Floor {
     bool enabled = false;

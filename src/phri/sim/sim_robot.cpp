@@ -119,6 +119,7 @@ SimRobot::SimRobot(const SimRobotConfig& config)
   if (config_.mismatch.enabled) perturb_link_inertials(arm_bodies);
   find_ft_sensor();
   if (config_.drop_test.enabled) find_drop_test();
+  if (config_.surrogate.enabled) find_surrogate();
   find_disturbance_bodies();
   if (config_.random_pushes.enabled) find_push_links(arm_bodies);
   make_data();
@@ -302,6 +303,21 @@ void SimRobot::find_drop_test() {
   latch_damping_ = 2.0 * std::sqrt(config_.drop_test.latch_stiffness_N_per_m * config_.drop_test.mass_kg);
 }
 
+void SimRobot::find_surrogate() {
+  const auto& c = config_.surrogate;
+  const auto& r = c.region;
+  tool_geom_ = mj_name2id(m_.get(), mjOBJ_GEOM, SimScene::kToolGeom);
+  if (tool_geom_ < 0 || m_->geom_type[tool_geom_] != mjGEOM_BOX) throw ConfigError(config_.source, "surrogate", "needs a tool for the body region to meet (no end of arm)");
+  if (!(r.mass_kg > 0.0) || !(r.stiffness_N_per_m > 0.0) || !(r.damping_Ns_per_m >= 0.0) || !std::isfinite(r.mass_kg) ||
+      !std::isfinite(r.stiffness_N_per_m) || !std::isfinite(r.damping_Ns_per_m)) {
+    throw ConfigError(config_.source, "surrogate.region", "needs a finite mass > 0, stiffness > 0 and damping >= 0");
+  }
+  if (!c.face_m.allFinite() || !c.normal.allFinite() || std::abs(c.normal.norm() - 1.0) > 1e-6 || !(c.face_radius_m > 0.0)) {
+    throw ConfigError(config_.source, "surrogate", "needs a finite face position, a unit normal and a face radius > 0");
+  }
+  surrogate_ = BodyRegionSurrogate(r);
+}
+
 void SimRobot::find_disturbance_bodies() {
   for (std::size_t i = 0; i < config_.disturbances.size(); ++i) {
     const auto& f = config_.disturbances[i];
@@ -394,6 +410,12 @@ void SimRobot::reset() {
   state_.cycle = 0;
 }
 
+void SimRobot::set_surrogate_face(const Eigen::Vector3d& face, const Eigen::Vector3d& normal) {
+  config_.surrogate.face_m = face;
+  config_.surrogate.normal = normal.normalized();
+  surrogate_.reset();
+}
+
 int SimRobot::body_id(const std::string& name) const {
   const int b = mj_name2id(m_.get(), mjOBJ_BODY, name.c_str());
   return b > 0 ? b : -1;
@@ -435,6 +457,8 @@ void SimRobot::restart_noise_and_counters() {
   state_ = RobotState(n_);
   truth_.drop_released = false;
   truth_.cable_force_N = 0.0;
+  surrogate_.reset();
+  surrogate_peak_ = 0.0;
 }
 
 Eigen::Vector3d SimRobot::place_initial_pose() {
@@ -602,6 +626,7 @@ const RobotState& SimRobot::read() {
     has_pending_ = false;
   }
   drive_->begin_cycle(command_, fresh, q_meas_, vendor_torque());
+  surrogate_peak_ = 0.0;
   for (int s = 0; s < substeps_; ++s) substep();
   if (d_->warning[mjWARN_BADQACC].number > 0 || d_->warning[mjWARN_BADQVEL].number > 0 ||
       d_->warning[mjWARN_BADQPOS].number > 0) {
@@ -743,6 +768,7 @@ void SimRobot::apply_force(int body, const Eigen::Vector3d& point_local, bool lo
 }
 
 void SimRobot::apply_external_forces(double t) {
+  if (tool_geom_ >= 0) apply_surrogate_force();
   for (std::size_t i = 0; i < config_.disturbances.size(); ++i) {
     const ExternalForce& f = config_.disturbances[i];
     const double s = f.scale_at(t);
@@ -877,6 +903,61 @@ void SimRobot::sample_state() {
   }
   truth_.last_push = pushes_.latest();
   truth_.floor_normal_force_N = floor_geom_ >= 0 ? floor_normal_force() : 0.0;
+  truth_.surrogate_force_N = surrogate_.force_N();
+  truth_.surrogate_peak_force_N = surrogate_peak_;
+  truth_.surrogate_compression_m = surrogate_.compression_m();
+  truth_.surrogate_displacement_m = surrogate_.displacement_m();
+}
+
+namespace {
+// How far a box (centre c, axes, half sizes h) reaches from its centre along the unit `direction`
+// (its support function): sum_i h_i |a_i . direction|.
+double box_reach(const Eigen::Matrix3d& axes, const mjtNum* half, const Eigen::Vector3d& direction) {
+  double reach = 0.0;
+  for (int i = 0; i < 3; ++i) reach += half[i] * std::abs(direction.dot(axes.col(i)));
+  return reach;
+}
+}  // namespace
+
+Eigen::Vector3d SimRobot::tool_point_along(const Eigen::Vector3d& direction) const {
+  const Eigen::Matrix3d axes = rotation(d_->geom_xmat + 9 * tool_geom_);
+  const Eigen::Vector3d centre(d_->geom_xpos[3 * tool_geom_], d_->geom_xpos[3 * tool_geom_ + 1], d_->geom_xpos[3 * tool_geom_ + 2]);
+  return centre + box_reach(axes, m_->geom_size + 3 * tool_geom_, direction) * direction;
+}
+
+Eigen::Vector3d SimRobot::tool_velocity() const {
+  mjtNum v[6];
+  mj_objectVelocity(m_.get(), d_.get(), mjOBJ_GEOM, tool_geom_, v, 0);
+  return {v[3], v[4], v[5]};
+}
+
+// The body region's force on the tool (body_region_surrogate.hpp). The depth is exact (the box's
+// reach along the face's inward normal); the box is over the face when its centre is; the force
+// acts at the deepest corner, moved toward the middle of the box's face as that face turns square
+// to the normal (within ~6 degrees: kSquare), so that a face meeting the face flat pushes at its
+// middle and a slight tilt does not throw the point from one corner to the other.
+void SimRobot::apply_surrogate_force() {
+  constexpr double kSquare = 0.1;
+  const auto& c = config_.surrogate;
+  const Eigen::Matrix3d axes = rotation(d_->geom_xmat + 9 * tool_geom_);
+  const mjtNum* half = m_->geom_size + 3 * tool_geom_;
+  const Eigen::Vector3d centre(d_->geom_xpos[3 * tool_geom_], d_->geom_xpos[3 * tool_geom_ + 1], d_->geom_xpos[3 * tool_geom_ + 2]);
+  const Eigen::Vector3d from_face = centre - c.face_m;
+  const double height = from_face.dot(c.normal);
+  const double depth = box_reach(axes, half, c.normal) - height;
+  const bool over_face = (from_face - height * c.normal).norm() <= c.face_radius_m;
+  const double force = surrogate_.step(depth, over_face, m_->opt.timestep);
+  surrogate_peak_ = std::max(surrogate_peak_, force);
+  if (force == 0.0) return;
+  Eigen::Vector3d point = centre;
+  for (int i = 0; i < 3; ++i) {
+    const double along = -c.normal.dot(axes.col(i));
+    point += half[i] * std::clamp(along / kSquare, -1.0, 1.0) * axes.col(i);
+  }
+  const int body = m_->geom_bodyid[tool_geom_];
+  const Eigen::Matrix3d R = rotation(d_->xmat + 9 * body);
+  const Eigen::Vector3d origin(d_->xpos[3 * body], d_->xpos[3 * body + 1], d_->xpos[3 * body + 2]);
+  apply_force(body, R.transpose() * (point - origin), false, force * c.normal, Eigen::Vector3d::Zero());
 }
 
 // The normal force of every contact between the floor and a geom of the arm or its tool.

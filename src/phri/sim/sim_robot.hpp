@@ -45,6 +45,7 @@
 #include <phri/sim/elastic_transmission.hpp>
 #include <phri/sim/mujoco_handles.hpp>
 #include <phri/sim/random_push_generator.hpp>
+#include <phri/sim/body_region_surrogate.hpp>
 #include <phri/robot/ground_truth.hpp>
 #include <phri/robot/push_input.hpp>
 #include <phri/robot/robot_interface.hpp>
@@ -83,6 +84,11 @@ public:
     double cable_force_N = 0.0;   ///< cable tension (0 while slack)
     // floor (a table when the tool touches it)
     double floor_normal_force_N = 0.0;  ///< the floor's normal force on the robot's geoms, summed
+    // a body region in the way (SimRobotConfig::surrogate)
+    double surrogate_force_N = 0.0;       ///< on the tool, along the face's normal, at the cycle's last physics step
+    double surrogate_peak_force_N = 0.0;  ///< the largest over the cycle's physics steps
+    double surrogate_compression_m = 0.0; ///< of its spring while touched (0 otherwise)
+    double surrogate_displacement_m = 0.0;  ///< how far its mass has recoiled
     // random pushes
     RandomPushGenerator::Push last_push;  ///< latest push drawn (index 0: none yet)
   };
@@ -119,6 +125,18 @@ public:
   /// No allocation.
   void set_live_disturbance(int body, const ExternalForce& force);
 
+  /// Moves the body region (config().surrogate, enabled) so that its face at rest is at `face`
+  /// with the outward unit `normal` (world), at rest and untouched; an experiment places it on the
+  /// arm's path once it knows the path. No allocation.
+  void set_surrogate_face(const Eigen::Vector3d& face, const Eigen::Vector3d& normal);
+
+  /// The point on the tool box's centre line along `direction` (world, unit) as far out as the box
+  /// reaches: a body region's face square to `direction` placed there just touches the box. Needs
+  /// config().surrogate enabled.
+  Eigen::Vector3d tool_point_along(const Eigen::Vector3d& direction) const;
+  /// The tool box centre's true velocity (world) [m/s]. Needs config().surrogate enabled.
+  Eigen::Vector3d tool_velocity() const;
+
   // ---- PushInput: a step force as a live disturbance from the latest state's time on.
   int push_target(const std::string& link) const override { return body_id(link); }
   void push(int target, const Eigen::Vector3d& point_m, const Eigen::Vector3d& force_world_N, double hold_s) override;
@@ -144,6 +162,7 @@ private:
   void perturb_link_inertials(const std::vector<int>& arm_bodies);
   void find_ft_sensor();
   void find_drop_test();
+  void find_surrogate();
   void find_disturbance_bodies();
   void find_push_links(const std::vector<int>& arm_bodies);
   void make_data();
@@ -172,6 +191,7 @@ private:
   void apply_force(int body, const Eigen::Vector3d& point_local, bool local_frame, const Eigen::Vector3d& force,
                    const Eigen::Vector3d& torque);
   void apply_drop_forces(double t);
+  void apply_surrogate_force();
   void sample_state();
   // The motor torque as the vendor firmware believes it: the drive current times its stored
   // (nominal, actuators.yaml) K_T G_r. It differs from tau_motor_ when the plant's torque
@@ -227,6 +247,9 @@ private:
   int anchor_site_ = -1;
   int drop_body_ = -1, drop_qadr_ = -1, drop_dadr_ = -1;
   int floor_geom_ = -1;
+  int tool_geom_ = -1;  // the box the surrogate meets
+  BodyRegionSurrogate surrogate_;
+  double surrogate_peak_ = 0.0;  // over the cycle's physics steps
   double floor_normal_force() const;
   double latch_damping_ = 0.0;
   Eigen::Vector3d release_offset_ = Eigen::Vector3d::Zero();  // world axes, drawn at reset()

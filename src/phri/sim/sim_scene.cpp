@@ -98,7 +98,7 @@ std::string bare_tool_mjcf(const SimRobotConfig& config, const FlangeMount& moun
            num(sp[2]) + "\" quat=\"" + num(sq[0]) + " " + num(sq[1]) + " " + num(sq[2]) + " " + num(sq[3]) + "\">\n";
   chain += "  <inertial pos=\"" + vec(tool.com_m) + "\" mass=\"" + num(tool.mass_kg) + "\" diaginertia=\"" +
            vec(tool.inertia_kgm2) + "\"/>\n";
-  chain += "  <geom name=\"tool_geom\" type=\"box\" size=\"0.03 0.05 0.03\" pos=\"" + vec(tool.com_m) +
+  chain += "  <geom name=\"" + std::string(SimScene::kToolGeom) + "\" type=\"box\" size=\"0.03 0.05 0.03\" pos=\"" + vec(tool.com_m) +
            "\" contype=\"" + tool_contact + "\" conaffinity=\"" + tool_contact +
            "\" group=\"1\" rgba=\"0.2 0.2 0.8 0.6\"/>\n";
   if (config.drop_test.enabled) {
@@ -137,7 +137,7 @@ std::string tool_chain_mjcf(const SimRobotConfig& config, const FlangeMount& mou
   chain += "  <body name=\"" + std::string(SimScene::kToolBody) + "\" pos=\"" + vec(at) + "\"" + mount_quat(ft.sensor_mount) + ">\n";
   chain += "    <inertial pos=\"" + vec(tool.com_m) + "\" mass=\"" + num(tool.mass_kg) + "\" diaginertia=\"" +
            vec(tool.inertia_kgm2) + "\"/>\n";
-  chain += "    <geom name=\"tool_geom\" type=\"box\" size=\"0.03 0.05 0.03\" pos=\"" + vec(tool.com_m) +
+  chain += "    <geom name=\"" + std::string(SimScene::kToolGeom) + "\" type=\"box\" size=\"0.03 0.05 0.03\" pos=\"" + vec(tool.com_m) +
            "\" contype=\"" + tool_contact + "\" conaffinity=\"" + tool_contact +
            "\" group=\"1\" rgba=\"0.2 0.2 0.8 0.6\"/>\n";
   chain += "    <site name=\"" + std::string(SimScene::kSensorSite) + "\" size=\"0.01\"/>\n";

@@ -27,6 +27,7 @@ namespace phri {
 struct SimScene {
   static constexpr const char* kAdapterBody = "ft_adapter";
   static constexpr const char* kToolBody = "tool";
+  static constexpr const char* kToolGeom = "tool_geom";  ///< the tool's box (what a body region meets)
   /// A robot bundle's payload is the body kPayloadBodyPrefix + its name, a child of its link's body.
   static constexpr const char* kPayloadBodyPrefix = "payload_";
   static constexpr const char* kSensorSite = "ft_sensor";
