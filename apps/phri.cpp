@@ -799,6 +799,7 @@ int collision_command(CollisionArguments args) {
     o.modes.clear();
     for (const std::string& name : args.modes) o.modes.push_back(*phri::compliance_mode_from_string(name));
   }
+  phri::collision_regions(o);  // refused before the output folder is made
   phri::ensure_output_directory(o.output_dir);
   return phri::run_collision_command(o, std::cout);
 }

@@ -420,7 +420,7 @@ std::string mode_loop_table(const CollisionResult& r) {
 
 }  // namespace
 
-CollisionResult run_collision(const CollisionOptions& o, std::ostream* progress) {
+std::vector<BodyRegion> collision_regions(const CollisionOptions& o) {
   if (o.regions.empty()) throw ConfigError("<collision options>", "regions", "name at least one region");
   if (o.modes.empty() || o.loops.empty()) throw ConfigError("<collision options>", "modes/loops", "name at least one of each");
   if (o.speeds_m_s.empty() && !o.dynamic) throw ConfigError("<collision options>", "speeds_m_s", "no motion to run");
@@ -434,6 +434,11 @@ CollisionResult run_collision(const CollisionOptions& o, std::ostream* progress)
   }
   std::vector<BodyRegion> regions;
   for (const std::string& name : o.regions) regions.push_back(body_region_from_file(o.regions_file, name));
+  return regions;
+}
+
+CollisionResult run_collision(const CollisionOptions& o, std::ostream* progress) {
+  const std::vector<BodyRegion> regions = collision_regions(o);
   if (!o.output_dir.empty()) ensure_output_directory(o.output_dir);
   CollisionResult r;
   r.options = o;
@@ -569,6 +574,7 @@ std::string collision_table(const CollisionResult& r) {
 }
 
 int run_collision_command(const CollisionOptions& options, std::ostream& out) {
+  collision_regions(options);  // a refusal before anything is printed
   out << "Collision test: " << options.regions.size() << " regions, " << options.speeds_m_s.size()
       << " point-to-point speeds" << (options.dynamic ? " and the dynamic scenario" : "") << ", free and clamped, "
       << options.modes.size() << " modes x " << options.loops.size() << " loops, without and with the constraint" << std::endl;

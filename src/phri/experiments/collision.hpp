@@ -96,6 +96,8 @@ struct CollisionResult {
   std::vector<std::string> files;
 };
 
+/// The options' regions from their file; ConfigError on an unknown region or an option out of range.
+std::vector<BodyRegion> collision_regions(const CollisionOptions& options);
 CollisionResult run_collision(const CollisionOptions& options, std::ostream* progress = nullptr);
 /// The markdown tables and the conclusions computed from them.
 std::string collision_table(const CollisionResult& result);
