@@ -804,6 +804,14 @@ int collision_command(CollisionArguments args) {
   return phri::run_collision_command(o, std::cout);
 }
 
+const CLI::App* add_evaluate_command(CLI::App& app, phri::EvaluationOptions& evaluation) {
+  auto* evaluate = app.add_subcommand("evaluate", "The paper's five evaluations and a report (report.md, report.html)");
+  evaluate->add_option("--out", evaluation.output_dir, "output folder")->capture_default_str();
+  evaluate->add_flag("--quick", evaluation.quick, "short protocols (a smoke test; not the paper's numbers)");
+  evaluate->add_option("--jobs", evaluation.jobs, "threads for the drops")->check(CLI::Range(1, 64))->capture_default_str();
+  return evaluate;
+}
+
 // `phri evaluate`: the files are found from the working directory, else from the source tree.
 int evaluate_command(phri::EvaluationOptions e) {
   const std::string probe = locate("configs/plant_gen3.yaml");
@@ -936,10 +944,7 @@ int main(int argc, char** argv) {
   const CLI::App* iso = add_iso9283_command(*experiment, iso_args);
   CollisionArguments collision_args;
   const CLI::App* collision = add_collision_command(*experiment, collision_args);
-  auto* evaluate = app.add_subcommand("evaluate", "The paper's five evaluations and a report (report.md, report.html)");
-  evaluate->add_option("--out", evaluation.output_dir, "output folder")->capture_default_str();
-  evaluate->add_flag("--quick", evaluation.quick, "short protocols (a smoke test; not the paper's numbers)");
-  evaluate->add_option("--jobs", evaluation.jobs, "threads for the drops")->check(CLI::Range(1, 64))->capture_default_str();
+  const CLI::App* evaluate = add_evaluate_command(app, evaluation);
   FitCollisionArguments fit_args;
   const CLI::App* fit_collision = add_fit_collision_command(app, fit_args);
   FtMonitorArguments ft_args;

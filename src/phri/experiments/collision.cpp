@@ -470,6 +470,94 @@ CollisionResult run_collision(const CollisionOptions& o, std::ostream* progress)
   return r;
 }
 
+namespace {
+
+// The runs of one region, motion (and speed) and contact, without [0] and with [1] the constraint.
+struct CollisionGroup {
+  const CollisionRun* first = nullptr;
+  double speed[2] = {0, 0}, vmax = 1e9, peak[2] = {0, 0}, clamp[2] = {0, 0};
+  int over[2] = {0, 0}, count[2] = {0, 0}, invalid = 0;
+};
+
+bool over_limit(const CollisionRun& c) {
+  return c.peak_force_N > c.limit_N() || (c.clamped && c.quasi_static_force_N > c.region.quasi_static_force_N);
+}
+
+std::vector<CollisionGroup> collision_groups(const CollisionResult& r) {
+  std::vector<CollisionGroup> groups;
+  for (const CollisionRun& c : r.runs) {
+    auto it = std::find_if(groups.begin(), groups.end(), [&](const CollisionGroup& g) {
+      return g.first->region.name == c.region.name && g.first->motion == c.motion &&
+             g.first->nominal_speed_m_s == c.nominal_speed_m_s && g.first->clamped == c.clamped;
+    });
+    if (it == groups.end()) {
+      groups.emplace_back();
+      groups.back().first = &c;
+      it = groups.end() - 1;
+    }
+    CollisionGroup& g = *it;
+    if (!c.valid) {
+      ++g.invalid;
+      continue;
+    }
+    const int w = c.constraint ? 1 : 0;
+    g.speed[w] = std::max(g.speed[w], c.approach_speed_m_s);
+    if (c.permissible_speed_m_s > 0.0) g.vmax = std::min(g.vmax, c.permissible_speed_m_s);
+    g.peak[w] = std::max(g.peak[w], c.peak_force_N);
+    g.clamp[w] = std::max(g.clamp[w], c.quasi_static_force_N);
+    g.over[w] += over_limit(c) ? 1 : 0;
+    ++g.count[w];
+  }
+  return groups;
+}
+
+std::string group_label(const CollisionRun& c) {
+  return c.region.name + ", " + to_string(c.motion) +
+         (c.motion == CollisionMotion::kPointToPoint ? " at " + format_fixed(c.nominal_speed_m_s, 2) + " m/s" : "") + ", " +
+         (c.clamped ? "clamped" : "free");
+}
+
+// The conclusions, from this run's numbers.
+std::string collision_conclusions(const std::vector<CollisionGroup>& groups) {
+  int over[2] = {0, 0}, count[2] = {0, 0}, invalid = 0;
+  double best_reduction = 0.0, worst_change = 0.0;
+  const CollisionRun* best = nullptr;
+  const CollisionRun* worst = nullptr;
+  for (const CollisionGroup& g : groups) {
+    for (int w = 0; w < 2; ++w) {
+      over[w] += g.over[w];
+      count[w] += g.count[w];
+    }
+    invalid += g.invalid;
+    if (g.peak[0] <= 0.0 || g.count[1] == 0) continue;
+    const double reduction = 1.0 - g.peak[1] / g.peak[0];
+    if (reduction > best_reduction) {
+      best_reduction = reduction;
+      best = g.first;
+    }
+    if (-reduction > worst_change) {
+      worst_change = -reduction;
+      worst = g.first;
+    }
+  }
+  std::ostringstream s;
+  s << "- Without the constraint " << over[0] << " of " << count[0] << " valid collisions exceeded their region's limit "
+    << "(the peak over the transient limit free, over F_QS clamped, or the clamping force over F_QS); with it " << over[1]
+    << " of " << count[1] << ".\n";
+  if (best) {
+    s << "- The constraint lowered the worst peak force by up to " << format_fixed(100.0 * best_reduction, 0) << " % ("
+      << group_label(*best) << ").\n";
+  }
+  if (worst) {
+    s << "- It raised it by up to " << format_fixed(100.0 * worst_change, 0) << " % (" << group_label(*worst)
+      << "): it bounds the speed before the touch, not the push after it.\n";
+  }
+  if (invalid > 0) s << "- " << invalid << " runs invalid (collision_runs.csv says why); not counted.\n";
+  return s.str();
+}
+
+}  // namespace
+
 std::string collision_table(const CollisionResult& r) {
   const CollisionOptions& o = r.options;
   std::ostringstream s;
@@ -482,44 +570,9 @@ std::string collision_table(const CollisionResult& r) {
   s << "| region | motion | contact | limit [N] | speed at touch [m/s] (v_max) | peak [N] unlimited | peak [N] limited | "
        "clamping force [N] unlimited / limited (F_QS) | runs over the limit unlimited / limited | invalid |\n";
   s << "|---|---|---|---|---|---|---|---|---|---|\n";
-  struct Group {
-    double speed[2] = {0, 0}, vmax = 1e9, peak[2] = {0, 0}, clamp[2] = {0, 0};
-    int over[2] = {0, 0}, count[2] = {0, 0}, invalid = 0;
-  };
-  int total_over[2] = {0, 0}, total[2] = {0, 0}, total_invalid = 0;
-  std::vector<std::string> order;
-  std::vector<Group> groups;
-  std::vector<const CollisionRun*> first;
-  for (const CollisionRun& c : r.runs) {
-    std::ostringstream key;
-    key << c.region.name << '|' << to_string(c.motion) << '|' << c.nominal_speed_m_s << '|' << c.clamped;
-    auto it = std::find(order.begin(), order.end(), key.str());
-    if (it == order.end()) {
-      order.push_back(key.str());
-      groups.emplace_back();
-      first.push_back(&c);
-      it = order.end() - 1;
-    }
-    Group& g = groups[static_cast<std::size_t>(it - order.begin())];
-    if (!c.valid) {
-      ++g.invalid;
-      ++total_invalid;
-      continue;
-    }
-    const int w = c.constraint ? 1 : 0;
-    g.speed[w] = std::max(g.speed[w], c.approach_speed_m_s);
-    if (c.permissible_speed_m_s > 0.0) g.vmax = std::min(g.vmax, c.permissible_speed_m_s);
-    g.peak[w] = std::max(g.peak[w], c.peak_force_N);
-    g.clamp[w] = std::max(g.clamp[w], c.quasi_static_force_N);
-    const bool over = c.peak_force_N > c.limit_N() || (c.clamped && c.quasi_static_force_N > c.region.quasi_static_force_N);
-    g.over[w] += over ? 1 : 0;
-    ++g.count[w];
-    total_over[w] += over ? 1 : 0;
-    ++total[w];
-  }
-  for (std::size_t i = 0; i < groups.size(); ++i) {
-    const Group& g = groups[i];
-    const CollisionRun& c = *first[i];
+  const std::vector<CollisionGroup> groups = collision_groups(r);
+  for (const CollisionGroup& g : groups) {
+    const CollisionRun& c = *g.first;
     s << "| " << c.region.name << " | " << to_string(c.motion);
     if (c.motion == CollisionMotion::kPointToPoint) s << " " << format_fixed(c.nominal_speed_m_s, 2) << " m/s";
     s << " | " << (c.clamped ? "clamped" : "free") << " | " << format_fixed(c.limit_N(), 0) << " | "
@@ -535,41 +588,7 @@ std::string collision_table(const CollisionResult& r) {
     s << " | " << g.over[0] << " of " << g.count[0] << " / " << g.over[1] << " of " << g.count[1] << " | " << g.invalid
       << " |\n";
   }
-  s << "\n" << mode_loop_table(r) << "\n";
-  // The conclusions, from this run's numbers.
-  s << "- Without the constraint " << total_over[0] << " of " << total[0] << " valid collisions exceeded their region's limit "
-    << "(the peak over the transient limit free, over F_QS clamped, or the clamping force over F_QS); with it "
-    << total_over[1] << " of " << total[1] << ".\n";
-  double best_reduction = 0.0, worst_change = 0.0;
-  const CollisionRun* best = nullptr;
-  const CollisionRun* worst = nullptr;
-  for (std::size_t i = 0; i < groups.size(); ++i) {
-    if (groups[i].peak[0] > 0.0 && groups[i].count[1] > 0) {
-      const double reduction = 1.0 - groups[i].peak[1] / groups[i].peak[0];
-      if (reduction > best_reduction) {
-        best_reduction = reduction;
-        best = first[i];
-      }
-      if (-reduction > worst_change) {
-        worst_change = -reduction;
-        worst = first[i];
-      }
-    }
-  }
-  auto label = [](const CollisionRun& c) {
-    return c.region.name + ", " + to_string(c.motion) +
-           (c.motion == CollisionMotion::kPointToPoint ? " at " + format_fixed(c.nominal_speed_m_s, 2) + " m/s" : "") + ", " +
-           (c.clamped ? "clamped" : "free");
-  };
-  if (best) {
-    s << "- The constraint lowered the worst peak force by up to " << format_fixed(100.0 * best_reduction, 0) << " % ("
-      << label(*best) << ").\n";
-  }
-  if (worst) {
-    s << "- It raised it by up to " << format_fixed(100.0 * worst_change, 0) << " % (" << label(*worst)
-      << "): it bounds the speed before the touch, not the push after it.\n";
-  }
-  if (total_invalid > 0) s << "- " << total_invalid << " runs invalid (collision_runs.csv says why); not counted.\n";
+  s << "\n" << mode_loop_table(r) << "\n" << collision_conclusions(groups);
   return s.str();
 }
 
