@@ -73,7 +73,6 @@ public:
         pushes_(options.pushes),
         ground_truth_(options.ground_truth),
         truth_data_(cycle.model()),
-        contact_data_(cycle.model()),
         observers_(options.observers) {
     if (live_) observers_.push_back(&live_->snapshots());
     if (live_ && pushes_) push_targets_ = push_targets(cycle.model(), *pushes_);
@@ -81,9 +80,6 @@ public:
       Eigen::VectorXd rotor(cycle.model().nv());
       for (int i = 0; i < rotor.size(); ++i) rotor[i] = cycle.actuators()[i].reflected_inertia_kgm2;
       contact_.emplace(cycle.model(), *cycle.collision(), rotor, *options.body_regions);
-      for (int i = 0; i < contact_->num_links(); ++i) {
-        summary_.contact.push_back({contact_->link_name(i), contact_->region(i).name});
-      }
       summary_.contact_true_state = has_true_state();
     }
   }
@@ -120,6 +116,7 @@ public:
     if (tty_) out_ << "\n";
     summary_.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
     summarize(k);
+    if (contact_) summary_.contact = contact_->links();
     return summary_;
   }
 
@@ -257,8 +254,10 @@ private:
     snapshot_.posture_gamma_override = compliance.posture_gamma_override();
     snapshot_.posture_stiffness = compliance.posture_stiffness();
     snapshot_.overruns = clock_.overruns();
-    snapshot_.contact_links = contact_ ? std::min(contact_->num_links(), kLiveMaxContactLinks) : 0;
-    for (int i = 0; i < snapshot_.contact_links; ++i) snapshot_.contact_ratio[static_cast<std::size_t>(i)] = contact_->link(i).ratio();
+    snapshot_.contact_links = contact_ ? std::min(contact_->monitor().num_links(), kLiveMaxContactLinks) : 0;
+    for (int i = 0; i < snapshot_.contact_links; ++i) {
+      snapshot_.contact_ratio[static_cast<std::size_t>(i)] = contact_->monitor().link(i).ratio();
+    }
     return snapshot_;
   }
 
@@ -273,31 +272,15 @@ private:
   void monitor_contact(const RobotState& state) {
     if (!contact_) return;
     const bool truth = has_true_state();
-    const Eigen::VectorXd& q = truth ? ground_truth_->true_joint_positions() : state.q_rad;
-    const Eigen::VectorXd& qd = truth ? ground_truth_->true_joint_velocities() : state.qd_rad_s;
-    if (q.size() != cycle_.model().nq() || qd.size() != cycle_.model().nv() || !q.allFinite() || !qd.allFinite()) return;
-    compute_all_terms(cycle_.model(), contact_data_, q, qd);
-    contact_->update(cycle_.model(), contact_data_);
-    for (int i = 0; i < contact_->num_links(); ++i) {
-      const ContactPointState& p = contact_->link(i);
-      ContactLinkSummary& s = summary_.contact[static_cast<std::size_t>(i)];
-      if (p.ratio() > s.max_ratio) {
-        s.max_ratio = p.ratio();
-        s.speed_at_max_m_s = p.speed_m_s;
-        s.reflected_mass_at_max_kg = p.reflected_mass_kg;
-        s.permissible_speed_at_max_m_s = p.permissible_speed_m_s;
-      }
-      s.max_speed_m_s = std::max(s.max_speed_m_s, p.speed_m_s);
-      s.max_energy_J = std::max(s.max_energy_J, p.energy_J);
-      if (p.ratio() > 1.0) s.time_above_s += period_;
-    }
+    contact_->record(cycle_.model(), truth ? ground_truth_->true_joint_positions() : state.q_rad,
+                     truth ? ground_truth_->true_joint_velocities() : state.qd_rad_s, period_);
   }
 
   void fill_contact_columns() {
-    const int worst = contact_ ? contact_->worst_link() : -1;
+    const int worst = contact_ ? contact_->monitor().worst_link() : -1;
     row_.pfl_link = worst;
     const ContactPointState none;
-    const ContactPointState& p = worst >= 0 ? contact_->link(worst) : none;
+    const ContactPointState& p = worst >= 0 ? contact_->monitor().link(worst) : none;
     row_.pfl_ratio = p.ratio();
     row_.pfl_speed_m_s = p.speed_m_s;
     row_.pfl_reflected_mass_kg = p.reflected_mass_kg;
@@ -469,8 +452,7 @@ private:
   PushInput* pushes_;
   const GroundTruth* ground_truth_;
   Data truth_data_;  // forward kinematics of the true joints, sized once
-  Data contact_data_;  // the power-and-force-limiting figures' state (true or measured), sized once
-  std::optional<PowerForceLimitMonitor> contact_;
+  std::optional<ContactRecorder> contact_;  // the power-and-force-limiting figures (true or measured state)
   std::vector<SnapshotChannel*> observers_;  // options.observers and the live front end's; sized before the loop
   std::vector<int> push_targets_;
   double push_start_s_ = 0.0, push_end_s_ = 0.0;
@@ -523,19 +505,23 @@ void print_contact_summary(const RunSummary& s, std::ostream& out) {
     out << "\nPower and force limiting (ISO/TS 15066): not measured (no body_regions in the configuration, or no capsules)\n";
     return;
   }
-  const auto worst = std::max_element(s.contact.begin(), s.contact.end(),
+  print_contact_table(s.contact, s.contact_true_state ? "the plant's true state" : "the measured state", out);
+}
+
+void print_contact_table(const std::vector<ContactLinkSummary>& links, const char* state, std::ostream& out) {
+  if (links.empty()) return;
+  const auto worst = std::max_element(links.begin(), links.end(),
                                       [](const ContactLinkSummary& a, const ContactLinkSummary& b) { return a.max_ratio < b.max_ratio; });
   char line[400];
   std::snprintf(line, sizeof line,
                 "\nPower and force limiting (ISO/TS 15066 transient contact, %s): worst v / v_max %.2f on %s (%s), %.3f s above 1 "
                 "on that link\n",
-                s.contact_true_state ? "the plant's true state" : "the measured state", worst->max_ratio, worst->link.c_str(),
-                worst->region.c_str(), worst->time_above_s);
+                state, worst->max_ratio, worst->link.c_str(), worst->region.c_str(), worst->time_above_s);
   out << line;
   out << "| link | region | max v / v_max | speed there m/s | reflected mass there kg | v_max there m/s | max speed m/s | "
          "max energy J | time above 1 s |\n";
   out << "|---|---|---|---|---|---|---|---|---|\n";
-  for (const ContactLinkSummary& c : s.contact) {
+  for (const ContactLinkSummary& c : links) {
     std::snprintf(line, sizeof line, "| %s | %s | %.3f | %.3f | %.2f | %.3f | %.3f | %.4f | %.3f |\n", c.link.c_str(),
                   c.region.c_str(), c.max_ratio, c.speed_at_max_m_s, c.reflected_mass_at_max_kg, c.permissible_speed_at_max_m_s,
                   c.max_speed_m_s, c.max_energy_J, c.time_above_s);

@@ -69,18 +69,6 @@ struct RunOptions {
   const BodyRegionMap* body_regions = nullptr;
 };
 
-/// One link's power-and-force-limiting figures over the run (ISO/TS 15066 transient contact).
-struct ContactLinkSummary {
-  std::string link, region;
-  double max_ratio = 0.0;                 ///< largest v / v_max
-  double speed_at_max_m_s = 0.0;          ///< the speed, reflected mass and v_max of that cycle
-  double reflected_mass_at_max_kg = 0.0;
-  double permissible_speed_at_max_m_s = 0.0;
-  double max_speed_m_s = 0.0;
-  double max_energy_J = 0.0;              ///< largest 1/2 mu v^2
-  double time_above_s = 0.0;              ///< robot time with v / v_max > 1
-};
-
 struct PhaseSummary {
   std::string name;
   double start_s = 0.0, end_s = 0.0;
@@ -125,5 +113,8 @@ RunSummary run_session(RobotInterface& robot, Controller& cycle, Fsm& fsm, Gamep
 void print_run_summary(const RunSummary& summary, std::ostream& out);
 /// The power-and-force-limiting table alone (a line when nothing was measured).
 void print_contact_summary(const RunSummary& summary, std::ostream& out);
+/// The same of any run's links (ContactRecorder::links()), measured on `state` ("the plant's true
+/// state", "the measured state"): the worst link's line and a markdown table.
+void print_contact_table(const std::vector<ContactLinkSummary>& links, const char* state, std::ostream& out);
 
 }  // namespace phri

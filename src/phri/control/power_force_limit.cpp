@@ -157,4 +157,29 @@ void PowerForceLimitMonitor::update(const Model& model, const Data& data) {
   }
 }
 
+ContactRecorder::ContactRecorder(const Model& model, const CollisionModel& capsules, const Eigen::VectorXd& rotor_inertia,
+                                 const BodyRegionMap& regions)
+    : monitor_(model, capsules, rotor_inertia, regions), data_(model) {
+  for (int i = 0; i < monitor_.num_links(); ++i) links_.push_back({monitor_.link_name(i), monitor_.region(i).name});
+}
+
+void ContactRecorder::record(const Model& model, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, double period) {
+  if (q.size() != model.nq() || qd.size() != model.nv() || !q.allFinite() || !qd.allFinite()) return;
+  compute_all_terms(model, data_, q, qd);
+  monitor_.update(model, data_);
+  for (int i = 0; i < monitor_.num_links(); ++i) {
+    const ContactPointState& p = monitor_.link(i);
+    ContactLinkSummary& s = links_[static_cast<std::size_t>(i)];
+    if (p.ratio() > s.max_ratio) {
+      s.max_ratio = p.ratio();
+      s.speed_at_max_m_s = p.speed_m_s;
+      s.reflected_mass_at_max_kg = p.reflected_mass_kg;
+      s.permissible_speed_at_max_m_s = p.permissible_speed_m_s;
+    }
+    s.max_speed_m_s = std::max(s.max_speed_m_s, p.speed_m_s);
+    s.max_energy_J = std::max(s.max_energy_J, p.energy_J);
+    if (p.ratio() > 1.0) s.time_above_s += period;
+  }
+}
+
 }  // namespace phri

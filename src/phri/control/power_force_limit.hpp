@@ -15,6 +15,7 @@
 // constraints: a push toward a faster motion is negated.
 #include <phri/control/constraint.hpp>
 #include <phri/model/collision_model.hpp>
+#include <phri/model/data.hpp>
 
 #include <Eigen/Cholesky>
 
@@ -150,6 +151,37 @@ private:
   Eigen::LLT<Eigen::MatrixXd> inertia_llt_;
   Eigen::MatrixXd jacobian_;
   Eigen::VectorXd scratch_, solved_;
+};
+
+/// One link's power-and-force-limiting figures over a run (ISO/TS 15066 transient contact).
+struct ContactLinkSummary {
+  std::string link, region;
+  double max_ratio = 0.0;                 ///< largest v / v_max
+  double speed_at_max_m_s = 0.0;          ///< the speed, reflected mass and v_max of that cycle
+  double reflected_mass_at_max_kg = 0.0;
+  double permissible_speed_at_max_m_s = 0.0;
+  double max_speed_m_s = 0.0;
+  double max_energy_J = 0.0;              ///< largest 1/2 mu v^2
+  double time_above_s = 0.0;              ///< time with v / v_max > 1
+};
+
+/// A run's per-link maxima of the monitor's figures, state after state (phri run's summary, the
+/// experiments' reports).
+class ContactRecorder {
+public:
+  /// As PowerForceLimitMonitor's.
+  ContactRecorder(const Model& model, const CollisionModel& capsules, const Eigen::VectorXd& rotor_inertia,
+                  const BodyRegionMap& regions);
+  /// The figures of the state (q, qd), which lasted `period` [s]; a state of the wrong size or not
+  /// finite is skipped. No allocation.
+  void record(const Model& model, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, double period);
+  const PowerForceLimitMonitor& monitor() const { return monitor_; }
+  const std::vector<ContactLinkSummary>& links() const { return links_; }
+
+private:
+  PowerForceLimitMonitor monitor_;
+  Data data_;
+  std::vector<ContactLinkSummary> links_;
 };
 
 }  // namespace phri
