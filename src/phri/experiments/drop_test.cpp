@@ -3,6 +3,7 @@
 #include <phri/control/controller.hpp>
 #include <phri/core/error.hpp>
 #include <phri/core/format.hpp>
+#include <phri/experiments/experiment_contact.hpp>
 #include <phri/experiments/experiment_files.hpp>
 #include <phri/experiments/parallel_runs.hpp>
 #include <phri/model/algorithms.hpp>
@@ -25,6 +26,7 @@ struct DropShared {
   Model model;
   ActuatorTable actuators;
   std::optional<CollisionModel> collision;
+  std::optional<BodyRegionMap> regions;  // power and force limiting's figures
 };
 
 ControllerSettings drop_settings(const DropTestOptions& o, DropMode mode, const SimRobotConfig& plant) {
@@ -121,6 +123,7 @@ DropRun run_drop(const DropShared& sh, DropMode mode, int index) {
   RobotCommand command(n);
   ControllerTargets targets(n);
   Data truth(cycle.model());
+  std::optional<ContactRecorder> contact = experiment_contact(cycle, sh.regions);
   const auto ee = static_cast<std::size_t>(cycle.end_effector_frame());
   DropRun run;
   run.mode = mode;
@@ -138,6 +141,7 @@ DropRun run_drop(const DropShared& sh, DropMode mode, int index) {
     const CycleStatus status = cycle.step(state, targets, command);
     check_cycle(o, mode, k >= switch_k + 1, status, cycle, command, run);
     robot.write(command);
+    record_true_contact(contact, cycle, robot);
     const SimRobot::Truth& t = robot.truth();
     const bool recording = !run.error_mm.empty() || (t.drop_released && t.cable_force_N > 0.0);
     if (!recording && (k < before_k || k >= release_k)) continue;
@@ -157,6 +161,7 @@ DropRun run_drop(const DropShared& sh, DropMode mode, int index) {
     throw ExperimentError("drop test", "no catch within 1 s of the release (drop " + std::to_string(index) + ")");
   }
   run.before_mm /= std::max(1, before_samples);
+  if (contact) run.contact = contact->links();
   finish_drop(o, dt, run);
   return run;
 }
@@ -278,7 +283,8 @@ DropTestResult run_drop_test(const DropTestOptions& o, std::ostream* progress) {
   std::optional<CollisionModel> collision;
   if (!o.collision_path.empty()) collision = CollisionModel::from_yaml_file(o.collision_path, model);
   const DropShared shared{o, std::move(plant), std::move(model),
-                          ActuatorTable::from_yaml_file(o.actuators_path), std::move(collision)};
+                          ActuatorTable::from_yaml_file(o.actuators_path), std::move(collision),
+                          experiment_body_regions(o.regions_file, o.plant_config_path)};
   DropTestResult result;
   result.runs.resize(static_cast<std::size_t>(2 * o.drops));
   std::mutex mutex;
@@ -351,6 +357,13 @@ std::string drop_test_table(const DropTestResult& r, const DropTestOptions& o) {
     << " s, metrics over " << format_fixed(o.window_s, 1) << " s after the catch. Simulated "
     << format_fixed(r.simulated_s, 0) << " s in " << format_fixed(r.wall_s, 1) << " s of wall time (" << o.jobs
     << " jobs).\n";
+  std::vector<std::pair<std::string, std::vector<ContactLinkSummary>>> contact(2);
+  for (const DropRun& run : r.runs) {
+    auto& mode = contact[run.mode == DropMode::kTorque ? 0 : 1];
+    mode.first = std::string(to_string(run.mode)) + " mode, all drops";
+    merge_contact(mode.second, run.contact);
+  }
+  s << contact_overview(contact);
   return s.str();
 }
 

@@ -36,6 +36,8 @@
 #include <string>
 #include <vector>
 
+#include <phri/control/power_force_limit.hpp>
+
 namespace phri {
 
 enum class DropMode { kTorque, kPosition };
@@ -48,6 +50,9 @@ struct DropTestOptions {
   std::string end_effector_frame = "end_effector_link";  ///< the URDF's frame the end of arm mounts on
   std::string actuators_path = "robots/kinova_gen3/actuators.yaml";
   std::string collision_path = "robots/kinova_gen3/collision.yaml";
+  /// Body regions of the power-and-force-limiting figures (experiment_contact.hpp); empty: the
+  /// iso_ts_15066_regions.yaml beside plant_config_path.
+  std::string regions_file;
   std::string output_dir = "results/drop_test";  ///< empty: no files
   std::string figure_script = "tools/report/drop_test_figure.py";  ///< empty: no figure
 
@@ -122,6 +127,7 @@ struct DropRun {
   long loop_mismatch_cycles = 0;  ///< cycles the command's loop was not the loop the mode names
   std::string loop_ran;          ///< the loop commanded at the end of the window
   std::vector<float> error_mm;  ///< e over the window, one sample per control period
+  std::vector<ContactLinkSummary> contact;  ///< per link, the whole drop (experiment_contact.hpp)
   /// Empty: valid; else why not (safe stop, QP fallback, wrong loop), for the table.
   std::string invalid_reason() const;
 };

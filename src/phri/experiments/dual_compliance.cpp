@@ -3,6 +3,7 @@
 #include <phri/control/controller.hpp>
 #include <phri/core/error.hpp>
 #include <phri/core/format.hpp>
+#include <phri/experiments/experiment_contact.hpp>
 #include <phri/experiments/experiment_files.hpp>
 #include <phri/model/algorithms.hpp>
 #include <phri/sim/sim_robot.hpp>
@@ -115,6 +116,7 @@ DualComplianceResult run_dual_compliance(const DualComplianceOptions& o, std::os
   RobotCommand command(robot.dof());
   ControllerTargets targets(robot.dof());
   Data truth(cycle.model());
+  std::optional<ContactRecorder> contact = experiment_contact(cycle, experiment_body_regions(o.regions_file, o.plant_config_path));
   std::vector<DualSample> samples;
   const int cycles = static_cast<int>(std::lround(o.duration_s / robot.period_s()));
   samples.reserve(static_cast<std::size_t>(cycles));
@@ -125,9 +127,11 @@ DualComplianceResult run_dual_compliance(const DualComplianceOptions& o, std::os
     if (k == static_cast<int>(std::lround(o.switch_s / robot.period_s()))) targets.low_level_mode = LowLevelMode::kCurrent;
     cycle.step(state, targets, command);
     robot.write(command);
+    record_true_contact(contact, cycle, robot);
     samples.push_back(sample(robot, cycle, truth));
   }
   DualComplianceResult r;
+  if (contact) r.contact = contact->links();
   r.guides = guide_metrics(samples, o.drift_window_s);
   r.touch_threshold = settings.compliance.touch_threshold;
   r.release_threshold = settings.compliance.release_threshold;
@@ -151,6 +155,7 @@ std::string dual_compliance_table(const DualComplianceResult& r) {
   }
   s << "\nSchmitt trigger on the F/T wrench norm: touch above " << format_fixed(r.touch_threshold, 1) << ", release below "
     << format_fixed(r.release_threshold, 1) << ".\n";
+  s << contact_overview({{"dual compliance, guided by hand", r.contact}});
   return s.str();
 }
 

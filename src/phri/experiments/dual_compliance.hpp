@@ -17,6 +17,8 @@
 
 #include <Eigen/Core>
 
+#include <phri/control/power_force_limit.hpp>
+
 namespace phri {
 
 struct DualComplianceOptions {
@@ -25,6 +27,9 @@ struct DualComplianceOptions {
   std::string end_effector_frame = "end_effector_link";  ///< the URDF's frame the end of arm mounts on
   std::string actuators_path = "robots/kinova_gen3/actuators.yaml";
   std::string collision_path = "robots/kinova_gen3/collision.yaml";
+  /// Body regions of the power-and-force-limiting figures (experiment_contact.hpp); empty: the
+  /// iso_ts_15066_regions.yaml beside plant_config_path.
+  std::string regions_file;
   std::string output_dir = "results/dual_compliance";
   std::uint64_t seed = 1;
   std::vector<double> start_q_rad = {0.0, 0.58, 3.14, -1.84, 0.0, 0.85, 1.57};
@@ -50,6 +55,7 @@ struct DualComplianceGuide {
 struct DualComplianceResult {
   std::vector<DualComplianceGuide> guides;
   double touch_threshold = 0.0, release_threshold = 0.0;
+  std::vector<ContactLinkSummary> contact;  ///< per link, the whole run (experiment_contact.hpp)
   std::vector<std::string> files;
 };
 

@@ -3,6 +3,7 @@
 #include <phri/control/controller.hpp>
 #include <phri/core/error.hpp>
 #include <phri/core/format.hpp>
+#include <phri/experiments/experiment_contact.hpp>
 #include <phri/experiments/experiment_files.hpp>
 #include <phri/experiments/parallel_runs.hpp>
 #include <phri/model/algorithms.hpp>
@@ -115,7 +116,8 @@ void settle_figures(const std::vector<Eigen::Vector3d>& after, const Eigen::Vect
 struct LoopRun {
   LoopRun(const Iso9283Options& options, LowLevelMode measured_loop)
       : o(options), loop(measured_loop), plant(iso_plant(options)), robot(plant), cycle(iso_settings(options, plant)),
-        command(robot.dof()), targets(robot.dof()), truth(cycle.model()), dt(robot.period_s()) {}
+        command(robot.dof()), targets(robot.dof()), truth(cycle.model()), dt(robot.period_s()),
+        contact(experiment_contact(cycle, experiment_body_regions(options.regions_file, options.plant_config_path))) {}
 
   void step(bool measuring) {
     const RobotState& state = robot.read();
@@ -124,6 +126,7 @@ struct LoopRun {
     targets.clear();
     if (robot.write(command) != WriteStatus::kOk) ++refused;
     if (measuring) {
+      record_true_contact(contact, cycle, robot);
       if (cycle.status() != CycleStatus::kOk && bad_cycles++ == 0) first_bad = cycle.status();
       if (cycle.low_level().loop() != loop) ++other_loop_cycles;
       if (cycle.compliance().mode() != ComplianceMode::kStiff) ++other_mode_cycles;
@@ -191,6 +194,7 @@ struct LoopRun {
   ControllerTargets targets;
   Data truth;
   double dt;
+  std::optional<ContactRecorder> contact;
   double t = 0.0;
   long bad_cycles = 0, other_loop_cycles = 0, other_mode_cycles = 0, refused = 0;
   CycleStatus first_bad = CycleStatus::kOk;
@@ -219,6 +223,7 @@ Iso9283Loop run_loop(const Iso9283Options& o, LowLevelMode loop, std::vector<Eig
   }
   result.invalid_reason = run.invalid_reason();
   result.valid = result.invalid_reason.empty();
+  if (run.contact) result.contact = run.contact->links();
   for (int p = 0; p < 5; ++p) {
     std::vector<Iso9283Arrival> at;
     for (const Iso9283Arrival& a : result.arrivals) {
@@ -373,7 +378,9 @@ std::string iso9283_table(const Iso9283Result& r) {
     s << "\n";
   }
   // The conclusion, from this run's numbers: each torque loop against the position loop.
-  s << "\n";
+  std::vector<std::pair<std::string, std::vector<ContactLinkSummary>>> contact;
+  for (const Iso9283Loop& l : r.loops) contact.emplace_back(std::string(to_string(l.loop)), l.contact);
+  s << contact_overview(contact) << "\n";
   if (!position) {
     s << "No valid position-loop run to compare with.\n";
     return s.str();

@@ -22,6 +22,7 @@
 // direction after the move's end). An arrival still outside a band in the last tenth of its
 // dwell did not stabilise and is counted; a loop whose run did not stay in that loop with every
 // cycle ok (no fallback, no safe stop) is reported invalid, not as a result.
+#include <phri/control/power_force_limit.hpp>
 #include <phri/robot/low_level_mode.hpp>
 
 #include <Eigen/Core>
@@ -40,6 +41,9 @@ struct Iso9283Options {
   std::string end_effector_frame = "end_effector_link";
   std::string actuators_path = "robots/kinova_gen3/actuators.yaml";
   std::string collision_path = "robots/kinova_gen3/collision.yaml";
+  /// Body regions of the power-and-force-limiting figures (experiment_contact.hpp); empty: the
+  /// iso_ts_15066_regions.yaml beside plant_config_path.
+  std::string regions_file;
   std::string output_dir = "results/iso9283";
   std::string figure_script = "tools/report/iso9283_figure.py";  ///< empty: no figure
   std::uint64_t seed = 1;
@@ -85,6 +89,7 @@ struct Iso9283Loop {
   std::string invalid_reason;  ///< why the run does not count (empty when valid)
   std::vector<Iso9283Pose> poses;  ///< P1..P5
   std::vector<Iso9283Arrival> arrivals;
+  std::vector<ContactLinkSummary> contact;  ///< per link, the measured cycles (experiment_contact.hpp)
 };
 
 struct Iso9283Result {

@@ -4,6 +4,7 @@
 #include <phri/core/error.hpp>
 #include <phri/core/format.hpp>
 #include <phri/core/statistics.hpp>
+#include <phri/experiments/experiment_contact.hpp>
 #include <phri/experiments/experiment_files.hpp>
 #include <phri/experiments/friction_perturbation.hpp>
 #include <phri/model/algorithms.hpp>
@@ -239,7 +240,8 @@ EeErrors true_ee_error(const Controller& cycle, const SimRobot& robot, Data& tru
 // Runs the schedule: position control, the switch to `loop`, the dynamic scenario's trajectory;
 // records the errors. Returns the number of QP fallbacks.
 long drive_run(const TorqueTrackingOptions& o, TrackingScenario scenario, LowLevelMode loop, const RunSchedule& schedule,
-               SimRobot& robot, Controller& cycle, TrackingRecorder& recorder, std::ostream* progress) {
+               SimRobot& robot, Controller& cycle, TrackingRecorder& recorder, std::optional<ContactRecorder>& contact,
+               std::ostream* progress) {
   const int n = robot.dof();
   const double dt = robot.period_s();
   const Trajectory trajectory{o.sine_amplitude_m, o.sine_omega_rad_s, o.triangle_speed_m_s,
@@ -276,6 +278,7 @@ long drive_run(const TorqueTrackingOptions& o, TrackingScenario scenario, LowLev
       targets.pose = {target, velocity, acceleration};
     }
     if (cycle.step(state, targets, command) == CycleStatus::kQpFallback) ++fallbacks;
+    if (after >= 0) record_true_contact(contact, cycle, robot);
     tau_desired_prev = cycle.qp().desired_torque();
     robot.write(command);
     if (state.fault) throw ExperimentError("torque tracking", "the simulated plant faulted");
@@ -295,7 +298,9 @@ TorqueTrackingRun run_one(const TorqueTrackingOptions& o, TrackingScenario scena
   TorqueTrackingRun run;
   run.scenario = scenario;
   run.loop = loop;
-  run.qp_fallbacks = drive_run(o, scenario, loop, schedule, robot, cycle, recorder, progress);
+  std::optional<ContactRecorder> contact = experiment_contact(cycle, experiment_body_regions(o.regions_file, o.plant_config_path));
+  run.qp_fallbacks = drive_run(o, scenario, loop, schedule, robot, cycle, recorder, contact, progress);
+  if (contact) run.contact = contact->links();
   simulated += robot.state().time_s;
   recorder.fill_statistics(run);
   if (!o.output_dir.empty()) {
@@ -398,7 +403,9 @@ std::string torque_tracking_table(const TorqueTrackingResult& r, const TorqueTra
       << " | " << format_fixed(run.p95_true_Nm, 4) << " | " << format_fixed(run.ee_position_rms_mm, 2) << " | "
       << format_fixed(run.ee_position_max_mm, 2) << " |\n";
   }
-  s << "\n";
+  std::vector<std::pair<std::string, std::vector<ContactLinkSummary>>> contact;
+  for (const TorqueTrackingRun& run : r.runs) contact.emplace_back(std::string(to_string(run.scenario)) + " / " + loop_name(run.loop), run.contact);
+  s << contact_overview(contact) << "\n";
   for (TrackingScenario scenario : o.scenarios) {
     const TorqueTrackingRun* c = r.find(scenario, LowLevelMode::kCurrent);
     const TorqueTrackingRun* h = r.find(scenario, LowLevelMode::kKinovaTorqueHighVelocity);

@@ -69,6 +69,9 @@ struct TorqueTrackingOptions {
   std::string end_effector_frame = "end_effector_link";  ///< the URDF's frame the end of arm mounts on
   std::string actuators_path = "robots/kinova_gen3/actuators.yaml";
   std::string collision_path = "robots/kinova_gen3/collision.yaml";
+  /// Body regions of the power-and-force-limiting figures (experiment_contact.hpp); empty: the
+  /// iso_ts_15066_regions.yaml beside plant_config_path.
+  std::string regions_file;
   /// CSV and markdown go here (created when missing); empty: no files.
   std::string output_dir = "results/torque_tracking";
   /// Figure script run by the command; empty: no figure.
@@ -145,6 +148,7 @@ struct TorqueTrackingRun {
   int samples = 0;
   long qp_fallbacks = 0;      ///< cycles where the QP failed (should be 0)
   std::string csv_path;       ///< time series, when written
+  std::vector<ContactLinkSummary> contact;  ///< per link, after the switch (experiment_contact.hpp)
 };
 
 struct TorqueTrackingResult {
