@@ -83,6 +83,20 @@ TEST(Iso9283, TwoCyclesOnThePlantRunInTheLoopsTheyNameAndThePositionLoopReachesT
   for (const phri::Iso9283Pose& p : r.loops[0].poses) worst_ap = std::max(worst_ap, p.ap_mm);
   std::printf("ISO 9283, 2 cycles: position loop worst AP %.3f mm\n", worst_ap);
   EXPECT_LT(worst_ap, 0.5);
+  // Every link's power-and-force-limiting figures on the plant's truth, each its speed over its v_max.
+  for (const phri::Iso9283Loop& l : r.loops) {
+    ASSERT_EQ(l.contact.size(), 8u);  // the Gen3's links with a capsule, but the base's
+    double fastest = 0.0;
+    for (const phri::ContactLinkSummary& c : l.contact) {
+      if (c.max_ratio > 0.0) {
+        EXPECT_NEAR(c.max_ratio, c.speed_at_max_m_s / c.permissible_speed_at_max_m_s, 1e-12);
+      }
+      fastest = std::max(fastest, c.max_speed_m_s);
+    }
+    EXPECT_GT(fastest, 0.2) << "moves at 250 mm/s peak";
+    EXPECT_LT(fastest, 0.4);
+  }
+  EXPECT_NE(phri::iso9283_table(r).find("| position | spherical_wrist"), std::string::npos) << phri::iso9283_table(r);
   // The commanded poses span the cube: a run that did not move would fail the accuracy above.
   EXPECT_NEAR((r.commanded[1] - r.commanded[3]).norm(), 0.8 * 0.2 * std::sqrt(3.0), 1e-9);
 }
