@@ -37,6 +37,53 @@ TEST(PowerForceLimit, PermissibleSpeedOfTheWorkedExample) {
   EXPECT_NEAR(0.5 * phri::reduced_mass(5.0, 0.6) * v * v, 280.0 * 280.0 / (2.0 * 75000.0), 1e-9);
 }
 
+// A planar two-link arm with point masses m1, m2 at the ends of links l1, l2 (joints about z):
+//   M = [m1 l1^2 + m2 (l1^2 + l2^2 + 2 l1 l2 c2),  m2 (l2^2 + l1 l2 c2);  m2 (l2^2 + l1 l2 c2),  m2 l2^2]
+//   J (tip, x y) = [-l1 s1 - l2 s12, -l2 s12;  l1 c1 + l2 c12, l2 c12]
+// and the reflected mass at the tip along u (in the plane) is 1 / (u^T J M^-1 J^T u); with the
+// rotor inertia I_r on both joints, M + I_r.
+TEST(PowerForceLimit, ReflectedMassOfATwoLinkArmIsItsClosedForm) {
+  const double l1 = 0.4, l2 = 0.3, m1 = 2.0, m2 = 1.5, rotor = 0.05;
+  auto link = [](const std::string& name, double mass, double x) {
+    return "<link name=\"" + name + "\"><inertial><origin xyz=\"" + std::to_string(x) +
+           " 0 0\"/><mass value=\"" + std::to_string(mass) +
+           "\"/><inertia ixx=\"1e-12\" iyy=\"1e-12\" izz=\"1e-12\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/></inertial></link>";
+  };
+  const std::string urdf =
+      "<robot name=\"two_link\"><link name=\"base\"/>" + link("upper", m1, l1) + link("fore", m2, l2) +
+      "<joint name=\"j1\" type=\"continuous\"><parent link=\"base\"/><child link=\"upper\"/><axis xyz=\"0 0 1\"/></joint>"
+      "<joint name=\"j2\" type=\"continuous\"><parent link=\"upper\"/><child link=\"fore\"/><origin xyz=\"" +
+      std::to_string(l1) + " 0 0\"/><axis xyz=\"0 0 1\"/></joint></robot>";
+  const phri::Model model = phri::Model::from_urdf_string(urdf);
+  ASSERT_EQ(model.nq(), 2);
+  phri::Data data(model);
+  for (const auto& [q1, q2] : {std::pair{0.3, 0.9}, std::pair{-1.1, 2.2}, std::pair{0.7, -0.4}}) {
+    Eigen::VectorXd q(2);
+    q << q1, q2;
+    phri::compute_all_terms(model, data, q, Eigen::VectorXd::Zero(2));
+    const double c2 = std::cos(q2), s1 = std::sin(q1), c1 = std::cos(q1), s12 = std::sin(q1 + q2), c12 = std::cos(q1 + q2);
+    Eigen::Matrix2d m;
+    m << m1 * l1 * l1 + m2 * (l1 * l1 + l2 * l2 + 2 * l1 * l2 * c2) + rotor, m2 * (l2 * l2 + l1 * l2 * c2),
+        m2 * (l2 * l2 + l1 * l2 * c2), m2 * l2 * l2 + rotor;
+    Eigen::Matrix2d j;
+    j << -l1 * s1 - l2 * s12, -l2 * s12, l1 * c1 + l2 * c12, l2 * c12;
+    Eigen::MatrixXd jv(3, 2);
+    const Eigen::Vector3d tip = data.body_placements[1] * Eigen::Vector3d(l2, 0.0, 0.0);
+    phri::body_point_linear_jacobian(model, data, 1, tip, jv);
+    EXPECT_LT((jv.topRows<2>() - j).norm(), 1e-12);
+    Eigen::MatrixXd inertia = data.mass_matrix;
+    inertia.diagonal().array() += rotor;
+    EXPECT_LT((inertia - m).norm(), 1e-9);
+    const Eigen::LLT<Eigen::MatrixXd> llt(inertia);
+    Eigen::VectorXd scratch(2), solved(2);
+    for (const double angle : {0.0, 0.8, 2.0}) {
+      const Eigen::Vector2d u2(std::cos(angle), std::sin(angle));
+      const double closed = 1.0 / u2.dot(j * m.inverse() * j.transpose() * u2);
+      EXPECT_NEAR(phri::reflected_mass(jv, llt, Eigen::Vector3d(u2.x(), u2.y(), 0.0), scratch, solved), closed, 1e-9 * closed);
+    }
+  }
+}
+
 TEST(PowerForceLimit, ReflectedMassIsTheLeastKineticEnergyOfAUnitSpeedAlongU) {
   const phri::Model model = phri::Model::from_urdf_file(kRoot + "/robots/kinova_gen3/gen3.urdf");
   phri::Data data(model);
