@@ -180,40 +180,58 @@ double drive_far(bool limited, phri::LowLevelMode loop = phri::LowLevelMode::kCu
   return worst;
 }
 
+// The Gen3's QP with the constraint for `region`, started holding the demo's home posture (the
+// QP alone: its acceleration is realised by the test, qd += qdd dt, q += qd dt).
+struct QpRig {
+  explicit QpRig(const phri::BodyRegion& region)
+      : model(phri::Model::from_urdf_file(kRoot + "/robots/kinova_gen3/gen3.urdf")),
+        capsules(phri::CollisionModel::from_yaml_file(kRoot + "/robots/kinova_gen3/collision.yaml", model)),
+        data(model), qp(model, &capsules, settings(region)), q(7), qd(Eigen::VectorXd::Zero(7)),
+        tau_ext(Eigen::VectorXd::Zero(7)) {
+    q << 0, 0.58, 3.14, -1.84, 0, 0.85, 1.57;
+    phri::compute_all_terms(model, data, q, qd);
+    qp.end_effector().reset_gains(phri::Vector6d::Constant(400), phri::Vector6d::Constant(40), 1e4, phri::Vector6d::Zero());
+    qp.posture().reset_gains(20, 9, 1, 0);
+    qp.posture().set_target(q);
+    qp.end_effector().hold_current_pose(data);
+  }
+  static phri::WholeBodyQpSettings settings(const phri::BodyRegion& region) {
+    phri::WholeBodyQpSettings s;
+    s.end_effector_frame = "end_effector_link";
+    phri::PowerForceLimitSettings limit;
+    limit.regions.region = region;
+    s.power_force_limit = limit;
+    return s;
+  }
+  // One cycle: the QP on the state, its acceleration realised; false when the QP failed.
+  bool step() {
+    phri::compute_all_terms(model, data, q, qd);
+    if (qp.update(model, data, q, qd, tau_ext, 0.001) != phri::WholeBodyQpStatus::kOk) return false;
+    qd += 0.001 * qp.desired_acceleration();
+    q += 0.001 * qd;
+    return true;
+  }
+  phri::Model model;
+  phri::CollisionModel capsules;
+  phri::Data data;
+  phri::WholeBodyQp qp;
+  Eigen::VectorXd q, qd, tau_ext;
+};
+
 // The QP alone, its acceleration realised exactly (qd += qdd dt, q += qd dt): every point within its
 // permissible speed (the constraint's first-order bound, paper eq. sec-order-vel-damp's form).
 TEST(PowerForceLimit, TheQpHoldsEachPointWithinItsPermissibleSpeedWhenItsAccelerationIsRealised) {
-  const std::string gen3 = kRoot + "/robots/kinova_gen3/";
-  const phri::Model model = phri::Model::from_urdf_file(gen3 + "gen3.urdf");
-  const phri::CollisionModel capsules = phri::CollisionModel::from_yaml_file(gen3 + "collision.yaml", model);
-  phri::Data data(model);
-  phri::WholeBodyQpSettings settings;
-  settings.end_effector_frame = "end_effector_link";
-  phri::PowerForceLimitSettings limit;
-  limit.regions.region = slow_region();
-  settings.power_force_limit = limit;
-  phri::WholeBodyQp qp(model, &capsules, settings);
-  Eigen::VectorXd q(7), qd = Eigen::VectorXd::Zero(7);
-  const Eigen::VectorXd tau_ext = Eigen::VectorXd::Zero(7);
-  q << 0, 0.58, 3.14, -1.84, 0, 0.85, 1.57;
-  phri::compute_all_terms(model, data, q, qd);
-  qp.end_effector().reset_gains(phri::Vector6d::Constant(400), phri::Vector6d::Constant(40), 1e4, phri::Vector6d::Zero());
-  qp.posture().reset_gains(20, 9, 1, 0);
-  qp.posture().set_target(q);
-  qp.end_effector().hold_current_pose(data);
-  Eigen::Isometry3d far = qp.end_effector().target_pose();
+  QpRig rig(slow_region());
+  const Eigen::Vector3d start = rig.qp.end_effector().target_pose().translation();
+  Eigen::Isometry3d far = rig.qp.end_effector().target_pose();
   far.translation() += Eigen::Vector3d(0.0, -0.3, -0.1);
-  qp.end_effector().set_target(far);
-  double worst = 0.0, moved = 0.0;
-  const Eigen::Vector3d start = far.translation() - Eigen::Vector3d(0.0, -0.3, -0.1);
+  rig.qp.end_effector().set_target(far);
+  double worst = 0.0;
   for (int k = 0; k < 2500; ++k) {
-    phri::compute_all_terms(model, data, q, qd);
-    ASSERT_EQ(qp.update(model, data, q, qd, tau_ext, 0.001), phri::WholeBodyQpStatus::kOk);
-    worst = std::max(worst, qp.power_force_limit()->worst_ratio());
-    qd += 0.001 * qp.desired_acceleration();
-    q += 0.001 * qd;
+    ASSERT_TRUE(rig.step());
+    worst = std::max(worst, rig.qp.power_force_limit()->worst_ratio());
   }
-  moved = (qp.end_effector().pose().translation() - start).norm();
+  const double moved = (rig.qp.end_effector().pose().translation() - start).norm();
   std::printf("power and force limit, QP alone: worst v / v_max %.4f, the end effector moved %.0f mm in 2.5 s\n", worst,
               1e3 * moved);
   EXPECT_LT(worst, 1.01);
@@ -224,40 +242,20 @@ TEST(PowerForceLimit, TheQpHoldsEachPointWithinItsPermissibleSpeedWhenItsAcceler
 // whose v_max (~0.2 m/s at the tool, ~0.03-0.2 m/s along the arm) binds, the QP's acceleration
 // realised exactly: while the constraint acts, every point stays within 1 % of its v_max.
 TEST(PowerForceLimit, TheQpHoldsEveryPointWithinItsPermissibleSpeedThroughTheDynamicScenario) {
-  const std::string gen3 = kRoot + "/robots/kinova_gen3/";
-  const phri::Model model = phri::Model::from_urdf_file(gen3 + "gen3.urdf");
-  const phri::CollisionModel capsules = phri::CollisionModel::from_yaml_file(gen3 + "collision.yaml", model);
-  phri::Data data(model);
-  phri::WholeBodyQpSettings settings;
-  settings.end_effector_frame = "end_effector_link";
-  phri::PowerForceLimitSettings limit;
-  limit.regions.region = {"face", 75000.0, 4.4, 65.0, 1.0};  // configs/iso_ts_15066_regions.yaml's face
-  settings.power_force_limit = limit;
-  phri::WholeBodyQp qp(model, &capsules, settings);
-  Eigen::VectorXd q(7), qd = Eigen::VectorXd::Zero(7);
-  const Eigen::VectorXd tau_ext = Eigen::VectorXd::Zero(7);
-  q << 0, 0.58, 3.14, -1.84, 0, 0.85, 1.57;
-  phri::compute_all_terms(model, data, q, qd);
-  qp.end_effector().reset_gains(phri::Vector6d::Constant(400), phri::Vector6d::Constant(40), 1e4, phri::Vector6d::Zero());
-  qp.posture().reset_gains(20, 9, 1, 0);
-  qp.posture().set_target(q);
-  qp.end_effector().hold_current_pose(data);
+  QpRig rig({"face", 75000.0, 4.4, 65.0, 1.0});  // configs/iso_ts_15066_regions.yaml's face
   phri::DynamicTrajectory scenario;
-  scenario.start(qp.end_effector().target_pose());
+  scenario.start(rig.qp.end_effector().target_pose());
   phri::PoseReference reference;
   double worst = 0.0, fastest_reference = 0.0;
   int binding = 0;
   for (int k = 0; k < 8000; ++k) {
     scenario.evaluate(0.001 * k, reference);
     fastest_reference = std::max(fastest_reference, reference.velocity.head<3>().norm());
-    qp.end_effector().set_target(reference.pose, reference.velocity, reference.acceleration);
-    phri::compute_all_terms(model, data, q, qd);
-    ASSERT_EQ(qp.update(model, data, q, qd, tau_ext, 0.001), phri::WholeBodyQpStatus::kOk);
-    const double ratio = qp.power_force_limit()->worst_ratio();
+    rig.qp.end_effector().set_target(reference.pose, reference.velocity, reference.acceleration);
+    ASSERT_TRUE(rig.step());
+    const double ratio = rig.qp.power_force_limit()->worst_ratio();
     worst = std::max(worst, ratio);
     if (ratio > 0.99) ++binding;
-    qd += 0.001 * qp.desired_acceleration();
-    q += 0.001 * qd;
   }
   std::printf("power and force limit, dynamic scenario (reference up to %.2f m/s), QP alone: worst v / v_max %.4f, "
               "%d of 8000 cycles at > 0.99\n", fastest_reference, worst, binding);
