@@ -546,11 +546,13 @@ void check_pose_topics(const Peer& peer, const Log& log) {
                                   [&](const gm::PoseStamped_& m, std::size_t r) { return pose_equal(m, log, r, "ee"); });
   check_matches<gm::PoseStamped_>("/phri/ee_target", log, peer.ee_target.messages, 50,
                                   [&](const gm::PoseStamped_& m, std::size_t r) { return pose_equal(m, log, r, "target"); });
-  check_matches<gm::WrenchStamped_>("/phri/wrench", log, peer.wrench.messages, 50, [&](const gm::WrenchStamped_& m, std::size_t r) {
+  // The sensor's sample in its own frame, as a ROS F/T driver publishes it (the log's ft_ columns).
+  check_matches<gm::WrenchStamped_>("/phri/wrench (ft_sensor frame)", log, peer.wrench.messages, 50,
+                                    [&](const gm::WrenchStamped_& m, std::size_t r) {
     const auto& f = m.wrench().force();
     const auto& t = m.wrench().torque();
-    return f.x() == log.at(r, "wrench_fx") && f.y() == log.at(r, "wrench_fy") && f.z() == log.at(r, "wrench_fz") &&
-           t.x() == log.at(r, "wrench_mx") && t.y() == log.at(r, "wrench_my") && t.z() == log.at(r, "wrench_mz");
+    return m.header().frame_id() == "ft_sensor" && f.x() == log.at(r, "ft_fx") && f.y() == log.at(r, "ft_fy") &&
+           f.z() == log.at(r, "ft_fz") && t.x() == log.at(r, "ft_mx") && t.y() == log.at(r, "ft_my") && t.z() == log.at(r, "ft_mz");
   });
 }
 
@@ -583,13 +585,16 @@ Eigen::Isometry3d transform_of(const gm::TransformStamped_& t) {
   return x;
 }
 
-// /tf_static (world -> base, last link -> end effector) and each /tf (base -> ... -> last link),
+// /tf_static (world -> base, last link -> end effector, and -> ft_sensor) and each /tf (base -> ... -> last link),
 // composed by the peer, against /phri/ee_pose of the same snapshot (stamps within 1 ms).
 void check_tf(const Peer& peer) {
   const auto& statics = peer.tf_static.messages;
-  check(!statics.empty() && statics.back().transforms().size() == 2 && statics.back().transforms()[0].header().frame_id() == "world",
-        fmt("/tf_static (transient local): %.0f message(s), world -> base and the end-effector frame", statics.size()));
-  if (statics.empty() || statics.back().transforms().size() != 2) return;
+  check(!statics.empty() && statics.back().transforms().size() == 3 && statics.back().transforms()[0].header().frame_id() == "world" &&
+            statics.back().transforms()[2].child_frame_id() == "ft_sensor" &&
+            statics.back().transforms()[2].header().frame_id() == statics.back().transforms()[1].header().frame_id(),
+        fmt("/tf_static (transient local): %.0f message(s), world -> base, the end-effector frame and the F/T sensor's frame "
+            "on the same link", statics.size()));
+  if (statics.empty() || statics.back().transforms().size() != 3) return;
   const auto& st = statics.back().transforms();
   int compared = 0;
   double worst = 0.0;

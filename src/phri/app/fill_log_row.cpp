@@ -48,6 +48,7 @@ void fill_log_row(LogRow& row, const RobotState& state, const Controller& cycle)
   const Vector6d& wrench = cycle.wrench().wrench_world();
   for (int i = 0; i < 6; ++i) row.wrench[static_cast<std::size_t>(i)] = wrench[i];
   row.wrench_norm = cycle.wrench().norm();
+  for (int i = 0; i < 6; ++i) row.ft_wrench[static_cast<std::size_t>(i)] = state.wrench_sensor[i];
   row.compliance_mode = static_cast<std::int32_t>(cycle.compliance().mode());
   row.touched = cycle.compliance().touched() ? 1 : 0;
   row.low_level_loop = static_cast<std::int32_t>(cycle.low_level().loop());

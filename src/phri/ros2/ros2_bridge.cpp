@@ -134,6 +134,8 @@ struct Ros2Bridge::Impl {
   std::vector<std::string> link_names;  // body i's link; parent of body 0: the base link
   std::vector<TransformMsg> tf_buffer;
   std::string world_frame = "world", empty;
+  int sensor_frame = -1;  // the model's "ft_sensor" frame (-1: no F/T sensor)
+  std::string sensor_frame_name = "ft_sensor";
   Eigen::VectorXd q;
   LiveSnapshot snapshot;
   std::array<std::int64_t, kRos2TopicCount> last_cycle{};
@@ -234,6 +236,7 @@ void Ros2Bridge::Impl::prepare_tf() {
   for (int b = 0; b < model.num_bodies(); ++b) {
     if (link_names[static_cast<std::size_t>(b)].empty()) link_names[static_cast<std::size_t>(b)] = "body_" + std::to_string(b + 1);
   }
+  if (model.has_frame(sensor_frame_name)) sensor_frame = model.frame_id(sensor_frame_name);
   tf_buffer.resize(static_cast<std::size_t>(model.num_bodies()));
   for (std::size_t b = 0; b < tf_buffer.size(); ++b) {
     const std::string& parent = b == 0 ? model.base_link() : link_names[b - 1];
@@ -282,11 +285,14 @@ void Ros2Bridge::Impl::publish_poses(const LiveSnapshot& s) {
   write(Ros2Topic::kEeTarget, &m);
 }
 
+// The F/T sensor's sample in its own frame (the model's "ft_sensor", on /tf_static), as a ROS F/T
+// driver publishes it; nothing without a sensor.
 void Ros2Bridge::Impl::publish_wrench(const LiveSnapshot& s) {
+  if (sensor_frame < 0) return;
   WrenchStampedMsg m{};
   m.header.stamp = wall_stamp();
-  m.header.frame_id = world_frame.data();
-  const auto& w = s.row.wrench;
+  m.header.frame_id = sensor_frame_name.data();
+  const auto& w = s.row.ft_wrench;
   m.wrench.force = {w[0], w[1], w[2]};
   m.wrench.torque = {w[3], w[4], w[5]};
   write(Ros2Topic::kWrench, &m);
@@ -329,6 +335,16 @@ void Ros2Bridge::Impl::publish_tf_static() {
     t[1].header.frame_id = ee_parent.data();
     t[1].child_frame_id = ee_name.data();
     set_transform(t[1].transform, ee.placement);
+  }
+  std::string sensor_parent;
+  if (sensor_frame >= 0) {
+    const Frame& sensor = model.frame(sensor_frame);
+    sensor_parent = sensor.body >= 0 ? link_names[static_cast<std::size_t>(sensor.body)] : base;
+    t.emplace_back();
+    t.back().header.stamp = t[0].header.stamp;
+    t.back().header.frame_id = sensor_parent.data();
+    t.back().child_frame_id = sensor_frame_name.data();
+    set_transform(t.back().transform, sensor.placement);
   }
   TfMsg m{};
   const auto count = static_cast<std::uint32_t>(t.size());
