@@ -12,6 +12,18 @@ const PLOT_PERIOD_MS = 12;    // plots redrawn with every frame, up to ~80 Hz (f
 const PUSH_N_PER_M = 300;     // push force per metre of drag from where the link was grabbed
 const PUSH_RENEW_MS = 150;    // a held push is re-sent (the server ends a push 0.5 s after its last)
 
+// A held push is renewed from a worker: its timer and its requests do not wait for the page's main
+// thread, which a slow client (software WebGL, a loaded CPU) keeps busy for hundreds of ms at a time.
+// The page hands it the latest request on every change and tells it when the push starts and ends.
+const pushRenewer = new Worker(URL.createObjectURL(new Blob([`
+  let timer = null, request = null;
+  const send = () => request && fetch(request.url, request.init).catch(() => {});
+  onmessage = ({ data }) => {
+    if (data.request) request = data.request;
+    if (data.start && timer === null) timer = setInterval(send, data.period);
+    if (data.stop) { clearInterval(timer); timer = null; request = null; }
+  };`], { type: 'text/javascript' })));
+
 const $ = (id) => document.getElementById(id);
 // Hooks for the browser test and for curious users (window.phri in the console).
 const phri = (window.phri = { frames: 0, plotUpdates: 0, last: null, model: null, pushes: 0, replies: [] });
@@ -228,7 +240,7 @@ phri.screenOfCapsule = (index) => {
 phri.capsuleIndex = (link) => view.capsules.findIndex((m) => m.userData.link === link);
 
 // ------------------------------------------------------------------ drag-to-push
-const drag = { active: false, body: -1, local: null, plane: new THREE.Plane(), hand: new THREE.Vector3(), timer: null, sent: 0 };
+const drag = { active: false, body: -1, local: null, plane: new THREE.Plane(), hand: new THREE.Vector3(), sent: 0 };
 const raycaster = new THREE.Raycaster();
 
 function pointerRay(event) {
@@ -254,7 +266,10 @@ function sendPush() {
   phri.pushes++;
   $('push-readout').textContent = `pushing ${view.capsules.find((m) => m.userData.body === drag.body)?.userData.link}: ` +
                                   `${force.length().toFixed(1)} N`;
-  post('push', { body: drag.body, point: drag.local.toArray(), force: force.toArray() });
+  const body = { body: drag.body, point: drag.local.toArray(), force: force.toArray() };
+  pushRenewer.postMessage({ request: { url: new URL('/api/push', location.href).href, init: {
+    method: 'POST', headers: { 'Content-Type': 'application/json', 'X-Phri-Token': token }, body: JSON.stringify(body) } } });
+  post('push', body);
 }
 
 renderer.domElement.addEventListener('pointerdown', (event) => {
@@ -270,7 +285,7 @@ renderer.domElement.addEventListener('pointerdown', (event) => {
   drag.plane.setFromNormalAndCoplanarPoint(camera.getWorldDirection(new THREE.Vector3()), hit.point);
   $('push-readout').classList.add('active');
   sendPush();
-  drag.timer = setInterval(sendPush, PUSH_RENEW_MS);
+  pushRenewer.postMessage({ start: true, period: PUSH_RENEW_MS });
 });
 
 renderer.domElement.addEventListener('pointermove', (event) => {
@@ -283,7 +298,7 @@ renderer.domElement.addEventListener('pointermove', (event) => {
 function release() {
   if (!drag.active) return;
   drag.active = false;
-  clearInterval(drag.timer);
+  pushRenewer.postMessage({ stop: true });
   controls.enabled = true;
   $('push-readout').classList.remove('active');
   $('push-readout').textContent = `drag a link to push it (max ${phri.model.push_max_N} N)`;

@@ -7,7 +7,9 @@
 //   3. dragging the end-effector link pushes the arm: the streamed end effector moves, the push
 //      shown never exceeds the cap;
 //   4. moving the stiffness slider applies the new gain (streamed and logged stiffness_scale);
-//   5. the power-and-force-limiting bars show one number per monitored link.
+//   5. the power-and-force-limiting bars show one number per monitored link;
+//   6. a push held still for 5 s while the page is slowed 4x (CPU throttling: long tasks of hundreds
+//      of ms) stays on the arm without a gap in the log (live_push_N); long tasks and plot rate printed.
 // Screenshots go to --out (dashboard_*.png). Exit 77 (ctest: skipped) when chromium is absent.
 //
 //   node web/test/dashboard_browser.test.mjs --phri build/release/phri --config configs/dashboard.yaml --out DIR
@@ -159,6 +161,45 @@ try {
         bars.rows.every((text, i) => text === bars.streamed[i].toFixed(2)),
         `a power-and-force-limiting bar per link (${bars.rows.length} of ${bars.links}: ${bars.rows.join(' ')})`);
   await waitFor(page, () => window.phri.last.push === null, 'letting go ends the push', 3000);
+
+  // 6. A push held for 5 s on a page slowed 4x (CPU throttling): the log shows it without a gap
+  //    (renewed from a worker, whatever the page's main thread is doing); long tasks and plot rate printed.
+  await page.evaluate(() => {
+    window.phri.longTasks = [];
+    new PerformanceObserver((list) => window.phri.longTasks.push(...list.getEntries().map((e) => e.duration)))
+      .observe({ type: 'longtask' });
+  });
+  const cdp = await page.target().createCDPSession();
+  const grab = await page.evaluate((i) => window.phri.screenOfCapsule(i), ee);  // where the link is now
+  const plotsBefore = await page.evaluate(() => window.phri.plotUpdates);
+  const heldFrom = Date.now();
+  await page.mouse.move(grab.x, grab.y);
+  await page.mouse.down();
+  for (let k = 1; k <= 5; ++k) { await page.mouse.move(grab.x + 6 * k, grab.y + 2 * k); await sleep(30); }
+  await waitFor(page, () => window.phri.last.push !== null && window.phri.last.push.magnitude > 5, 'the held push starts', 3000);
+  await cdp.send('Emulation.setCPUThrottlingRate', { rate: 4 });  // then the page slows down, the hand still
+  const fromT = await page.evaluate(() => window.phri.last.t);
+  await sleep(5000);
+  const toT = await page.evaluate(() => window.phri.last.t);
+  await page.mouse.up();
+  const heldS = (Date.now() - heldFrom) / 1000;
+  const plotsAfter = await page.evaluate(() => window.phri.plotUpdates);
+  await cdp.send('Emulation.setCPUThrottlingRate', { rate: 1 });
+  await sleep(1500);  // the push ends; the log writer flushes
+  const held = await downloadLog(page);
+  const times = held.column('time_s'), pushN = held.column('live_push_N');
+  let rows = 0, gap = 0, run = 0;  // within the stream's times seen while the mouse was down
+  for (let i = 0; i < times.length; ++i) {
+    if (times[i] < fromT || times[i] > toT) continue;
+    ++rows;
+    if (pushN[i] > 0) { gap = Math.max(gap, run); run = 0; } else { ++run; }
+  }
+  gap = Math.max(gap, run);
+  const tasks = await page.evaluate(() => window.phri.longTasks);
+  console.log(`held push on a 4x-throttled page: ${heldS.toFixed(1)} s held, ${tasks.length} long tasks ` +
+              `(${tasks.reduce((a, b) => a + b, 0).toFixed(0)} ms), plots redrawn at ${((plotsAfter - plotsBefore) / heldS).toFixed(1)} Hz`);
+  check(rows >= 3000 && gap <= 50,
+        `the held push is in the log over ${(rows / 1000).toFixed(2)} s of robot time, longest gap ${gap} ms (<= 50)`);
 
   // 4. The stiffness slider: drag its thumb to about 60 % of the range.
   const slider = await page.$('#gain-stiffness_scale');

@@ -156,6 +156,8 @@ private:
     if (logger_ || !observers_.empty()) {
       fill_log_row(row_, state, cycle_, fsm_);
       row_.cycle_time_s = 1e-6 * us;
+      // The live push acts from the read after its request until its hold runs out unrenewed.
+      row_.live_push_N = push_.body >= 0 && row_.time_s > push_start_s_ && row_.time_s <= push_end_s_ ? push_.force_world.norm() : 0.0;
       fill_contact_columns();
     }
     if (logger_) logger_->push(row_);
