@@ -9,7 +9,7 @@
 //   4. moving the stiffness slider applies the new gain (streamed and logged stiffness_scale);
 //   5. the power-and-force-limiting bars show one number per monitored link;
 //   6. a push held still for 5 s while the page is slowed 4x (CPU throttling: long tasks of hundreds
-//      of ms) stays on the arm without a gap in the log (live_push_N); long tasks and plot rate printed.
+//      of ms) stays on the arm without a gap in the log (live_push_n); long tasks and plot rate printed.
 // Screenshots go to --out (dashboard_*.png). Exit 77 (ctest: skipped) when chromium is absent.
 //
 //   node web/test/dashboard_browser.test.mjs --phri build/release/phri --config configs/dashboard.yaml --out DIR
@@ -187,7 +187,7 @@ try {
   await cdp.send('Emulation.setCPUThrottlingRate', { rate: 1 });
   await sleep(1500);  // the push ends; the log writer flushes
   const held = await downloadLog(page);
-  const times = held.column('time_s'), pushN = held.column('live_push_N');
+  const times = held.column('time_s'), pushN = held.column('live_push_n');
   let rows = 0, gap = 0, run = 0;  // within the stream's times seen while the mouse was down
   for (let i = 0; i < times.length; ++i) {
     if (times[i] < fromT || times[i] > toT) continue;

@@ -21,7 +21,7 @@
 //                                         operator wrench at the EE, world axes [N, N.m] (F/T)
 //   ft_fx ft_fy ft_fz ft_mx ft_my ft_mz   the F/T sensor's latest sample as it reads it: its own frame
 //                                         (the model's "ft_sensor"), bias and tool load included [N, N.m]
-//   live_push_N                           the live front end's push on the arm this cycle (0: none) [N]
+//   live_push_n                           the live front end's push on the arm this cycle (0: none) [N]
 //   compliance_mode, touched, low_level_loop, fsm_state, event,
 //   cycle_status, safety_state, safety_fault, ft_status, controller_status, qp_status, qp_iterations
 //                                         integer codes; the legend is the sidecar
@@ -110,7 +110,7 @@ void visit_log_columns(const LogRow& r, int dof, Visitor&& v) {
   visit_numbers<Visitor, 6>(v, {"wrench_fx", "wrench_fy", "wrench_fz", "wrench_mx", "wrench_my", "wrench_mz"}, r.wrench);
   v.number("wrench_norm", r.wrench_norm);
   visit_numbers<Visitor, 6>(v, {"ft_fx", "ft_fy", "ft_fz", "ft_mx", "ft_my", "ft_mz"}, r.ft_wrench);
-  v.number("live_push_N", r.live_push_N);
+  v.number("live_push_n", r.live_push_N);
   v.integer("compliance_mode", r.compliance_mode);
   v.integer("touched", r.touched);
   v.integer("low_level_loop", r.low_level_loop);
