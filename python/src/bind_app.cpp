@@ -101,8 +101,11 @@ void bind_config(py::module_& m) {
       .def("for_link", &BodyRegionMap::for_link, py::arg("link"), py::return_value_policy::copy,
            "The region the named link may meet (its own, else `region`).");
   py::class_<Config>(m, "Config", "ONE YAML per run (configs/demo.yaml documents every key), as the settings of each piece.")
-      .def_static("from_yaml_file", [](const std::string& path, const std::string& robot) { return Config::from_yaml_file(path, robot); },
-                  py::arg("path"), py::arg("robot") = std::string(),
+      .def_static("from_yaml_file",
+                  [](const std::filesystem::path& path, const std::optional<std::filesystem::path>& robot) {
+                    return Config::from_yaml_file(path.string(), robot ? robot->string() : std::string());
+                  },
+                  py::arg("path"), py::arg("robot") = py::none(),
                   "ConfigError naming the file and the key path; robot: a robot bundle's folder in place of the file's robot.")
       .def_static("from_yaml_string", &Config::from_yaml_string, py::arg("yaml"), py::arg("source_name"), py::arg("base_dir"))
       .def_readwrite("source", &Config::source)

@@ -16,6 +16,7 @@ struct ErrorClasses {
   PyObject* io = nullptr;
   PyObject* experiment = nullptr;
   PyObject* argument = nullptr;
+  PyObject* missing_file = nullptr;
 };
 ErrorClasses errors;
 
@@ -38,7 +39,11 @@ void translate(std::exception_ptr p) {
   try {
     if (p) std::rethrow_exception(p);
   } catch (const ConfigError& e) {
-    raise(errors.config, e.what(), {{"file", e.file()}, {"element", e.element()}, {"reason", e.reason()}});
+    // A file that is not there is also Python's FileNotFoundError (an OSError); str(e) stays the
+    // C++ message (OSError's filename is left unset: it would replace the message in str(e)).
+    const bool missing = !e.file().empty() && e.file().front() != '<' && !std::filesystem::exists(e.file());
+    raise(missing ? errors.missing_file : errors.config, e.what(),
+          {{"file", e.file()}, {"element", e.element()}, {"reason", e.reason()}});
   } catch (const IoError& e) {
     raise(errors.io, e.what(), {{"path", e.path()}});
   } catch (const ExperimentError& e) {
@@ -61,6 +66,8 @@ void bind_errors(py::module_& m) {
                                       "An experiment ran but could not produce its result; attribute subject.");
   errors.argument = new_error_class(m, "ArgumentError", py::make_tuple(base, py::handle(PyExc_ValueError)),
                                     "A vector or matrix of the wrong size or a bad value was handed to phri.");
+  errors.missing_file = new_error_class(m, "MissingFileError", py::make_tuple(py::handle(errors.config), py::handle(PyExc_FileNotFoundError)),
+                                        "A file phri was given is not there: a ConfigError and a FileNotFoundError; attribute file.");
   py::register_exception_translator(&translate);
 }
 

@@ -94,7 +94,8 @@ void bind_log(py::module_& m) {
       }, py::arg("dof") = kLogMaxJoints, "(name, 'float64' | 'int64') of every column of a phri log, in CSV order.");
   m.def("log_dtype", [](int dof) { return table_dtype(log_columns(dof)); }, py::arg("dof") = kLogMaxJoints,
         "The numpy dtype of a phri log with `dof` joints (load_log and ClosedLoop.record).");
-  m.def("load_log", [](const std::string& path) {
+  m.def("load_log", [](const std::filesystem::path& file) {
+        const std::string path = file.string();
         CsvTable table;
         {
           const py::gil_scoped_release release;

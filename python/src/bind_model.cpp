@@ -88,7 +88,9 @@ void bind_model_options(py::module_& m) {
 
 void bind_model_class(py::module_& m) {
   py::class_<Model>(m, "Model", "A serial arm loaded from a URDF; immutable (algorithms write into a Data).")
-      .def_static("from_urdf_file", &Model::from_urdf_file, py::arg("path"), py::arg("options") = ModelOptions{},
+      .def_static("from_urdf_file",
+                  [](const std::filesystem::path& path, const ModelOptions& options) { return Model::from_urdf_file(path.string(), options); },
+                  py::arg("path"), py::arg("options") = ModelOptions{},
                   "Loads a URDF file; ConfigError naming the file and the element on bad input.")
       .def_static("from_urdf_string", &Model::from_urdf_string, py::arg("urdf"), py::arg("options") = ModelOptions{},
                   py::arg("source_name") = "<urdf string>", "Loads a URDF from text; source_name stands for it in errors.")

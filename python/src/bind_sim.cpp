@@ -31,7 +31,8 @@ void bind_actuators(py::module_& m) {
       .def_readwrite("friction", &ActuatorParameters::friction)
       .def("torque_per_amp", &ActuatorParameters::torque_per_amp, "K_T G_r [N m/A].");
   py::class_<ActuatorTable>(m, "ActuatorTable", "The drives of every joint, in order (actuators.yaml).")
-      .def_static("from_yaml_file", &ActuatorTable::from_yaml_file, py::arg("path"))
+      .def_static("from_yaml_file", [](const std::filesystem::path& path) { return ActuatorTable::from_yaml_file(path.string()); },
+                  py::arg("path"))
       .def_property_readonly("joints", &ActuatorTable::joints, "The drives (copies).")
       .def("index_of", &ActuatorTable::index_of, py::arg("joint_name"), "-1 when absent.")
       .def("__len__", &ActuatorTable::size);
@@ -140,7 +141,8 @@ void bind_config(py::module_& m) {
                   "(config.drop_test.enabled = True); list fields are copies: assign a whole new list.");
   bind_config_parts(c);
   c.def(py::init<>())
-      .def_static("from_yaml_file", &C::from_yaml_file, py::arg("path"), "Loads and validates; ConfigError with the key path.")
+      .def_static("from_yaml_file", [](const std::filesystem::path& path) { return C::from_yaml_file(path.string()); },
+                  py::arg("path"), "Loads and validates; ConfigError with the key path.")
       .def_static("from_yaml_string", &C::from_yaml_string, py::arg("yaml"), py::arg("source_name"), py::arg("base_dir"))
       .def("fill_defaults", &C::fill_defaults, "Per-joint vectors left empty get their defaults (vendor gains, zero offsets).")
       .def("validate", &C::validate, "Cross-field checks; ConfigError with the key path.")

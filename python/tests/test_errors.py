@@ -78,3 +78,20 @@ def test_io_error_names_the_path(tmp_path):
         phri.load_log(str(tmp_path / "none.csv"))
     assert caught.value.path == str(tmp_path / "none.csv")
     assert str(caught.value) == f"{tmp_path / 'none.csv'}: cannot open the file"
+
+
+def test_a_missing_file_is_also_a_file_not_found_error_and_paths_may_be_path_objects(tmp_path):
+    missing = tmp_path / "missing.urdf"
+    for load in (phri.Model.from_urdf_file, phri.Config.from_yaml_file, phri.ActuatorTable.from_yaml_file,
+                 phri.SimRobotConfig.from_yaml_file):
+        with pytest.raises(FileNotFoundError) as caught:
+            load(missing)  # a pathlib.Path, as os.PathLike
+        assert isinstance(caught.value, phri.ConfigError) and isinstance(caught.value, OSError)
+        assert caught.value.file == str(missing) and "\n" not in str(caught.value)
+    # A file that is there but wrong stays a ConfigError only.
+    bad = tmp_path / "bad.urdf"
+    bad.write_text("<robot name='x'><link name='a'/><joint name='j' type='revolute'></joint></robot>")
+    with pytest.raises(phri.ConfigError) as caught:
+        phri.Model.from_urdf_file(bad)
+    assert not isinstance(caught.value, FileNotFoundError)
+    assert phri.Model.from_urdf_file(SOURCE_DIR / "robots/kinova_gen3/gen3.urdf").nq == 7

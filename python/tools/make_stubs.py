@@ -58,6 +58,8 @@ def python_type(text):
     result = re.sub(r"(?<!\.)\bdtype\b", "numpy.dtype[Any]", result)
     result = re.sub(r"\blist\b", "List[Any]", result)
     result = re.sub(r"\bobject\b", "Any", result)
+    # std::filesystem::path arguments: pybind11 accepts a str as well as any os.PathLike.
+    result = re.sub(r"(?<![\w.])os\.PathLike\b(?!\[)", "Union[str, os.PathLike[str]]", result)
     if "::" in result or "<" in result:
         raise SystemExit(f"make_stubs: a signature names a C++ type (missing binding?): {text}")
     return result
