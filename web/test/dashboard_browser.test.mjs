@@ -176,7 +176,8 @@ try {
   await page.mouse.move(grab.x, grab.y);
   await page.mouse.down();
   for (let k = 1; k <= 5; ++k) { await page.mouse.move(grab.x + 6 * k, grab.y + 2 * k); await sleep(30); }
-  await waitFor(page, () => window.phri.last.push !== null && window.phri.last.push.magnitude > 5, 'the held push starts', 3000);
+  // A loaded 2-core machine (the browser at nice 15) may take seconds to take the drag in.
+  await waitFor(page, () => window.phri.last.push !== null && window.phri.last.push.magnitude > 5, 'the held push starts', 20000);
   await cdp.send('Emulation.setCPUThrottlingRate', { rate: 4 });  // then the page slows down, the hand still
   const fromT = await page.evaluate(() => window.phri.last.t);
   await sleep(5000);
