@@ -170,14 +170,21 @@ try {
       .observe({ type: 'longtask' });
   });
   const cdp = await page.target().createCDPSession();
-  const grab = await page.evaluate((i) => window.phri.screenOfCapsule(i), ee);  // where the link is now
-  const plotsBefore = await page.evaluate(() => window.phri.plotUpdates);
-  const heldFrom = Date.now();
-  await page.mouse.move(grab.x, grab.y);
-  await page.mouse.down();
-  for (let k = 1; k <= 5; ++k) { await page.mouse.move(grab.x + 6 * k, grab.y + 2 * k); await sleep(30); }
-  // A loaded 2-core machine (the browser at nice 15) may take seconds to take the drag in.
-  await waitFor(page, () => window.phri.last.push !== null && window.phri.last.push.magnitude > 5, 'the held push starts', 20000);
+  // Grab the link where it is now and drag; a loaded 2-core machine (the browser at nice 15) may take
+  // seconds to take the drag in, or the link may have moved under the pointer: up to three tries.
+  let started = false, heldFrom = 0, plotsBefore = 0;
+  for (let attempt = 0; attempt < 3 && !started; ++attempt) {
+    const grab = await page.evaluate((i) => window.phri.screenOfCapsule(i), ee);
+    plotsBefore = await page.evaluate(() => window.phri.plotUpdates);
+    heldFrom = Date.now();
+    await page.mouse.move(grab.x, grab.y);
+    await page.mouse.down();
+    for (let k = 1; k <= 5; ++k) { await page.mouse.move(grab.x + 6 * k, grab.y + 2 * k); await sleep(30); }
+    started = await page.waitForFunction(() => window.phri.last.push !== null && window.phri.last.push.magnitude > 5,
+                                         { timeout: 10000 }).then(() => true, () => false);
+    if (!started) { await page.mouse.up(); await sleep(1000); }
+  }
+  check(started, 'the held push starts');
   await cdp.send('Emulation.setCPUThrottlingRate', { rate: 4 });  // then the page slows down, the hand still
   const fromT = await page.evaluate(() => window.phri.last.t);
   await sleep(5000);
