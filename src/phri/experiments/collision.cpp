@@ -87,11 +87,11 @@ public:
     } else {
       dynamic(start, ee, trace);
     }
-    finish(trace);
+    finish();
     return run_;
   }
 
-  const std::vector<std::string> link_names() const {
+  std::vector<std::string> link_names() const {
     std::vector<std::string> names;
     for (int i = 0; i < monitor_->num_links(); ++i) names.push_back(monitor_->link_name(i));
     return names;
@@ -254,8 +254,7 @@ private:
     });
   }
 
-  void finish(std::vector<TraceRow>& trace) {
-    (void)trace;
+  void finish() {
     std::ostringstream why;
     if (!touched_) why << "the tool never touched the region; ";
     if (other_loop_ > 0) why << other_loop_ << " cycles before the touch not in the " << to_string(run_.loop) << " loop; ";

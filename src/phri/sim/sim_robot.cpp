@@ -920,12 +920,14 @@ double box_reach(const Eigen::Matrix3d& axes, const mjtNum* half, const Eigen::V
 }  // namespace
 
 Eigen::Vector3d SimRobot::tool_point_along(const Eigen::Vector3d& direction) const {
+  if (tool_geom_ < 0) return Eigen::Vector3d::Zero();  // no surrogate bound: no tool box
   const Eigen::Matrix3d axes = rotation(d_->geom_xmat + 9 * tool_geom_);
   const Eigen::Vector3d centre(d_->geom_xpos[3 * tool_geom_], d_->geom_xpos[3 * tool_geom_ + 1], d_->geom_xpos[3 * tool_geom_ + 2]);
   return centre + box_reach(axes, m_->geom_size + 3 * tool_geom_, direction) * direction;
 }
 
 Eigen::Vector3d SimRobot::tool_velocity() const {
+  if (tool_geom_ < 0) return Eigen::Vector3d::Zero();
   mjtNum v[6];
   mj_objectVelocity(m_.get(), d_.get(), mjOBJ_GEOM, tool_geom_, v, 0);
   return {v[3], v[4], v[5]};

@@ -132,9 +132,9 @@ public:
 
   /// The point on the tool box's centre line along `direction` (world, unit) as far out as the box
   /// reaches: a body region's face square to `direction` placed there just touches the box. Needs
-  /// config().surrogate enabled.
+  /// config().surrogate enabled (zero otherwise).
   Eigen::Vector3d tool_point_along(const Eigen::Vector3d& direction) const;
-  /// The tool box centre's true velocity (world) [m/s]. Needs config().surrogate enabled.
+  /// The tool box centre's true velocity (world) [m/s]. Needs config().surrogate enabled (zero otherwise).
   Eigen::Vector3d tool_velocity() const;
 
   // ---- PushInput: a step force as a live disturbance from the latest state's time on.
