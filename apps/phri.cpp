@@ -21,12 +21,14 @@
 //   phri experiment ros2-load [options]        loop cycle time with vs without the ROS 2 bridge, F/T round trip (ros2_cli.cpp)
 //   phri ft-monitor [--device DEV | --emulate] the Bota F/T sensor's wrench and counters (apps/ft_monitor.cpp)
 //   phri ft-bridge [--device DEV | --emulate] the Bota F/T sensor published on ROS 2 /phri/ft_in (apps/ft_bridge.cpp)
+//   phri log export --csv OUT LOG.mcap        an MCAP log back to its CSV; phri log info LOG: its topics (apps/log_cli.cpp)
 // Every bad argument or file, and every failure of a run or an experiment (phri::Error: ConfigError,
 // IoError, ExperimentError), gives one line on stderr naming what is wrong and exit status 2.
 // `phri run` exits 0, 3 after a safe hold, and 128 + the signal's number (130 SIGINT, 143 SIGTERM)
 // when a signal ended it early: the run then stops as if its duration had run out, and the log,
 // summary.md and figure are still written (a second signal kills as usual).
 #include "exit_status.hpp"
+#include "log_cli.hpp"
 #include "ft_monitor.hpp"
 #include "kortex_backend.hpp"
 #include "ros2_cli.hpp"
@@ -182,6 +184,28 @@ void draw_demo_figure(const std::string& log_path, const std::string& png, const
   }
 }
 
+// `phri experiment friction-identification`: the same as `phri identify-friction`.
+CLI::App* add_friction_alias(CLI::App& experiment, phri::FrictionIdentificationOptions& friction) {
+  auto* alias = experiment.add_subcommand("friction-identification", "Same as 'phri identify-friction'");
+  alias->add_option("--out", friction.output_dir, "output folder");
+  alias->add_option("--seed", friction.seed, "seed");
+  return alias;
+}
+
+// The figure of the run's log; an MCAP log is exported to a CSV beside it for the script, then removed.
+void draw_run_figure(const std::string& log_path, const std::string& png, const phri::Config& config) {
+  if (config.logging.format == phri::LogFormat::kCsv) return draw_demo_figure(log_path, png, config);
+  const std::string csv = std::filesystem::path(log_path).replace_extension(".figure.csv").string();
+  try {
+    phri::export_mcap_log_csv(log_path, csv, false);
+    draw_demo_figure(csv, png, config);
+  } catch (const phri::Error& e) {
+    std::fprintf(stderr, "phri: warning: no figure: %s\n", e.what());
+  }
+  std::error_code ignored;
+  std::filesystem::remove(csv, ignored);
+}
+
 // Where the dashboard's page is: --web-root, else web/ here, else the installed copy beside the
 // program (cmake --install), else the source tree's (scripts/setup put the npm packages there).
 std::string dashboard_web_root(const std::string& given) {
@@ -276,6 +300,7 @@ struct RunArguments {
   double duration_s = -1.0;
   std::string out_dir = "out";
   bool figure = true;
+  std::string log_format;  ///< --log csv|mcap (empty: the configuration's logging.format)
   KortexArguments kortex;
   Ros2Arguments ros2;
 };
@@ -314,6 +339,9 @@ void open_run_log(phri::Config& config, const phri::Controller& cycle, std::opti
   if (config.body_regions && cycle.collision() != nullptr) {
     config.logging.pfl_links = phri::PowerForceLimitMonitor::monitored_links(*cycle.collision());
   }
+  for (const phri::Joint& j : cycle.model().joints()) config.logging.joint_names.push_back(j.name);
+  config.logging.has_ft_sensor = config.plant.ft_sensor_present();
+  config.logging.topic_namespace = config.ros2.topic_namespace;
   logger.emplace(config.logging);
 }
 
@@ -327,12 +355,22 @@ void write_run_summary(const phri::RunSummary& summary, const std::string& confi
   std::printf("\nwrote %s\n", (out / "summary.md").c_str());
 }
 
+// --log over logging.format; then the format is settled (auto: by the run's final duration).
+void apply_log_format(const std::string& log_format, phri::Config& config) {
+  if (!log_format.empty()) {
+    config.log_format_auto = false;
+    config.logging.format = log_format == "mcap" ? phri::LogFormat::kMcap : phri::LogFormat::kCsv;
+  }
+  phri::resolve_log_format(config);
+}
+
 // `phri run`: loads the configuration, runs the session, writes the log, summary and figure.
 int run_command(const RunArguments& args) {
   phri::Config config = phri::Config::from_yaml_file(args.config_path, args.robot_folder);
   if (args.lockstep) config.run.pacing = phri::LoopClock::Pacing::kLockstep;
   if (args.real_time) config.run.pacing = phri::LoopClock::Pacing::kRealTime;
   if (args.duration_s > 0.0) config.run.duration_s = args.duration_s;
+  apply_log_format(args.log_format, config);
   apply_ros2_arguments(args.ros2, config.ros2, config.run.pacing == phri::LoopClock::Pacing::kLockstep);
   phri::ensure_output_directory(args.out_dir);
   const std::filesystem::path out(args.out_dir);
@@ -400,7 +438,7 @@ int run_command(const RunArguments& args) {
     const phri::LoggerStats stats = logger->close();
     std::printf("%s\n", logger->summary().c_str());
     if (stats.dropped > 0 || stats.write_error) std::fprintf(stderr, "phri: warning: log incomplete\n");
-    if (args.figure) draw_demo_figure(logger->path(), (out / "demo.png").string(), config);
+    if (args.figure) draw_run_figure(logger->path(), (out / "demo.png").string(), config);
   }
   return run_exit_status(summary, config.run.duration_s);
 }
@@ -457,6 +495,10 @@ CLI::App* add_run_command(CLI::App& app, RunArguments& args) {
       ->check(duration_seconds());
   run->add_option("--out", args.out_dir, "output folder (log, summary, figure)")->capture_default_str();
   run->add_flag("!--no-figure", args.figure, "skip the figure");
+  run->add_option("--log", args.log_format, "log format: csv (text) or mcap (ROS 2 messages, zstd; read by ros2 bag, "
+                  "Foxglove, PlotJuggler, `phri log export --csv`); default: the configuration's logging.format "
+                  "(auto: mcap for runs over 60 s)")
+      ->check(CLI::IsMember({"csv", "mcap"}));
   run->add_option("--backend", args.kortex.backend,
                   "the arm: sim (the simulated Gen3), kortex (the real Gen3 through Kinova's Kortex API; needs a build with "
                   "-DPHRI_KORTEX_API_DIR) or kortex-emulator (the Kortex backend on an emulated arm over the simulation)")
@@ -934,9 +976,7 @@ int main(int argc, char** argv) {
   const CLI::App* fuzz = add_safety_fuzz_command(*experiment, fuzz_args);
   const CLI::App* load = add_dashboard_load_command(*experiment, load_args);
   Ros2Commands ros2_commands(app, *experiment);  // ft-bridge, experiment ros2-load
-  auto* friction_alias = experiment->add_subcommand("friction-identification", "Same as 'phri identify-friction'");
-  friction_alias->add_option("--out", friction.output_dir, "output folder");
-  friction_alias->add_option("--seed", friction.seed, "seed");
+  const CLI::App* friction_alias = add_friction_alias(*experiment, friction);
   const CLI::App* drop = add_drop_test_command(*experiment, drop_args);
   const CLI::App* dynamic = add_dynamic_tracking_command(*experiment, dynamic_options);
   const CLI::App* dual = add_dual_compliance_command(*experiment, dual_options);
@@ -949,6 +989,7 @@ int main(int argc, char** argv) {
   const CLI::App* fit_collision = add_fit_collision_command(app, fit_args);
   FtMonitorArguments ft_args;
   const CLI::App* ft_monitor = add_ft_monitor_command(app, ft_args);
+  const LogCommands log_commands(app);
 
   add_shared_checks(app);
   if (const std::string error = command_word_error(app, argc, argv); !error.empty()) return print_error(error.c_str());
@@ -963,6 +1004,7 @@ int main(int argc, char** argv) {
     if (info->parsed()) return info_command(info_args);
     if (fit_collision->parsed()) return fit_collision_command(fit_args);
     if (ft_monitor->parsed()) return ft_monitor_command(ft_args);
+    if (log_commands.parsed()) return log_commands.run();
     if (ros2_commands.parsed()) return ros2_commands.run();
     if (identify->parsed() || friction_alias->parsed()) return friction_identification_command(friction);
     if (tracking->parsed()) return torque_tracking_command(tracking_args);

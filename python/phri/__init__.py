@@ -56,13 +56,21 @@ class RunResult:
 
 def run(config: Union[str, _os.PathLike[str]], duration_s: Optional[float] = None,
         out_dir: Union[str, _os.PathLike[str]] = "out",
-        real_time: bool = False, status_line: bool = False) -> RunResult:
+        real_time: bool = False, status_line: bool = False, log: Optional[str] = None) -> RunResult:
     """Runs a session as `phri run --config CONFIG` does (simulated arm, FSM and its timeline, log), without the
     figure: lockstep unless real_time, for duration_s (default: the configuration's), the log written into out_dir.
-    The loop runs in C++ with the GIL released; phase lines go to sys.stdout."""
-    config = Config.from_yaml_file(_os.fspath(config))
+    A relative `config` not found from the working directory is looked up in phri's data (phri.locate). The
+    loop runs in C++ with the GIL released; phase lines go to sys.stdout. `log`: "csv" or "mcap" (default:
+    the configuration's logging.format; auto: mcap for runs over 60 s)."""
+    config = Config.from_yaml_file(locate(_os.fspath(config)))  # the shipped configs/ from anywhere
     if duration_s is not None:
         config.run.duration_s = float(duration_s)
+    if log is not None:
+        if log not in ("csv", "mcap"):
+            raise ValueError(f"run: log is 'csv' or 'mcap', not {log!r}")
+        config.log_format_auto = False
+        config.logging.format = LogFormat.mcap if log == "mcap" else LogFormat.csv
+    resolve_log_format(config)
     out = _pathlib.Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     config.logging.path = str(out / _pathlib.Path(config.logging.path).name)  # edits config in place
@@ -70,6 +78,8 @@ def run(config: Union[str, _os.PathLike[str]], duration_s: Optional[float] = Non
     controller = Controller(config.controller)
     if config.body_regions is not None:
         config.logging.pfl_links = contact_links(controller)
+    config.logging.joint_names = [j.name for j in controller.model.joints]
+    config.logging.has_ft_sensor = config.plant.ft_sensor_present()
     fsm = Fsm(config.fsm, controller)
     logger = Logger(config.logging) if config.logging_enabled else None
     options = RunOptions()

@@ -5,11 +5,13 @@
 #include "python_stream.hpp"
 
 #include <phri/app/loop_clock.hpp>
+#include <phri/app/mcap_log.hpp>
 #include <phri/config/config.hpp>
 #include <phri/app/run_session.hpp>
 #include <phri/control/power_force_limit.hpp>
 #include <phri/robot/ground_truth.hpp>
 
+#include <filesystem>
 #include <sstream>
 
 namespace phri::python {
@@ -57,9 +59,19 @@ void bind_fsm(py::module_& m) {
 }
 
 void bind_logger(py::module_& m) {
-  py::class_<LoggerSettings>(m, "LoggerSettings", "The CSV log of a run.")
+  py::enum_<LogFormat>(m, "LogFormat", "csv: a text line per cycle; mcap: ROS 2 messages in zstd chunks (ros2 bag, "
+                                        "Foxglove, PlotJuggler; load_log reads both).")
+      .value("csv", LogFormat::kCsv)
+      .value("mcap", LogFormat::kMcap);
+  py::class_<LoggerSettings>(m, "LoggerSettings", "The log of a run (CSV or MCAP).")
       .def(py::init<>())
       .def_readwrite("path", &LoggerSettings::path)
+      .def_readwrite("format", &LoggerSettings::format)
+      .def_readwrite("joint_names", &LoggerSettings::joint_names, "MCAP: sensor_msgs/JointState's joint names.")
+      .def_readwrite("has_ft_sensor", &LoggerSettings::has_ft_sensor, "MCAP: log <ns>/wrench.")
+      .def_readwrite("topic_namespace", &LoggerSettings::topic_namespace)
+      .def_readwrite("ros_topics_every", &LoggerSettings::ros_topics_every,
+                     "MCAP: the standard ROS topics every N cycles (the cycle record: every cycle).")
       .def_readwrite("dof", &LoggerSettings::dof)
       .def_readwrite("capacity_rows", &LoggerSettings::capacity_rows)
       .def_readwrite("write_legend", &LoggerSettings::write_legend)
@@ -69,7 +81,7 @@ void bind_logger(py::module_& m) {
       .def_readonly("dropped", &LoggerStats::dropped)
       .def_readonly("written", &LoggerStats::written)
       .def_readonly("write_error", &LoggerStats::write_error);
-  py::class_<Logger>(m, "Logger", "One CSV row per cycle, written off the control thread (load it with phri.load_log).")
+  py::class_<Logger>(m, "Logger", "One row per cycle, CSV or MCAP, written off the control thread (load it with phri.load_log).")
       .def(py::init<const LoggerSettings&>(), py::arg("settings"), "Opens the file; ConfigError when it cannot be created.")
       .def("close", &Logger::close, py::call_guard<py::gil_scoped_release>(), "Drains the ring, closes the file.")
       .def("stats", &Logger::stats, "Counters so far.")
@@ -114,6 +126,8 @@ void bind_config(py::module_& m) {
       .def_readwrite("fsm", &Config::fsm)
       .def_readwrite("logging_enabled", &Config::logging_enabled)
       .def_readwrite("logging", &Config::logging)
+      .def_readwrite("log_format_auto", &Config::log_format_auto,
+                     "logging.format is auto: resolve_log_format decides by the run's duration.")
       .def_readwrite("run", &Config::run)
       .def_readwrite("body_regions", &Config::body_regions, "The body regions the run is measured against, or None.");
 }
@@ -186,6 +200,15 @@ void bind_run_session(py::module_& m) {
         print_run_summary(summary, text);
         return text.str();
       }, py::arg("summary"), "The end-of-run report (markdown), as `phri run` prints it.");
+  m.def("resolve_log_format", &resolve_log_format, py::arg("config"),
+        "Settles config.logging.format once the run's duration is final (auto: mcap over 60 s or for a .mcap path) "
+        "and gives the path that format's extension.");
+  m.def("export_log_csv", [](const std::filesystem::path& mcap, const std::filesystem::path& csv) {
+        const py::gil_scoped_release release;
+        return export_mcap_log_csv(mcap.string(), csv.string(), true).rows;
+      }, py::arg("mcap"), py::arg("csv"),
+      "An MCAP log back to the CSV the run would have written (every column bit for bit) and its legend; returns "
+      "the rows written (`phri log export --csv`).");
 }
 
 }  // namespace

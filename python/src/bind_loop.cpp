@@ -4,6 +4,8 @@
 #include "closed_loop.hpp"
 #include "log_table.hpp"
 
+#include <phri/app/mcap_log.hpp>
+
 #include <cstring>
 
 namespace phri::python {
@@ -96,18 +98,18 @@ void bind_log(py::module_& m) {
         "The numpy dtype of a phri log with `dof` joints (load_log and ClosedLoop.record).");
   m.def("load_log", [](const std::filesystem::path& file) {
         const std::string path = file.string();
-        CsvTable table;
+        LogTable table;
         {
           const py::gil_scoped_release release;
-          table = read_csv_table(path);
+          table = is_mcap_file(path) ? read_mcap_table(path) : read_csv_table(path);
         }
         py::array out = records_array(table.columns, table.rows);
         if (!table.cells.empty()) std::memcpy(out.mutable_data(), table.cells.data(), table.cells.size());
         return out;
       }, py::arg("path"),
-      "A phri CSV log (or any numeric CSV with a header) as a numpy structured array, one field per column: int64 "
-      "for the integer codes of a phri log, float64 otherwise, parsed exactly. IoError naming the line and column of "
-      "a bad cell.");
+      "A phri log, CSV or MCAP (phri run --log mcap; one cut short by a crash is read up to its last chunk), or any "
+      "numeric CSV with a header, as a numpy structured array, one field per column: int64 for the integer codes of "
+      "a phri log, float64 otherwise, exactly as written. IoError naming the line and column of a bad cell.");
 }
 
 }  // namespace phri::python

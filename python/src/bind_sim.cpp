@@ -147,6 +147,7 @@ void bind_config(py::module_& m) {
       .def("fill_defaults", &C::fill_defaults, "Per-joint vectors left empty get their defaults (vendor gains, zero offsets).")
       .def("validate", &C::validate, "Cross-field checks; ConfigError with the key path.")
       .def("plant_actuators", &C::plant_actuators, "The plant's drives: actuators with the overrides applied.")
+      .def("ft_sensor_present", &C::ft_sensor_present, "The arm carries an F/T sensor (its end of arm has one).")
       .def_property_readonly("dof", &C::dof)
       .def("substeps_per_cycle", &C::substeps_per_cycle, "Physics steps per control period.")
       .def_readwrite("source", &C::source)

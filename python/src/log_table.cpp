@@ -1,5 +1,6 @@
 #include "log_table.hpp"
 
+#include <phri/app/mcap_log.hpp>
 #include <phri/core/error.hpp>
 
 #include <charconv>
@@ -89,12 +90,12 @@ void write_log_record(const LogRow& row, int dof, unsigned char* record) {
   visit_log_columns(row, dof, RecordWriter{record});
 }
 
-CsvTable read_csv_table(const std::string& path) {
+LogTable read_csv_table(const std::string& path) {
   std::ifstream file(path);
   if (!file) throw IoError(path, "cannot open the file");
   std::string line;
   if (!std::getline(file, line) || line.empty()) throw IoError(path, "no header line");
-  CsvTable table;
+  LogTable table;
   if (line.back() == '\r') line.pop_back();
   for (std::string_view name : split(line)) {
     const bool integer = integer_column_names().count(std::string(name)) > 0;
@@ -114,6 +115,18 @@ CsvTable read_csv_table(const std::string& path) {
     for (std::size_t c = 0; c < width; ++c) parse_cell(path, number, table.columns[c], fields[c], row + 8 * c);
     ++table.rows;
   }
+  return table;
+}
+
+LogTable read_mcap_table(const std::string& path) {
+  LogTable table;
+  read_mcap_log(path, [&](const LogRow& row, int dof) {
+    if (table.rows == 0) table.columns = log_columns(dof);
+    const std::size_t width = table.columns.size();
+    table.cells.resize(table.cells.size() + 8 * width);
+    write_log_record(row, dof, table.cells.data() + table.cells.size() - 8 * width);
+    ++table.rows;
+  });
   return table;
 }
 

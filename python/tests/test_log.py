@@ -67,3 +67,33 @@ def test_a_bad_cell_names_its_line_and_column(tmp_path):
     path.write_text("time_s,cycle\n0.001,1\n0.002,two\n")
     with pytest.raises(phri.IoError, match=r"line 3, column 'cycle': not an integer: 'two'"):
         phri.load_log(str(path))
+
+
+def test_an_mcap_log_loads_into_the_same_rows_as_its_csv(tmp_path):
+    csv = phri.run(DEMO_YAML, duration_s=0.5, out_dir=tmp_path / "csv", log="csv")
+    mcap = phri.run(DEMO_YAML, duration_s=0.5, out_dir=tmp_path / "mcap", log="mcap")
+    assert mcap.log_path.endswith(".mcap") and csv.log_path.endswith(".csv")
+    a, b = phri.load_log(csv.log_path), phri.load_log(mcap.log_path)
+    assert a.dtype == b.dtype and len(a) == len(b) == 500
+    for name in a.dtype.names:
+        if name != "cycle_time_s":  # the wall clock of each cycle's computation
+            assert a[name].tobytes() == b[name].tobytes(), name
+    exported = tmp_path / "exported.csv"
+    assert phri.export_log_csv(mcap.log_path, exported) == 500
+    assert phri.load_log(exported).tobytes() == b.tobytes()
+
+
+def test_a_long_run_logs_to_mcap_unless_told_otherwise():
+    config = phri.Config.from_yaml_file(DEMO_YAML)
+    config.run.duration_s = 120.0
+    assert phri.resolve_log_format(config) == phri.LogFormat.mcap and config.logging.path.endswith(".mcap")
+    config = phri.Config.from_yaml_file(DEMO_YAML)
+    assert phri.resolve_log_format(config) == phri.LogFormat.csv and config.logging.path.endswith(".csv")
+    with pytest.raises(ValueError):
+        phri.run(DEMO_YAML, duration_s=0.01, log="parquet")
+
+
+def test_the_shipped_configs_run_from_any_working_directory(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)  # no configs/ here
+    result = phri.run("configs/demo.yaml", duration_s=0.05, out_dir="out")
+    assert result.summary.cycles == 50 and (tmp_path / "out").is_dir()

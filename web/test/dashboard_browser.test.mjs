@@ -41,7 +41,7 @@ function check(ok, what) {
 // browser runs at nice +15 (below).
 function startPhri() {
   const child = spawn(args.phri, ['run', '--config', args.config, '--realtime', '--dashboard', '--port', '0',
-                                  '--out', out, '--duration', '300', '--no-figure'], { stdio: ['ignore', 'pipe', 'pipe'] });
+                                  '--out', out, '--duration', '300', '--no-figure', '--log', 'csv'], { stdio: ['ignore', 'pipe', 'pipe'] });
   let text = '';
   child.stderr.on('data', (d) => process.stderr.write(d));
   return new Promise((resolve, reject) => {

@@ -16,7 +16,9 @@ namespace phri {
 namespace {
 
 constexpr std::size_t kBufferBytes = 1 << 20;
-constexpr std::size_t kMaxRowBytes = 8192;  // > 120 columns x 25 characters
+constexpr std::size_t kMaxRowBytes = Logger::kMaxCsvLineBytes;
+// An MCAP chunk still open after this long is written anyway: a crash loses at most this much.
+constexpr double kMcapFlushPeriodS = 1.0;
 
 // Header names.
 struct HeaderVisitor {
@@ -70,6 +72,12 @@ std::string Logger::header(int dof) {
   HeaderVisitor v;
   visit_log_columns(LogRow{}, dof, v);
   return v.out;
+}
+
+char* Logger::csv_line(const LogRow& row, int dof, char* out, char* end) {
+  RowVisitor v{out, end};
+  visit_log_columns(row, dof, v);
+  return v.p;
 }
 
 std::string Logger::legend_yaml(const std::vector<std::string>& pfl_links) {
@@ -133,6 +141,16 @@ Logger::Logger(const LoggerSettings& settings)
   if (settings.dof < 1 || settings.dof > kLogMaxJoints) {
     throw ConfigError(settings.path, "dof", "the logger records 1 to " + std::to_string(kLogMaxJoints) + " joints");
   }
+  if (settings.format == LogFormat::kMcap) {
+    try {
+      mcap_ = std::make_unique<McapLogWriter>(settings);
+    } catch (const IoError& e) {
+      throw ConfigError(settings.path, "", std::string("cannot create the log file: ") + e.what());
+    }
+    running_ = true;
+    writer_ = std::thread([this] { writer_loop(); });
+    return;
+  }
   file_ = std::fopen(settings.path.c_str(), "wb");
   if (file_ == nullptr) {
     throw ConfigError(settings.path, "", std::string("cannot create the log file: ") + std::strerror(errno));
@@ -179,12 +197,26 @@ void Logger::flush_buffer() {
 // Formats every row in the ring; writes the buffer whenever it fills up and once at the end.
 void Logger::drain() {
   std::uint64_t count = 0;
+  if (mcap_) {
+    while (const LogRow* row = ring_.front()) {
+      if (!write_error_.load(std::memory_order_relaxed)) {
+        try {
+          mcap_->write(*row);
+        } catch (const Error&) {  // a compression failure: rows after it are lost, as after a failed fwrite
+          write_error_.store(true, std::memory_order_relaxed);
+        }
+      }
+      ring_.pop_front();
+      ++count;
+    }
+    written_.fetch_add(count, std::memory_order_relaxed);
+    return;
+  }
   while (const LogRow* row = ring_.front()) {
     if (kBufferBytes - buffer_used_ < kMaxRowBytes) flush_buffer();
-    RowVisitor v{buffer_.data() + buffer_used_, buffer_.data() + kBufferBytes};
-    visit_log_columns(*row, settings_.dof, v);
-    *v.p++ = '\n';
-    buffer_used_ = static_cast<std::size_t>(v.p - buffer_.data());
+    char* end = csv_line(*row, settings_.dof, buffer_.data() + buffer_used_, buffer_.data() + kBufferBytes);
+    *end++ = '\n';
+    buffer_used_ = static_cast<std::size_t>(end - buffer_.data());
     ring_.pop_front();
     ++count;
   }
@@ -198,10 +230,19 @@ void Logger::drain() {
 void Logger::writer_loop() {
   using Clock = std::chrono::steady_clock;
   const auto pause = std::chrono::milliseconds(settings_.writer_sleep_ms);
+  auto last_flush = Clock::now();
   for (;;) {
     const bool last = !running_.load(std::memory_order_acquire);
     const auto start = Clock::now();
     drain();
+    if (mcap_ && std::chrono::duration<double>(start - last_flush).count() > kMcapFlushPeriodS) {
+      try {
+        mcap_->flush();
+      } catch (const Error&) {
+        write_error_.store(true, std::memory_order_relaxed);
+      }
+      last_flush = start;
+    }
     busy_s_.store(busy_s_.load(std::memory_order_relaxed) + std::chrono::duration<double>(Clock::now() - start).count(),
                   std::memory_order_relaxed);
     if (last) return;  // the producer stopped before this final drain: nothing is left behind
@@ -214,6 +255,13 @@ LoggerStats Logger::close() {
     closed_ = true;
     running_.store(false, std::memory_order_release);
     if (writer_.joinable()) writer_.join();
+    if (mcap_) {
+      try {
+        mcap_->close();
+      } catch (const Error&) {
+        write_error_ = true;
+      }
+    }
     if (file_ != nullptr) {
       if (std::fclose(file_) != 0) write_error_ = true;
       file_ = nullptr;

@@ -1,6 +1,7 @@
 #pragma once
-// phri::Logger: one CSV row per control cycle (config/log_row.hpp), written to disk off the control
-// thread (DESIGN.md section 2, last stage).
+// phri::Logger: one row per control cycle (config/log_row.hpp), written to disk off the control
+// thread (DESIGN.md section 2, last stage), as CSV text or as an MCAP file (settings.format;
+// app/mcap_log.hpp: the same columns, ROS 2 messages in zstd chunks, each chunk flushed within 1 s).
 //
 //   phri::Logger logger({.path = "run.csv"});   // opens the file, writes header + legend, starts the writer
 //   for (...) {                                   // control thread, 1 kHz
@@ -25,11 +26,13 @@
 // a sidecar <path without .csv>.legend.yaml (legend_yaml()).
 #include <phri/config/log_row.hpp>
 #include <phri/config/logger_settings.hpp>
+#include <phri/app/mcap_log.hpp>
 #include <phri/core/spsc_ring.hpp>
 
 #include <atomic>
 #include <cstdint>
 #include <cstdio>
+#include <memory>
 #include <string>
 #include <thread>
 #include <vector>
@@ -74,6 +77,9 @@ public:
 
   /// The CSV header line (no newline) for `dof` joints.
   static std::string header(int dof);
+  /// One CSV line of `row` (no newline) into [out, end) (end - out >= kMaxCsvLineBytes); returns its end.
+  static char* csv_line(const LogRow& row, int dof, char* out, char* end);
+  static constexpr std::size_t kMaxCsvLineBytes = 8192;  // > 120 columns x 25 characters
   /// The legend of the integer columns, as YAML.
   /// `pfl_links`: the names of the pfl_link column's indices (LoggerSettings::pfl_links).
   static std::string legend_yaml(const std::vector<std::string>& pfl_links = {});
@@ -88,7 +94,8 @@ private:
   LoggerSettings settings_;
   std::string legend_path_;
   SpscRing<LogRow> ring_;
-  std::FILE* file_ = nullptr;
+  std::FILE* file_ = nullptr;               // CSV
+  std::unique_ptr<McapLogWriter> mcap_;     // MCAP
   std::vector<char> buffer_;
   std::size_t buffer_used_ = 0;
   std::thread writer_;

@@ -512,10 +512,15 @@ std::vector<TimedEvent> parse_events(const YamlReader& list, double duration_s, 
 
 // ------------------------------------------------------------------------------------ logging, gamepad, run
 void parse_logging(const YamlReader& l, Config& c) {
-  l.allow_keys({"enabled", "path", "buffer_rows", "legend"});
+  l.allow_keys({"enabled", "path", "buffer_rows", "legend", "format", "ros_topics_every"});
   c.logging_enabled = l.boolean_or("enabled", c.logging_enabled);
   c.logging.path = l.text_or("path", c.logging.path);
   if (c.logging.path.empty()) throw l.error("path", "empty file name");
+  const std::string format = l.text_or("format", "auto");
+  if (format != "auto" && format != "csv" && format != "mcap") throw l.error("format", "auto, csv or mcap, got '" + format + "'");
+  c.log_format_auto = format == "auto";
+  if (!c.log_format_auto) c.logging.format = format == "mcap" ? LogFormat::kMcap : LogFormat::kCsv;
+  c.logging.ros_topics_every = static_cast<int>(l.integer_or("ros_topics_every", c.logging.ros_topics_every, 1, 1000));
   const long long rows = l.integer_or("buffer_rows", static_cast<long long>(c.logging.capacity_rows), 16, 1LL << 40);
   if (rows > static_cast<long long>(log_ring_max_rows())) {
     throw l.error("buffer_rows", "at most " + std::to_string(log_ring_max_rows()) + " rows of " +
@@ -651,6 +656,20 @@ Config parse(const YamlReader& root, const std::string& base_dir, const std::str
 }
 
 }  // namespace
+
+LogFormat resolve_log_format(Config& config) {
+  std::filesystem::path path(config.logging.path);
+  if (config.log_format_auto) {
+    const bool long_run = config.run.duration_s > kCsvLogMaxAutoDurationS;
+    config.logging.format = path.extension() == ".mcap" || long_run ? LogFormat::kMcap : LogFormat::kCsv;
+    config.log_format_auto = false;
+  }
+  if (path.extension() == ".csv" || path.extension() == ".mcap") {
+    path.replace_extension(config.logging.format == LogFormat::kMcap ? ".mcap" : ".csv");
+    config.logging.path = path.string();
+  }
+  return config.logging.format;
+}
 
 BodyRegion body_region_from_file(const std::string& file, const std::string& name) {
   return load_body_region(file, name, YamlReader::load_file(file), "regions");

@@ -86,6 +86,8 @@ struct Config {
   FsmSettings fsm;                 ///< with the `events:` timeline, sorted by time
   bool logging_enabled = true;
   LoggerSettings logging;
+  /// logging.format: auto (the default): resolve_log_format decides once the run's length is known.
+  bool log_format_auto = true;
   GamepadSettings gamepad;
   RunSettings run;
   Ros2Settings ros2;
@@ -94,6 +96,14 @@ struct Config {
   /// (controller.qp.power_force_limit); empty: none configured, no figures.
   std::optional<BodyRegionMap> body_regions;
 };
+
+/// Runs longer than this log to MCAP when logging.format is auto (a CSV grows by ~1.7 MB/s).
+inline constexpr double kCsvLogMaxAutoDurationS = 60.0;
+
+/// Settles logging.format once the run's duration is final (command-line overrides applied): auto
+/// picks MCAP for a path ending in .mcap or a run longer than kCsvLogMaxAutoDurationS, CSV otherwise;
+/// a path ending in .csv or .mcap then takes the chosen format's extension. Returns the format.
+LogFormat resolve_log_format(Config& config);
 
 /// The region `name` of a regions file (configs/iso_ts_15066_regions.yaml's form); ConfigError
 /// naming the file's regions when it has none of that name.

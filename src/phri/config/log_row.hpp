@@ -36,6 +36,7 @@
 //   cycle_time_s                          wall-clock time of the cycle's computation [s]
 #include <array>
 #include <cstdint>
+#include <type_traits>
 
 namespace phri {
 
@@ -81,14 +82,15 @@ struct LogRow {
 
 /// Calls, in column order, v.number(name, value) for each real column, v.integer(name, value) for
 /// each integer column and v.joints(name, values, dof) for each per-joint group (columns name_1 ..
-/// name_dof).
-template <class Visitor, std::size_t N>
-void visit_numbers(Visitor& v, const std::array<const char*, N>& names, const std::array<double, N>& values) {
+/// name_dof). `Row` is LogRow or const LogRow: a visitor may fill a row (the MCAP log's reader).
+template <class Visitor, std::size_t N, class Values>
+void visit_numbers(Visitor& v, const std::array<const char*, N>& names, Values& values) {
   for (std::size_t i = 0; i < N; ++i) v.number(names[i], values[i]);
 }
 
-template <class Visitor>
-void visit_log_columns(const LogRow& r, int dof, Visitor&& v) {
+template <class Row, class Visitor>
+void visit_log_columns(Row&& r, int dof, Visitor&& v) {
+  static_assert(std::is_same_v<std::remove_cvref_t<Row>, LogRow>);
   v.number("time_s", r.time_s);
   v.integer("cycle", r.cycle);
   v.joints("q", r.q, dof);

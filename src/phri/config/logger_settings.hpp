@@ -21,14 +21,28 @@ constexpr std::size_t log_ring_max_rows() {
   return rows;
 }
 
+/// The log's file format: CSV (one text line per cycle, for short runs and spreadsheets) or MCAP
+/// (app/mcap_log.hpp: ROS 2 messages in zstd chunks, ~10x smaller, read by ros2 bag, Foxglove and
+/// PlotJuggler; `phri log export --csv` turns it back into the CSV).
+enum class LogFormat { kCsv, kMcap };
+
 struct LoggerSettings {
-  std::string path = "phri_log.csv";  ///< CSV file (truncated); its folder must exist
+  std::string path = "phri_log.csv";  ///< log file (truncated); its folder must exist
+  LogFormat format = LogFormat::kCsv;
   int dof = kLogMaxJoints;            ///< joints written per group (<= kLogMaxJoints)
   std::size_t capacity_rows = 16384;  ///< ring size (rounded up to a power of two), <= log_ring_max_rows()
   bool write_legend = true;           ///< write the <path>.legend.yaml sidecar
   int writer_sleep_ms = 2;            ///< writer's pause when the ring is empty
   /// The links of the pfl_link column, in index order (the legend names them; the run fills it).
   std::vector<std::string> pfl_links;
+
+  // MCAP only (app/mcap_log.hpp)
+  std::vector<std::string> joint_names;       ///< sensor_msgs/JointState's names
+  bool has_ft_sensor = false;                 ///< log <ns>/wrench
+  std::string topic_namespace = "/phri";      ///< the ROS 2 bridge's namespace
+  int ros_topics_every = 10;                  ///< the standard ROS topics every N cycles (100 Hz, as the bridge's joint states); the cycle record: every cycle
+  std::size_t mcap_chunk_bytes = 1 << 20;     ///< uncompressed bytes per chunk: at most this much is lost on a crash
+  int mcap_zstd_level = 3;                    ///< chunk compression level (0: stored; higher levels gain < 1 % on these rows)
 };
 
 }  // namespace phri

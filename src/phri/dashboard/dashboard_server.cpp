@@ -269,12 +269,14 @@ void DashboardServer::Impl::serve_log(httplib::Response& res) {
                     "application/json");
     return;
   }
-  // The writer thread flushes every few milliseconds: the file up to now, sent in pieces (a long
-  // run's log is hundreds of MB; it is never held in memory whole).
+  // The writer thread flushes every few milliseconds (an MCAP log: a chunk at least every second):
+  // the file up to now, sent in pieces (a long run's log is hundreds of MB; it is never held in memory
+  // whole). An MCAP log taken mid-run has no summary yet: `phri log export` reads it to its last chunk.
   res.set_header("Content-Disposition", "attachment; filename=\"" +
                                             std::filesystem::path(settings.log_path).filename().string() + "\"");
   auto file = std::make_shared<std::ifstream>(settings.log_path, std::ios::binary);
-  res.set_content_provider(static_cast<std::size_t>(size), "text/csv",
+  const bool mcap = std::filesystem::path(settings.log_path).extension() == ".mcap";
+  res.set_content_provider(static_cast<std::size_t>(size), mcap ? "application/octet-stream" : "text/csv",
                            [file](std::size_t offset, std::size_t length, httplib::DataSink& sink) {
                              std::array<char, 65536> buffer;
                              file->seekg(static_cast<std::streamoff>(offset));
