@@ -8,6 +8,8 @@
 #include <phri/model/model.hpp>
 #include <phri/sim/sim_robot.hpp>
 #include <phri/sim/sim_scene.hpp>
+#include <phri/sim/site_wrench_sensor.hpp>
+#include <phri/core/random_generator.hpp>
 
 #include "allocation_counter.hpp"
 #include "config_error.hpp"
@@ -331,6 +333,62 @@ TEST(SimRobotSensors, FtSensorReadsToolWeight) {
     EXPECT_NEAR(mean[k], weight[k], tf);
     EXPECT_NEAR(mean[3 + k], moment[k], tm);
   }
+}
+
+// SiteWrenchSensor, SimRobot's F/T readings, against MuJoCo's own sensor stage, bit for bit: on the
+// scene SimRobot builds (drop mass, floor), with forces applied on every body (the tool and its
+// parents among them) and the tool pressed into the floor (contacts on the sensor's body and on
+// others), after mj_forward and across mj_step (given the velocities from before the step).
+TEST(SimRobotSensors, FtReadingsAreMujocosSensorStageBitForBit) {
+  SimRobotConfig c = load();
+  c.drop_test.enabled = true;
+  c.floor.enabled = true;
+  SimRobot robot(c);
+  mjModel* m = mj_copyModel(nullptr, robot.mujoco_model());
+  m->opt.disableflags &= ~(mjDSBL_SENSOR | mjDSBL_CONTACT);
+  const int force = mj_name2id(m, mjOBJ_SENSOR, phri::SimScene::kForceSensor);
+  const int torque = mj_name2id(m, mjOBJ_SENSOR, phri::SimScene::kTorqueSensor);
+  ASSERT_TRUE(phri::SiteWrenchSensor::reproduces(m, force, torque));
+  EXPECT_FALSE(phri::SiteWrenchSensor::reproduces(m, torque, force));
+  m->sensor_cutoff[force] = 100.0;
+  EXPECT_FALSE(phri::SiteWrenchSensor::reproduces(m, force, torque));
+  m->sensor_cutoff[force] = 0.0;
+  // The tool's box and the floor collide, the floor raised into the box.
+  const int tool_geom = mj_name2id(m, mjOBJ_GEOM, phri::SimScene::kToolGeom);
+  const int floor = mj_name2id(m, mjOBJ_GEOM, phri::SimScene::kFloorGeom);
+  ASSERT_GE(tool_geom, 0);
+  ASSERT_GE(floor, 0);
+  for (int g : {tool_geom, floor}) m->geom_contype[g] = m->geom_conaffinity[g] = 1;
+  mjData* d = mj_makeData(m);
+  mju_copy(d->qpos, robot.mujoco_data()->qpos, m->nq);
+  mj_forward(m, d);
+  m->geom_pos[3 * floor + 2] = d->geom_xpos[3 * tool_geom + 2] + 0.2 * m->geom_size[3 * tool_geom + 2];
+  phri::SiteWrenchSensor readings(m, force, torque);
+  phri::RandomGenerator rng(3);
+  std::vector<double> qvel(static_cast<std::size_t>(m->nv));
+  int tool_contacts = 0;
+  for (int k = 0; k < 400; ++k) {
+    for (int i = 0; i < m->nv; ++i) d->qvel[i] = rng.uniform(-1.0, 1.0);
+    for (int i = 0; i < 6 * m->nbody; ++i) d->xfrc_applied[i] = k % 5 == 0 ? 0.0 : rng.uniform(-20.0, 20.0);
+    mju_copy(qvel.data(), d->qvel, m->nv);
+    if (k % 2 == 0) {
+      mj_forward(m, d);
+    } else {
+      mj_step(m, d);  // its forward pass reads the sensors, then d->qvel advances
+    }
+    double f[3], t[3];
+    readings.evaluate(m, d, qvel.data(), f, t);
+    EXPECT_EQ(std::memcmp(f, d->sensordata + m->sensor_adr[force], sizeof f), 0) << k;
+    EXPECT_EQ(std::memcmp(t, d->sensordata + m->sensor_adr[torque], sizeof t), 0) << k;
+    for (int i = 0; i < d->ncon; ++i) tool_contacts += d->contact[i].geom1 == tool_geom || d->contact[i].geom2 == tool_geom;
+  }
+  EXPECT_EQ(d->warning[mjWARN_BADQACC].number, 0);
+  EXPECT_GT(tool_contacts, 100);
+  std::printf("F/T readings: 400 states, %d contacts of the tool, last force (%.3f, %.3f, %.3f) N\n", tool_contacts,
+              d->sensordata[m->sensor_adr[force]], d->sensordata[m->sensor_adr[force] + 1],
+              d->sensordata[m->sensor_adr[force] + 2]);
+  mj_deleteData(d);
+  mj_deleteModel(m);
 }
 
 TEST(SimRobotSensors, EncoderIsQuantised) {

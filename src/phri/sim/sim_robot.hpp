@@ -34,7 +34,8 @@
 //      i.e. the torque transmitted between the
 //      drive output and the link, with friction and rotor inertia on the motor side;
 //   6. at the F/T rate, MuJoCo's force/torque sensor at the tool origin (the interaction between the
-//      tool body and the adapter body it is welded to).
+//      tool body and the adapter body it is welded to), as MuJoCo's sensor stage of that step
+//      would read it (SiteWrenchSensor: the same numbers for the tool alone).
 // Sensor values reach the vendor loops one physics step later (the sampling delay).
 //
 // No allocation and no exception inside read() and write(); refused commands are statuses.
@@ -46,6 +47,7 @@
 #include <phri/sim/mujoco_handles.hpp>
 #include <phri/sim/random_push_generator.hpp>
 #include <phri/sim/body_region_surrogate.hpp>
+#include <phri/sim/site_wrench_sensor.hpp>
 #include <phri/robot/ground_truth.hpp>
 #include <phri/robot/push_input.hpp>
 #include <phri/robot/robot_interface.hpp>
@@ -175,7 +177,8 @@ private:
   void start_drives_holding(const Eigen::VectorXd& hold);
   void take_initial_ft_sample(const Eigen::VectorXd& hold);
 
-  void sample_ft_sensor();
+  // The F/T sample from MuJoCo's sensor readings (force, torque: site frame, on the tool).
+  void sample_ft_sensor(const double* force, const double* torque);
   void substep();
   // Step 1 and 5 of substep() per transmission: rigid (friction and rotor inertia on the link) or
   // elastic (ElasticTransmission: the link feels the spring only).
@@ -244,6 +247,8 @@ private:
   int tool_body_ = -1;
   int sensor_site_ = -1;
   int force_adr_ = -1, torque_adr_ = -1;
+  SiteWrenchSensor ft_readings_;  // bound: MuJoCo's F/T readings without its sensor stage (all bodies)
+  std::vector<double> ft_qvel_;   // the velocities of an F/T step's forward pass (mj_step2 advances qvel)
   int anchor_site_ = -1;
   int drop_body_ = -1, drop_qadr_ = -1, drop_dadr_ = -1;
   int floor_geom_ = -1;
