@@ -53,7 +53,9 @@ public:
   virtual void tick(const Eigen::VectorXd& q_meas, const Eigen::VectorXd& qd_meas, const Eigen::VectorXd& tau_meas,
                     bool filter_tick, Eigen::VectorXd& current_out) = 0;
 
-  /// Which measurements the running mode reads (the plant draws sensor noise only for those).
+  /// Which measurements the running mode reads (the plant draws sensor noise only for those, and
+  /// reads the encoder for the loop only when it closes on position).
+  virtual bool uses_position() const = 0;
   virtual bool uses_velocity() const = 0;
   virtual bool uses_torque() const = 0;
 

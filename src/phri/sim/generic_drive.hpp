@@ -54,6 +54,7 @@ public:
                    const Eigen::VectorXd& tau_motor) override;
   void tick(const Eigen::VectorXd& q_meas, const Eigen::VectorXd& qd_meas, const Eigen::VectorXd& tau_meas,
             bool filter_tick, Eigen::VectorXd& current_out) override;
+  bool uses_position() const override { return mode_ == LowLevelMode::kPosition; }
   bool uses_velocity() const override { return mode_ == LowLevelMode::kPosition; }
   bool uses_torque() const override { return false; }
   void start_holding(const Eigen::VectorXd& tau) override { hold_torque_ = tau; }

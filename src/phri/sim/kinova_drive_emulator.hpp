@@ -67,6 +67,7 @@ public:
             bool filter_tick, Eigen::VectorXd& current_out) override;
 
   /// Which measurements the running mode reads (the plant draws sensor noise only for those).
+  bool uses_position() const override { return mode_ == LowLevelMode::kPosition; }
   bool uses_velocity() const override { return mode_ == LowLevelMode::kPosition || mode_ == LowLevelMode::kKinovaTorque; }
   bool uses_torque() const override {
     return mode_ == LowLevelMode::kKinovaTorque || mode_ == LowLevelMode::kKinovaTorqueHighVelocity;

@@ -108,6 +108,8 @@ SimRobot::SimRobot(const SimRobotConfig& config)
       n_(config_.dof()),
       drive_(make_drive_loops(config_, {}, {})) {
   substeps_ = config_.substeps_per_cycle();
+  motor_encoder_ = config_.elasticity.enabled &&
+                   config_.elasticity.position_loop_encoder == SimRobotConfig::Elasticity::Encoder::kMotor;
   filter_decimation_ = static_cast<int>(std::lround(config_.physics_rate_Hz / config_.vendor.high_velocity_rate_Hz));
   ft_decimation_ = static_cast<int>(std::lround(config_.physics_rate_Hz / config_.ft_sensor.rate_Hz));
 
@@ -458,7 +460,8 @@ void SimRobot::restart_noise_and_counters() {
   fault_ = false;
   has_pending_ = false;
   live_body_ = -1;
-  substep_count_ = 0;
+  filter_phase_ = 0;
+  ft_phase_ = 0;
   wrench_sequence_ = 0;
   state_ = RobotState(n_);
   truth_.drop_released = false;
@@ -564,7 +567,14 @@ void SimRobot::sample_ft_sensor(const double* force, const double* torque) {
   }
 }
 
-double SimRobot::quantize(double q) const { return quantum_ > 0.0 ? quantum_ * std::round(q / quantum_) : q; }
+// std::round(x) (half away from zero) without its libm call: x - trunc(x) is exact, so stepping
+// away from zero where that fraction reaches one half gives std::round's result to the bit.
+double SimRobot::quantize(double q) const {
+  if (quantum_ <= 0.0) return q;
+  const double x = q / quantum_;
+  const double whole = std::trunc(x);
+  return quantum_ * (std::abs(x - whole) >= 0.5 ? whole + std::copysign(1.0, x) : whole);
+}
 
 namespace {
 constexpr double kMaxFollowingError_rad = 5.0 * 3.14159265358979323846 / 180.0;
@@ -632,8 +642,12 @@ const RobotState& SimRobot::read() {
     has_pending_ = false;
   }
   drive_->begin_cycle(command_, fresh, q_meas_, vendor_torque());
+  // The mode is set for the period: what its loop reads, asked once.
+  drive_reads_position_ = drive_->uses_position();
+  drive_reads_velocity_ = drive_->uses_velocity();
+  drive_reads_torque_ = drive_->uses_torque();
   surrogate_peak_ = 0.0;
-  for (int s = 0; s < substeps_; ++s) substep();
+  for (int s = 0; s < substeps_; ++s) substep(s == substeps_ - 1);
   if (d_->warning[mjWARN_BADQACC].number > 0 || d_->warning[mjWARN_BADQVEL].number > 0 ||
       d_->warning[mjWARN_BADQPOS].number > 0) {
     fault_ = true;
@@ -643,13 +657,11 @@ const RobotState& SimRobot::read() {
 }
 
 double SimRobot::servo_position(int i) const {
-  const bool motor = elastic() && config_.elasticity.position_loop_encoder == SimRobotConfig::Elasticity::Encoder::kMotor;
-  return motor ? elastic_[static_cast<std::size_t>(i)].position() : d_->qpos[qadr_[static_cast<std::size_t>(i)]];
+  return motor_encoder_ ? elastic_[static_cast<std::size_t>(i)].position() : d_->qpos[qadr_[static_cast<std::size_t>(i)]];
 }
 
 double SimRobot::servo_velocity(int i) const {
-  const bool motor = elastic() && config_.elasticity.position_loop_encoder == SimRobotConfig::Elasticity::Encoder::kMotor;
-  return motor ? elastic_[static_cast<std::size_t>(i)].velocity() : d_->qvel[dadr_[static_cast<std::size_t>(i)]];
+  return motor_encoder_ ? elastic_[static_cast<std::size_t>(i)].velocity() : d_->qvel[dadr_[static_cast<std::size_t>(i)]];
 }
 
 // Rigid: dry friction from the current state (its damping enters MuJoCo's passive forces in
@@ -704,7 +716,7 @@ void SimRobot::finish_elastic() {
   }
 }
 
-void SimRobot::substep() {
+void SimRobot::substep(bool last_of_period) {
   // 1. Friction or spring from the current state, then positions, velocities, bias forces.
   if (elastic()) {
     prepare_elastic();
@@ -714,17 +726,17 @@ void SimRobot::substep() {
   mj_step1(m_.get(), d_.get());
   const double t = d_->time;
 
-  // 2. The drives' sensors and the vendor loop.
-  const bool noisy_velocity = drive_->uses_velocity();
-  const bool noisy_torque = drive_->uses_torque();
+  // 2. The drives' sensors and the vendor loop. The encoder is read when the loop closes on
+  //    position, and at the period's last step for the next period's mode entry (begin_cycle).
+  const bool read_encoder = drive_reads_position_ || last_of_period;
   const double sv = config_.noise.velocity_std_rad_s;
   const double st = config_.noise.torque_sensor_std_Nm;
   for (int i = 0; i < n_; ++i) {
-    q_meas_[i] = quantize(servo_position(i));
-    qd_meas_[i] = servo_velocity(i) + (noisy_velocity ? joint_noise_.normal(sv) : 0.0);
-    tau_meas_[i] = tau_s_[i] + offsets_[i] + (noisy_torque ? joint_noise_.normal(st) : 0.0);
+    if (read_encoder) q_meas_[i] = quantize(servo_position(i));
+    qd_meas_[i] = servo_velocity(i) + (drive_reads_velocity_ ? joint_noise_.normal(sv) : 0.0);
+    tau_meas_[i] = tau_s_[i] + offsets_[i] + (drive_reads_torque_ ? joint_noise_.normal(st) : 0.0);
   }
-  drive_->tick(q_meas_, qd_meas_, tau_meas_, substep_count_ % static_cast<std::uint64_t>(filter_decimation_) == 0, current_);
+  drive_->tick(q_meas_, qd_meas_, tau_meas_, filter_phase_ == 0, current_);
 
   // 3. Joint torques: rigid, motor and the explicit part of the dry friction; elastic, the spring.
   for (int i = 0; i < n_; ++i) {
@@ -739,7 +751,7 @@ void SimRobot::substep() {
 
   // 5. Step, with the F/T sensor evaluated on its sampling steps only (by MuJoCo's sensor stage
   //    when ft_readings_ cannot stand in for it).
-  const bool ft_step = sensor_site_ >= 0 && (substep_count_ + 1) % static_cast<std::uint64_t>(ft_decimation_) == 0;
+  const bool ft_step = sensor_site_ >= 0 && ft_phase_ == ft_decimation_ - 1;
   const bool ft_by_mujoco = ft_step && !ft_readings_.bound();
   if (ft_step && !ft_by_mujoco) mju_copy(ft_qvel_.data(), d_->qvel, m_->nv);
   if (ft_by_mujoco) m_->opt.disableflags &= ~mjDSBL_SENSOR;
@@ -764,7 +776,9 @@ void SimRobot::substep() {
     ++wrench_sequence_;
     wrench_stamp_ = t;
   }
-  ++substep_count_;
+  // Steps since the reset, modulo the slower loops' decimations.
+  if (++filter_phase_ == filter_decimation_) filter_phase_ = 0;
+  if (++ft_phase_ == ft_decimation_) ft_phase_ = 0;
 }
 
 void SimRobot::apply_force(int body, const Eigen::Vector3d& point_local, bool local_frame, const Eigen::Vector3d& force,

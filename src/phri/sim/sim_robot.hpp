@@ -179,7 +179,7 @@ private:
 
   // The F/T sample from MuJoCo's sensor readings (force, torque: site frame, on the tool).
   void sample_ft_sensor(const double* force, const double* torque);
-  void substep();
+  void substep(bool last_of_period);
   // Step 1 and 5 of substep() per transmission: rigid (friction and rotor inertia on the link) or
   // elastic (ElasticTransmission: the link feels the spring only).
   void prepare_rigid();
@@ -223,13 +223,17 @@ private:
   std::vector<ElasticTransmission> elastic_;  // empty: rigid transmission
   Eigen::VectorXd q_before_;                  // link angles at a physics step's start
   double quantum_ = 0.0;
+  bool motor_encoder_ = false;  // the vendor servo's encoder is on the rotor (elastic joints, motor side)
 
   std::unique_ptr<DriveLoops> drive_;  // made at reset() (not in the cycle)
   std::vector<double> hold_kp_, hold_kd_;  // drive generic: the position hold's gains (set_generic_hold_gains)
   RobotCommand command_, pending_;
   bool has_pending_ = false;
   bool fault_ = false;
-  std::uint64_t substep_count_ = 0;
+  int filter_phase_ = 0;  // physics steps since the reset, modulo filter_decimation_
+  int ft_phase_ = 0;      // and modulo ft_decimation_
+  // What the running mode's loop reads (DriveLoops::uses_*), for the period's steps.
+  bool drive_reads_position_ = false, drive_reads_velocity_ = false, drive_reads_torque_ = false;
 
   // per-step buffers
   Eigen::VectorXd q_meas_, qd_meas_, tau_meas_, current_, tau_motor_, tau_viscous_, tau_dry_, tau_s_;
