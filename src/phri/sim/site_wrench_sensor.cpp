@@ -38,18 +38,19 @@ void cross_force(mjtNum res[6], const mjtNum vel[6], const mjtNum f[6]) {
   res[2] += -vel[4] * f[3] + vel[3] * f[4];
 }
 
-#pragma GCC pop_options
-
-// res = the body's n dof axes (6 x n, one row per dof) applied to vec (MuJoCo's mju_mulDofVec).
-void mul_dof_vec(mjtNum res[6], const mjtNum* dof, const mjtNum* vec, int n) {
-  if (n == 1) {
-    mju_scl(res, dof, vec[0], 6);
-  } else if (n <= 0) {
-    mju_zero(res, 6);
-  } else {
-    mju_mulMatTVec(res, dof, vec, n, 6);
+// cacc = (parent + axis_dot v) + axis a for a body of at most one dof (no axes: none), rounded as
+// MuJoCo's mju_mulDofVec (mju_scl, or zeros), mju_add and mju_addTo round it, without their calls.
+void one_dof_acceleration(mjtNum cacc[6], const mjtNum parent[6], const mjtNum* axis_dot, const mjtNum* axis,
+                          mjtNum v, mjtNum a) {
+  for (int k = 0; k < 6; ++k) {
+    const mjtNum velocity_term = axis_dot ? axis_dot[k] * v : 0.0;
+    const mjtNum acceleration_term = axis ? axis[k] * a : 0.0;
+    cacc[k] = parent[k] + velocity_term;
+    cacc[k] += acceleration_term;
   }
 }
+
+#pragma GCC pop_options
 
 }  // namespace
 
@@ -83,13 +84,20 @@ SiteWrenchSensor::SiteWrenchSensor(const mjModel* m, int force_sensor, int /*tor
 // cacc = cacc_parent + cdof_dot qvel + cdof qacc, as mj_rnePostConstraint's forward pass.
 void SiteWrenchSensor::accelerate(const mjModel* m, const mjData* d, const double* qvel, int body) {
   const int dofs = m->body_dofnum[body];
-  const int adr = dofs > 0 ? m->body_dofadr[body] : 0;
+  const int adr = m->body_dofadr[body];
   mjtNum* cacc = cacc_.data() + 6 * body;
-  mjtNum tmp[6];
-  mul_dof_vec(tmp, d->cdof_dot + 6 * adr, qvel + adr, dofs);
-  mju_add(cacc, cacc_.data() + 6 * m->body_parentid[body], tmp, 6);
-  mul_dof_vec(tmp, d->cdof + 6 * adr, d->qacc + adr, dofs);
-  mju_addTo(cacc, tmp, 6);
+  const mjtNum* parent = cacc_.data() + 6 * m->body_parentid[body];
+  if (dofs == 1) {
+    one_dof_acceleration(cacc, parent, d->cdof_dot + 6 * adr, d->cdof + 6 * adr, qvel[adr], d->qacc[adr]);
+  } else if (dofs == 0) {
+    one_dof_acceleration(cacc, parent, nullptr, nullptr, 0.0, 0.0);
+  } else {  // a ball or free joint on the way: MuJoCo's mju_mulDofVec is then a matrix product
+    mjtNum tmp[6];
+    mju_mulMatTVec(tmp, d->cdof_dot + 6 * adr, qvel + adr, dofs, 6);
+    mju_add(cacc, parent, tmp, 6);
+    mju_mulMatTVec(tmp, d->cdof + 6 * adr, d->qacc + adr, dofs, 6);
+    mju_addTo(cacc, tmp, 6);
+  }
 }
 
 // The subtree's share of mj_rnePostConstraint's cfrc_ext: the applied forces (xfrc_applied).
