@@ -147,7 +147,9 @@ public:
   const Eigen::VectorXd& true_joint_positions() const override { return truth_.q_rad; }
   const Eigen::VectorXd& true_joint_velocities() const override { return truth_.qd_rad_s; }
 
-  /// MuJoCo model and data, read-only (viewers, tests comparing with MuJoCo's own quantities).
+  /// MuJoCo model and data, read-only (viewers, tests comparing with MuJoCo's own quantities). The
+  /// cycle runs without MuJoCo's sensor stage: sensordata, cacc and cfrc_* keep their values of the
+  /// initial F/T sample (the cycle's samples are in truth().wrench_sensor).
   const mjModel_* mujoco_model() const { return m_.get(); }
   const mjData_* mujoco_data() const { return d_.get(); }
   /// MJCF text of the scene that was loaded.
