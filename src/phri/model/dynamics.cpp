@@ -2,6 +2,7 @@
 // For a chain, body i's parent is body i-1, so the backward sweeps are plain running sums.
 #include <phri/model/algorithms.hpp>
 
+#include <array>
 
 namespace phri {
 namespace {
@@ -20,21 +21,71 @@ void update_body_inertias(const Model& model, Data& data) {
   }
 }
 
-// Composite inertias and M(q) = S^T Ic S (entries (j, i), j <= i, use the composite of i).
-void composite_rigid_body(const Model& model, Data& data) {
-  const int n = model.nq();
-  for (int i = n - 1; i >= 0; --i) {
-    WorldInertia& ic = data.composite_inertias[static_cast<std::size_t>(i)];
-    ic = data.body_inertias[static_cast<std::size_t>(i)];
-    if (i + 1 < n) ic += data.composite_inertias[static_cast<std::size_t>(i + 1)];
-    const Vector6d force = ic.apply(data.motion_subspace.col(i));
+// An inertia about the world origin as its ten parameters: mass, first moment h, upper triangle
+// of the symmetric rotational inertia I. Plain scalars, so that the CRBA's running sum stays in
+// registers: a WorldInertia went through the stack in pieces, and reading it back whole stalled on
+// store forwarding, which was most of the CRBA's own time.
+struct InertiaParameters {
+  double mass = 0.0;
+  double hx = 0.0, hy = 0.0, hz = 0.0;
+  double ixx = 0.0, iyy = 0.0, izz = 0.0, ixy = 0.0, ixz = 0.0, iyz = 0.0;
+
+  static InertiaParameters of(const WorldInertia& w) {
+    const Eigen::Matrix3d& r = w.rotational;
+    return {w.mass, w.first_moment.x(), w.first_moment.y(), w.first_moment.z(),
+            r(0, 0), r(1, 1), r(2, 2), r(0, 1), r(0, 2), r(1, 2)};
+  }
+  void add(const InertiaParameters& o) {
+    mass += o.mass;
+    hx += o.hx;
+    hy += o.hy;
+    hz += o.hz;
+    ixx += o.ixx;
+    iyy += o.iyy;
+    izz += o.izz;
+    ixy += o.ixy;
+    ixz += o.ixz;
+    iyz += o.iyz;
+  }
+  void store(WorldInertia& out) const {
+    out.mass = mass;
+    out.first_moment << hx, hy, hz;
+    out.rotational << ixx, ixy, ixz, ixy, iyy, iyz, ixz, iyz, izz;
+  }
+  /// The momentum for the unit motion s = (v; w): (m v - h x w; I w + h x v), as WorldInertia::apply.
+  std::array<double, 6> apply(const double* s) const {
+    const double vx = s[0], vy = s[1], vz = s[2], wx = s[3], wy = s[4], wz = s[5];
+    return {mass * vx - (hy * wz - hz * wy), mass * vy - (hz * wx - hx * wz), mass * vz - (hx * wy - hy * wx),
+            ixx * wx + ixy * wy + ixz * wz + (hy * vz - hz * vy), ixy * wx + iyy * wy + iyz * wz + (hz * vx - hx * vz),
+            ixz * wx + iyz * wy + izz * wz + (hx * vy - hy * vx)};
+  }
+};
+
+// Composite inertias and M(q) = S^T Ic S from the last body down (entries (j, i), j <= i, use the
+// composite of i), with F_i = Ic_i S_i in scalars too; body_inertia(i) is body i's inertia about
+// the world origin.
+template <class BodyInertia>
+void composite_rigid_body(const Model& model, Data& data, const BodyInertia& body_inertia) {
+  InertiaParameters composite;
+  for (int i = model.nq() - 1; i >= 0; --i) {
+    composite.add(body_inertia(i));
+    composite.store(data.composite_inertias[static_cast<std::size_t>(i)]);
+    const std::array<double, 6> f = composite.apply(&data.motion_subspace(0, i));
     for (int j = 0; j <= i; ++j) {
-      const double m = data.motion_subspace.col(j).dot(force);
+      const double* s = &data.motion_subspace(0, j);
+      const double m = s[0] * f[0] + s[1] * f[1] + s[2] * f[2] + s[3] * f[3] + s[4] * f[4] + s[5] * f[5];
       data.mass_matrix(j, i) = m;
       data.mass_matrix(i, j) = m;
     }
     data.mass_matrix(i, i) += model.joint(i).armature;
   }
+}
+
+// The CRBA on the inertias update_body_inertias left in data.
+void composite_rigid_body(const Model& model, Data& data) {
+  composite_rigid_body(model, data, [&data](int i) {
+    return InertiaParameters::of(data.body_inertias[static_cast<std::size_t>(i)]);
+  });
 }
 
 // Backward Newton-Euler sweep with the body velocities and accelerations already in Data.
