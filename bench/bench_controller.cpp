@@ -15,6 +15,8 @@
 #include <phri/core/statistics.hpp>
 #include <phri/sim/sim_robot.hpp>
 
+#include "pushed_gen3.hpp"
+
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -27,24 +29,8 @@ namespace {
 // The closed-loop run above with `configure` applied to the controller's settings.
 void time_cycles(benchmark::State& state, const std::function<void(phri::ControllerSettings&)>& configure) {
   const std::string root = PHRI_SOURCE_DIR;
-  phri::SimRobotConfig plant = phri::SimRobotConfig::from_yaml_file(root + "/configs/plant_gen3.yaml");
-  plant.initial_q_rad = {0, 0.58, 3.14, -1.84, 0, 0.85, 1.57};
-  plant.mismatch.enabled = true;
   constexpr int kCycles = 100000;
-  for (double start = 1.0; start < kCycles * 1e-3; start += 6.0) {
-    phri::ExternalForce elbow;
-    elbow.body = "forearm_link";
-    elbow.force_N = Eigen::Vector3d(0, 30, 0);
-    elbow.profile = phri::ExternalForce::Profile::kHalfSine;
-    elbow.start_s = start;
-    elbow.duration_s = 1.0;
-    plant.disturbances.push_back(elbow);
-    phri::ExternalForce hand = elbow;
-    hand.body = "tool";
-    hand.force_N = Eigen::Vector3d(0, -15, 0);
-    hand.start_s = start + 3.0;
-    plant.disturbances.push_back(hand);
-  }
+  const phri::SimRobotConfig plant = pushed_gen3_plant(kCycles * 1e-3);
   phri::SimRobot robot(plant);
   phri::ControllerSettings settings;
   phri::RobotBundle::from_folder(root + "/robots/kinova_gen3").apply_to(settings);  // files, frames, end of arm

@@ -1,8 +1,8 @@
-// The log writer's work off the control thread: 20,000 rows of a closed-loop run on the simulated
-// Gen3 (SimRobot with its noise and 5 % mismatch, pushes on the elbow and the tool, dual compliance:
-// rows as a real run logs them, recorded once before timing) written as CSV text (Logger::csv_line,
-// one fwrite per MiB) or as the MCAP log (McapLogWriter: CDR encoding, zstd chunks, indexes,
-// summary). Reports rows per second of writer time and bytes per row of the file:
+// The log writer's work off the control thread: 20,000 rows of the controller benchmarks' closed
+// loop (pushed_gen3.hpp; dual compliance: rows as a real run logs them, recorded once before
+// timing) written as CSV text (Logger::csv_line, one fwrite per MiB) or as the MCAP log
+// (McapLogWriter: CDR encoding, zstd chunks, indexes, summary). Reports rows per second of writer
+// time and bytes per row of the file:
 //   build/release/bench/phri_bench --benchmark_filter=LogWriter
 #include <phri/app/fill_log_row.hpp>
 #include <phri/app/logger.hpp>
@@ -10,6 +10,8 @@
 #include <phri/config/robot_bundle.hpp>
 #include <phri/control/controller.hpp>
 #include <phri/sim/sim_robot.hpp>
+
+#include "pushed_gen3.hpp"
 
 #include <benchmark/benchmark.h>
 
@@ -23,23 +25,8 @@ namespace {
 const std::vector<phri::LogRow>& recorded_rows() {
   static const std::vector<phri::LogRow> rows = [] {
     const std::string root = PHRI_SOURCE_DIR;
-    phri::SimRobotConfig plant = phri::SimRobotConfig::from_yaml_file(root + "/configs/plant_gen3.yaml");
-    plant.initial_q_rad = {0, 0.58, 3.14, -1.84, 0, 0.85, 1.57};
-    plant.mismatch.enabled = true;
     constexpr int kRows = 20000;
-    for (double start = 1.0; start < kRows * 1e-3; start += 6.0) {
-      phri::ExternalForce push;
-      push.body = "forearm_link";
-      push.force_N = Eigen::Vector3d(0, 30, 0);
-      push.profile = phri::ExternalForce::Profile::kHalfSine;
-      push.start_s = start;
-      push.duration_s = 1.0;
-      plant.disturbances.push_back(push);
-      push.body = "tool";
-      push.force_N = Eigen::Vector3d(0, -15, 0);
-      push.start_s = start + 3.0;
-      plant.disturbances.push_back(push);
-    }
+    const phri::SimRobotConfig plant = pushed_gen3_plant(kRows * 1e-3);
     phri::SimRobot robot(plant);
     phri::ControllerSettings settings;
     phri::RobotBundle::from_folder(root + "/robots/kinova_gen3").apply_to(settings);

@@ -289,7 +289,7 @@ TEST_F(ConstraintTest, SelfCollisionBroadPhaseSkipsOnlyPairsThatBoundNothingAndL
   std::mt19937 rng(20261128);
   std::uniform_real_distribution<double> joint(-2.5, 2.5), speed(-2.0, 2.0);
   const int n = collision.num_pairs();
-  int skipped = 0, kept = 0;
+  int skipped = 0, kept = 0, far = 0;
   for (int trial = 0; trial < 2000; ++trial) {
     Eigen::VectorXd q(7), qd(7);
     for (int i = 0; i < 7; ++i) {
@@ -307,8 +307,18 @@ TEST_F(ConstraintTest, SelfCollisionBroadPhaseSkipsOnlyPairsThatBoundNothingAndL
     Eigen::VectorXd l_full(n);
     for (int p = 0; p < n; ++p) {
       const double d = full.distance[p], d_dot = full.velocity[p];
-      ASSERT_EQ(constraint.data().distance[p], d);
-      ASSERT_EQ(constraint.data().velocity[p], d_dot);
+      // The bounding spheres' bounds hold; a pair they show to be far keeps its lower bound.
+      const phri::CollisionData& got = constraint.data();
+      ASSERT_LE(got.distance_lower_bound[p], d + 1e-12);
+      ASSERT_LE(-d_dot, got.approach_speed_bound[p] + 1e-12);
+      if (got.distance[p] == got.distance_lower_bound[p] && got.distance[p] != d) {
+        ++far;
+        ASSERT_GE(got.distance[p], 0.03);
+        ASSERT_EQ(got.velocity[p], 0.0);
+      } else {
+        ASSERT_EQ(got.distance[p], d);
+        ASSERT_EQ(got.velocity[p], d_dot);
+      }
       const double lower = d < 0.03 ? damper.min_acceleration(d, d_dot) : -std::numeric_limits<double>::infinity();
       l_full[p] = std::max(lower, phri::collision_braking_bound(d, d_dot, 0.015, braking)) - full.jdot_qdot[p];
       a_full.row(p) = full.jacobian.row(p);
@@ -342,9 +352,11 @@ TEST_F(ConstraintTest, SelfCollisionBroadPhaseSkipsOnlyPairsThatBoundNothingAndL
       EXPECT_TRUE(x_broad == solver.x()) << "trial " << trial;
     }
   }
-  std::printf("broad phase over 2000 random states: %d pair rows kept, %d skipped\n", kept, skipped);
+  std::printf("broad phase over 2000 random states: %d pair rows kept, %d skipped (%d without closest points)\n", kept,
+              skipped, far);
   EXPECT_GT(skipped, 0);
   EXPECT_GT(kept, 0);
+  EXPECT_GT(far, 0);
 }
 
 // The braking row ahead of the collision damper (self_collision_constraint.hpp) on a distance

@@ -251,6 +251,67 @@ TEST_F(ModelFiniteDifferences, CoriolisTransposeTimesVelocityIsTheKineticEnergyG
   }
 }
 
+// ------------------------------------------------------------------- CRBA against the textbook sum
+// M = sum_k J_k^T I_k J_k + armature: body k's world spatial Jacobian (the S_j of the joints j <= k)
+// through its 6 x 6 spatial inertia about the world origin, built here from the model's local inertia
+// and the body placement. No composite inertia, no recursion: an independent check of the CRBA.
+Eigen::Matrix<double, 6, 6> spatial_inertia_in_world(const phri::Inertia& local, const Eigen::Isometry3d& placement) {
+  const Eigen::Vector3d c = placement * local.com;
+  const Eigen::Matrix3d rotation = placement.linear();
+  Eigen::Matrix3d c_hat;  // c_hat x = c.cross(x)
+  c_hat << 0.0, -c.z(), c.y(), c.z(), 0.0, -c.x(), -c.y(), c.x(), 0.0;
+  Eigen::Matrix<double, 6, 6> inertia;
+  inertia << local.mass * Eigen::Matrix3d::Identity(), -local.mass * c_hat,  //
+      local.mass * c_hat, rotation * local.inertia_com * rotation.transpose() - local.mass * c_hat * c_hat;
+  return inertia;
+}
+
+// The sum with the placements and motion subspaces that forward kinematics left in data.
+Eigen::MatrixXd mass_matrix_as_sum_over_bodies(const phri::Model& model, const phri::Data& data) {
+  const int n = model.nv();
+  Eigen::MatrixXd mass = Eigen::MatrixXd::Zero(n, n);
+  for (int k = 0; k < n; ++k) {
+    Eigen::MatrixXd jacobian = Eigen::MatrixXd::Zero(6, n);
+    jacobian.leftCols(k + 1) = data.motion_subspace.leftCols(k + 1);
+    mass += jacobian.transpose() *
+            spatial_inertia_in_world(model.body_inertia(k), data.body_placements[static_cast<std::size_t>(k)]) * jacobian;
+  }
+  for (int i = 0; i < n; ++i) mass(i, i) += model.joint(i).armature;
+  return mass;
+}
+
+double relative_difference(const Eigen::MatrixXd& value, const Eigen::MatrixXd& reference) {
+  return (value - reference).cwiseAbs().maxCoeff() / reference.cwiseAbs().maxCoeff();
+}
+
+// The Gen3 (revolute joints about their local z), the random chains of test_robots (any axis,
+// prismatic joints, armature) and a 30-DoF random chain; crba and compute_all_terms (which runs the
+// same composite pass on the inertias of its own forward pass).
+TEST(ModelCrba, MassMatrixIsTheSumOverBodiesOfJacobianInertiaJacobianToRounding) {
+  std::vector<Robot> robots = test_robots();
+  std::mt19937 rng(19);
+  robots.push_back({phri::Model::from_urdf_string(phri::test::make_random_chain(30, rng).urdf), "30-dof random"});
+  int prismatic = 0, revolute_off_z = 0;
+  for (const auto& [model, name] : robots) {
+    for (const phri::Joint& joint : model.joints()) {
+      if (joint.type == phri::JointType::kPrismatic) ++prismatic;
+      else if (!joint.axis.isApprox(Eigen::Vector3d::UnitZ())) ++revolute_off_z;
+    }
+    phri::Data data(model);
+    for (int sample = 0; sample < 20; ++sample) {
+      const Eigen::VectorXd q = random_vector(model.nq(), 3.0, rng);
+      const Eigen::MatrixXd mass = phri::crba(model, data, q);
+      const Eigen::MatrixXd reference = mass_matrix_as_sum_over_bodies(model, data);
+      EXPECT_LT(relative_difference(mass, reference), 1e-12) << name << " sample " << sample;
+      EXPECT_EQ(mass, mass.transpose()) << name;
+      ASSERT_TRUE(phri::compute_all_terms(model, data, q, random_vector(model.nv(), 1.0, rng)));
+      EXPECT_LT(relative_difference(data.mass_matrix, reference), 1e-12) << name << " sample " << sample;
+    }
+  }
+  EXPECT_GT(prismatic, 0);  // the general joints are covered, not only the Gen3's
+  EXPECT_GT(revolute_off_z, 0);
+}
+
 // ------------------------------------------------------------------- Kinova's own FK figures
 TEST(Gen3Model, ForwardKinematicsMatchesKinovaTable) {
   const phri::Model model = phri::Model::from_urdf_file(kGen3Urdf);

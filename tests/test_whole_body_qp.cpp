@@ -13,6 +13,7 @@
 
 #include <Eigen/QR>
 #include <gtest/gtest.h>
+#include <unsupported/Eigen/MatrixFunctions>
 
 #include <random>
 
@@ -385,6 +386,45 @@ TEST(SingularDirectionWeightTest, IsContinuousThroughTheSingularity) {
   }
   // Step in t: 5e-4; f = (sigma / 0.03)^2 changes by at most 2 sigma dsigma / 0.03^2 ~ 0.04 a step.
   EXPECT_LT(worst, 0.05);
+}
+
+// Along a path that stays near a singularity (one weak direction, turning a little each step) the
+// weight is tracked from the last weak direction instead of decomposed anew: the same W as a fresh
+// eigen-decomposition to 1e-12; two weak directions, or a jump, go back to the decomposition.
+TEST(SingularDirectionWeightTest, TrackingTheWeakDirectionGivesTheDecompositionsWeight) {
+  std::mt19937 rng(11);
+  std::normal_distribution<double> normal;
+  const Eigen::MatrixXd v = Eigen::HouseholderQR<Eigen::MatrixXd>(
+                                Eigen::MatrixXd::NullaryExpr(7, 7, [&] { return normal(rng); })).householderQ();
+  auto jacobian_at = [&](double t, double second) {
+    // U turns with t; the weakest singular value goes through zero and back, the second stays put.
+    Eigen::Matrix<double, 6, 6> generator = Eigen::Matrix<double, 6, 6>::Zero();
+    generator(0, 5) = 1.0, generator(5, 0) = -1.0, generator(2, 4) = 0.5, generator(4, 2) = -0.5;
+    const Eigen::Matrix<double, 6, 6> u = (t * generator).exp();
+    Eigen::MatrixXd s = Eigen::MatrixXd::Zero(6, 7);
+    s.diagonal() << 1.5, 1.1, 0.8, 0.4, second, 0.02 * std::cos(3.0 * t);
+    return Eigen::MatrixXd(u * s * v.transpose());
+  };
+  phri::SingularDirectionWeight tracked(0.03);
+  double worst = 0.0;
+  int steps = 0;
+  for (double t = 0.0; t < 2.0; t += 1e-3, ++steps) {
+    const Eigen::MatrixXd j = jacobian_at(t, 0.3);
+    phri::SingularDirectionWeight fresh(0.03);
+    ASSERT_EQ(tracked.update(j), fresh.update(j)) << "t " << t;
+    if (!fresh.active()) continue;
+    worst = std::max(worst, (tracked.weight() - fresh.weight()).norm());
+    EXPECT_NEAR(tracked.smallest_singular_value(), fresh.smallest_singular_value(), 1e-10);
+  }
+  EXPECT_LT(worst, 1e-12);
+  EXPECT_LT(tracked.decompositions(), steps / 10) << "tracked, not decomposed, on most steps";
+  // A second weak direction: the decomposition decides, and agrees.
+  const long before = tracked.decompositions();
+  const Eigen::MatrixXd two = jacobian_at(2.0, 0.01);
+  phri::SingularDirectionWeight fresh(0.03);
+  ASSERT_TRUE(tracked.update(two) && fresh.update(two));
+  EXPECT_EQ(tracked.decompositions(), before + 1);
+  EXPECT_LT((tracked.weight() - fresh.weight()).norm(), 1e-12);
 }
 
 // Near the Gen3's outstretched elbow (q4 = 0.07: sigma_min ~ 0.01, the arm cannot reach further

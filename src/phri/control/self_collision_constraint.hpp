@@ -65,17 +65,29 @@ public:
 
   /// Distances at the current state (data: after the model terms), then one row per pair. A pair
   /// beyond the influence distance whose braking row is left out bounds nothing (-inf <= row):
-  /// its row is zero and its Jacobian is not computed (the broad phase; the QP is the same).
+  /// its row is zero and its Jacobian is not computed; a pair whose bounding spheres already show
+  /// that (distance bound beyond the influence distance, approach too slow for the braking row
+  /// there: the bound grows with distance) gets no closest points either, and data().distance
+  /// holds that lower bound for it (the broad phase; the QP is the same).
   template <class Rows, class Bound>
   void rows(const Model& model, const Data& data, Rows&& a, Bound&& l, Bound&& u) {
-    compute_collision_distance_rates(model, data, *collision_, data_);
+    compute_collision_bounds(model, data, *collision_, data_);
     constexpr double kInf = std::numeric_limits<double>::infinity();
     braking_binds_ = false;
     for (int p = 0; p < num_rows(); ++p) {
       u[p] = kInf;
+      const double bound = data_.distance_lower_bound[p];
+      const bool far = bound >= influence_distance_ &&
+                       collision_braking_bound(bound, -data_.approach_speed_bound[p], safety_distance_, braking_) == -kInf;
+      if (far) {
+        data_.distance[p] = bound;
+        data_.velocity[p] = 0.0;
+      } else {
+        compute_collision_pair_distance_rate(model, data, *collision_, p, data_);
+      }
       const double d = data_.distance[p];
       const double d_dot = data_.velocity[p];
-      if (d >= influence_distance_ && collision_braking_bound(d, d_dot, safety_distance_, braking_) == -kInf) {
+      if (far || (d >= influence_distance_ && collision_braking_bound(d, d_dot, safety_distance_, braking_) == -kInf)) {
         a.row(p).setZero();
         data_.jacobian.row(p).setZero();
         data_.jdot_qdot[p] = 0.0;

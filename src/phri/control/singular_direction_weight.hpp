@@ -24,11 +24,17 @@
 // and the task is exactly the paper's (W is then not even formed: update() says false).
 //
 // The test is cheap: every sigma_i >= sigma_0 exactly when J J^T - sigma_0^2 I has a Cholesky
-// factor (6 x 6); only when it has none is the eigen-decomposition computed. Fixed-size, no
-// allocation.
+// factor (6 x 6). Near a singularity one direction is weak, cycle after cycle, and its direction
+// moves little in a millisecond: W = I - (1 - f_w) u_w u_w^T is then updated from the last u_w by
+// Rayleigh-quotient iteration (cubic convergence, two or three 6 x 6 solves) and accepted only when
+// checked exact: the residual |A u - mu u| at rounding level, mu below sigma_0^2, and every other
+// eigenvalue at or above it (A - sigma_0^2 I + c u u^T has a Cholesky factor). Otherwise (first
+// cycle near the singularity, two weak directions, a check failing) the eigen-decomposition decides,
+// as it always did. Fixed-size, no allocation.
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
 #include <Eigen/Eigenvalues>
+#include <Eigen/LU>
 
 #include <algorithm>
 #include <cmath>
@@ -54,15 +60,13 @@ public:
     shifted_ = jjt_;
     shifted_.diagonal().array() -= threshold;
     llt_.compute(shifted_);
-    if (llt_.info() == Eigen::Success) return false;
-    eigen_.compute(jjt_);
-    const Eigen::Matrix<double, 6, 1>& lambda = eigen_.eigenvalues();
-    if (lambda.minCoeff() >= threshold) return false;
-    for (int i = 0; i < 6; ++i) factor_[i] = std::clamp(lambda[i] / threshold, 0.0, 1.0);
-    weight_.noalias() = eigen_.eigenvectors() * factor_.asDiagonal() * eigen_.eigenvectors().transpose();
-    smallest_singular_value_ = std::sqrt(std::max(0.0, lambda.minCoeff()));
-    active_ = true;
-    return true;
+    if (llt_.info() == Eigen::Success) {
+      has_weak_direction_ = false;
+      return false;
+    }
+    active_ = has_weak_direction_ && track_weak_direction(threshold);
+    if (!active_) active_ = decompose(threshold);
+    return active_;
   }
 
   bool active() const { return active_; }
@@ -71,15 +75,69 @@ public:
   double smallest_singular_value() const { return smallest_singular_value_; }
   double threshold() const { return sigma0_; }
 
+  /// Updates since construction that the eigen-decomposition decided (the rest: tracked or skipped).
+  long decompositions() const { return decompositions_; }
+
 private:
+  // The eigen-decomposition of J J^T; remembers the weak direction when there is exactly one.
+  bool decompose(double threshold) {
+    ++decompositions_;
+    eigen_.compute(jjt_);
+    const Eigen::Matrix<double, 6, 1>& lambda = eigen_.eigenvalues();  // ascending
+    has_weak_direction_ = lambda[0] < threshold && lambda[1] >= threshold;
+    if (lambda[0] >= threshold) return false;
+    if (has_weak_direction_) weak_ = eigen_.eigenvectors().col(0);
+    for (int i = 0; i < 6; ++i) factor_[i] = std::clamp(lambda[i] / threshold, 0.0, 1.0);
+    weight_.noalias() = eigen_.eigenvectors() * factor_.asDiagonal() * eigen_.eigenvectors().transpose();
+    smallest_singular_value_ = std::sqrt(std::max(0.0, lambda[0]));
+    return true;
+  }
+
+  // Rayleigh-quotient iteration from the last weak direction; true (W formed) only when the result
+  // is checked to be the one eigenvalue below the threshold, to rounding.
+  bool track_weak_direction(double threshold) {
+    const double scale = jjt_.norm() + threshold;
+    Eigen::Matrix<double, 6, 1> u = weak_;
+    double mu = u.dot(jjt_ * u);
+    bool converged = (jjt_ * u - mu * u).norm() <= 1e-14 * scale;
+    for (int iteration = 0; iteration < 4 && !converged; ++iteration) {
+      shifted_ = jjt_;
+      shifted_.diagonal().array() -= mu;
+      lu_.compute(shifted_);
+      Eigen::Matrix<double, 6, 1> next = lu_.solve(u);
+      const double norm = next.norm();
+      if (!std::isfinite(norm) || norm == 0.0) return false;
+      u = next / norm;
+      mu = u.dot(jjt_ * u);
+      converged = (jjt_ * u - mu * u).norm() <= 1e-14 * scale;
+    }
+    if (!converged || mu >= threshold) return false;
+    // Every other eigenvalue >= the threshold: A - t I with u's eigenvalue lifted by c > t is PD.
+    shifted_ = jjt_;
+    shifted_.diagonal().array() -= threshold;
+    shifted_.noalias() += (2.0 * scale) * u * u.transpose();
+    llt_.compute(shifted_);
+    if (llt_.info() != Eigen::Success) return false;
+    weak_ = u;
+    const double lambda = std::max(0.0, mu);
+    weight_.setIdentity();
+    weight_.noalias() -= (1.0 - std::min(1.0, lambda / threshold)) * u * u.transpose();
+    smallest_singular_value_ = std::sqrt(lambda);
+    return true;
+  }
+
   double sigma0_;
   bool active_ = false;
+  bool has_weak_direction_ = false;  // the last update had exactly one eigenvalue below the threshold
+  long decompositions_ = 0;
+  Eigen::Matrix<double, 6, 1> weak_ = Eigen::Matrix<double, 6, 1>::Zero();
   double smallest_singular_value_ = 0.0;
   Matrix6d jjt_ = Matrix6d::Zero();
   Matrix6d shifted_ = Matrix6d::Zero();
   Matrix6d weight_ = Matrix6d::Identity();
   Eigen::Matrix<double, 6, 1> factor_ = Eigen::Matrix<double, 6, 1>::Ones();
   Eigen::LLT<Matrix6d> llt_{6};
+  Eigen::PartialPivLU<Matrix6d> lu_{6};
   Eigen::SelfAdjointEigenSolver<Matrix6d> eigen_{6};
 };
 

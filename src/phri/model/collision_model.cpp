@@ -106,7 +106,11 @@ CollisionData::CollisionData(const Model& model, const CollisionModel& collision
       s(Eigen::VectorXd::Zero(collision.num_pairs())),
       t(Eigen::VectorXd::Zero(collision.num_pairs())),
       scratch_first(Eigen::MatrixXd::Zero(3, model.nv())),
-      scratch_second(Eigen::MatrixXd::Zero(3, model.nv())) {}
+      scratch_second(Eigen::MatrixXd::Zero(3, model.nv())),
+      capsule_center(Eigen::Matrix3Xd::Zero(3, static_cast<Eigen::Index>(collision.capsules().size()))),
+      capsule_speed(Eigen::VectorXd::Zero(static_cast<Eigen::Index>(collision.capsules().size()))),
+      distance_lower_bound(Eigen::VectorXd::Zero(collision.num_pairs())),
+      approach_speed_bound(Eigen::VectorXd::Zero(collision.num_pairs())) {}
 
 namespace {
 const Eigen::Isometry3d& placement_of(const Model& model, const Data& data, int body) {
@@ -163,6 +167,36 @@ void pair_distance(const Model& model, const Data& data, const CollisionModel& c
 void compute_collision_distance_rates(const Model& model, const Data& data, const CollisionModel& collision,
                                       CollisionData& out) {
   for (int k = 0; k < collision.num_pairs(); ++k) pair_distance(model, data, collision, k, true, out);
+}
+
+void compute_collision_pair_distance_rate(const Model& model, const Data& data, const CollisionModel& collision, int k,
+                                          CollisionData& out) {
+  pair_distance(model, data, collision, k, true, out);
+}
+
+void compute_collision_bounds(const Model& model, const Data& data, const CollisionModel& collision, CollisionData& out) {
+  const std::vector<Capsule>& capsules = collision.capsules();
+  for (std::size_t c = 0; c < capsules.size(); ++c) {
+    const Capsule& capsule = capsules[c];
+    const Eigen::Vector3d center = placement_of(model, data, capsule.body) * (0.5 * (capsule.p0 + capsule.p1));
+    const auto i = static_cast<Eigen::Index>(c);
+    out.capsule_center.col(i) = center;
+    if (capsule.body < 0) {
+      out.capsule_speed[i] = 0.0;
+      continue;
+    }
+    const double angular = data.body_velocities.col(capsule.body).tail<3>().norm();
+    out.capsule_speed[i] = body_point_velocity(model, data, capsule.body, center).norm() +
+                           angular * 0.5 * (capsule.p1 - capsule.p0).norm();
+  }
+  for (int k = 0; k < collision.num_pairs(); ++k) {
+    const CapsulePair& pair = collision.pairs()[static_cast<std::size_t>(k)];
+    const Capsule& a = capsules[static_cast<std::size_t>(pair.first)];
+    const Capsule& b = capsules[static_cast<std::size_t>(pair.second)];
+    const double reach = 0.5 * (a.p1 - a.p0).norm() + a.radius + 0.5 * (b.p1 - b.p0).norm() + b.radius;
+    out.distance_lower_bound[k] = (out.capsule_center.col(pair.first) - out.capsule_center.col(pair.second)).norm() - reach;
+    out.approach_speed_bound[k] = out.capsule_speed[pair.first] + out.capsule_speed[pair.second];
+  }
 }
 
 void compute_collision_distances(const Model& model, const Data& data, const CollisionModel& collision,

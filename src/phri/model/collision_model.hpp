@@ -57,6 +57,12 @@ struct CollisionData {
   Eigen::VectorXd s, t;            ///< where the closest points are along each axis, in [0, 1]
   Eigen::MatrixXd scratch_first;   ///< 3 x nv point Jacobians (workspace)
   Eigen::MatrixXd scratch_second;
+  // compute_collision_bounds: per capsule its axis's midpoint (world) and the fastest speed of a
+  // point of its axis; per pair a lower bound on the distance and an upper bound on -d(distance)/dt.
+  Eigen::Matrix3Xd capsule_center;
+  Eigen::VectorXd capsule_speed;
+  Eigen::VectorXd distance_lower_bound;
+  Eigen::VectorXd approach_speed_bound;
 };
 
 /// Distances of every pair from the body placements in `data` (after forward_kinematics).
@@ -68,6 +74,14 @@ void compute_collision_distances(const Model& model, const Data& data, const Col
 /// broad phase of a constraint that needs the Jacobian of the pairs near their limit only.
 void compute_collision_distance_rates(const Model& model, const Data& data, const CollisionModel& collision,
                                       CollisionData& out);
+/// Bounds of every pair from bounding spheres, without the segments' closest points: distance >=
+/// |c_a - c_b| - (h_a + r_a) - (h_b + r_b) (c: the axis's midpoint, h: half its length) and
+/// -d(distance)/dt <= the two axes' fastest point speeds |v(c)| + |omega| h (requires velocities).
+/// A pair whose bounds show it cannot matter to a constraint needs no closest points.
+void compute_collision_bounds(const Model& model, const Data& data, const CollisionModel& collision, CollisionData& out);
+/// Distance, closest points, normal and rate of pair k (requires velocities).
+void compute_collision_pair_distance_rate(const Model& model, const Data& data, const CollisionModel& collision, int k,
+                                          CollisionData& out);
 /// The distance Jacobian and J̇q̇ of pair k (requires drift accelerations), after
 /// compute_collision_distance_rates (or compute_collision_distances) of the same state.
 void compute_collision_pair_derivatives(const Model& model, const Data& data, const CollisionModel& collision, int k,

@@ -330,10 +330,16 @@ Index QpSolver::load_rows(const Eigen::MatrixXd& a, Index first) {
   bool in_range = true;
   for (Index i = 0; i < m; ++i) in_range &= scale[i] >= min_scale && scale[i] <= max_scale;
   if (!in_range) {
-    // Rare: non-finite, zero, or so large or small that the squares leave the double range.
+    // Non-finite, zero (a constraint's row that bounds nothing this cycle: common), or so large or
+    // small that the squares leave the double range (rare).
     for (Index i = 0; i < m; ++i) {
       if (scale[i] >= min_scale && scale[i] <= max_scale) continue;
       if (!a.row(i).allFinite()) return i;
+      if ((a.row(i).array() == 0.0).all()) {
+        scale[i] = 0.0;
+        has_null_rows_ = true;
+        continue;
+      }
       const double norm = a.row(i).stableNorm();
       scale[i] = norm > 0.0 && norm <= kMax ? 1.0 / norm : 0.0;
       has_null_rows_ |= scale[i] == 0.0;
