@@ -22,6 +22,9 @@ void add_ros2_options(CLI::App& run, Ros2Arguments& args) {
   run.add_option("--ros-domain", args.domain, "ROS 2 domain id (default: the configuration's, else ROS_DOMAIN_ID, else 0)")
       ->check(CLI::Range(0, 232))->needs(ros2);
   run.add_option("--ros-namespace", args.topic_namespace, "namespace of phri's own topics (default /phri)")->needs(ros2);
+  run.add_option("--ros-discovery", args.discovery, "loopback (this machine, unicast, no multicast) or network (Cyclone's "
+                 "defaults, or the file CYCLONEDDS_URI names; docs/ros2.md); default: the configuration's, else loopback")
+      ->check(CLI::IsMember({"loopback", "network"}))->needs(ros2);
   run.add_flag("--ros-ft-in", args.ft_in, "the F/T sensor from <namespace>/ft_in (another machine's `phri ft-bridge`), "
                "checked like the arm's own; needs --realtime")->needs(ros2);
 }
@@ -33,6 +36,7 @@ void apply_ros2_arguments(const Ros2Arguments& args, phri::Ros2Settings& setting
   if (args.enabled) settings.enabled = true;
   if (args.domain >= 0) settings.domain = args.domain;
   if (args.ft_in) settings.ft_in = true;
+  if (!args.discovery.empty()) settings.discovery = args.discovery;
   if (!args.topic_namespace.empty()) {
     if (!phri::valid_ros_namespace(args.topic_namespace)) {
       throw phri::ConfigError("--ros-namespace", "", "a ROS 2 namespace such as /phri ('/' then [A-Za-z0-9_] segments), got '" +

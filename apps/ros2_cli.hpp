@@ -20,6 +20,7 @@ struct Ros2Arguments {
   int domain = -1;              ///< -1: the configuration's (else ROS_DOMAIN_ID, else 0)
   std::string topic_namespace;  ///< empty: the configuration's
   bool ft_in = false;           ///< the F/T sensor from <namespace>/ft_in
+  std::string discovery;        ///< loopback | network; empty: the configuration's
 };
 
 void add_ros2_options(CLI::App& run, Ros2Arguments& args);
