@@ -304,6 +304,13 @@ private:
     return true;
   }
 
+  // The operator's wrench at the end effector as the touch trigger reads it: the F/T sensor's, or,
+  // without one, the estimate from the observer's tau_ext.
+  double operator_wrench_norm() const {
+    return cycle_.touch_source() == Controller::TouchSource::kForceTorque ? cycle_.wrench().norm()
+                                                                           : cycle_.estimated_wrench().norm();
+  }
+
   // Adds the cycle to its phase's sums; returns the end-effector position error [mm] (the true one
   // when the run has a ground truth, else the QP's task error).
   double accumulate_phase() {
@@ -312,7 +319,7 @@ private:
     const double qp_pos = 1e3 * error.head<3>().norm();
     double pos = qp_pos, ori = error.tail<3>().norm() * 180.0 / std::numbers::pi;
     true_ee_error(pos, ori);
-    a.add(pos, ori, cycle_.wrench().norm(), qp_pos);
+    a.add(pos, ori, operator_wrench_norm(), qp_pos);
     const ComplianceController& compliance = cycle_.compliance();
     if (compliance.mode() != last_mode_ || compliance.touch_count() != last_touches_) ++a.compliance_switches;
     if (cycle_.low_level().switch_count() != last_loop_switches_) ++a.loop_switches;
@@ -379,7 +386,7 @@ private:
     const std::string_view loop = to_string(cycle_.low_level().loop());
     std::snprintf(line, sizeof line, "t %6.2f s | %-10.*s | loop %-27.*s | EE error %6.2f mm | wrench %5.1f | cycle %5.1f us",
                   t, static_cast<int>(mode.size()), mode.data(), static_cast<int>(loop.size()), loop.data(), pos,
-                  cycle_.wrench().norm(), us);
+                  operator_wrench_norm(), us);
     if (tty_) {
       out_ << "\r" << line << std::flush;
     } else {

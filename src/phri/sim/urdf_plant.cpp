@@ -206,7 +206,8 @@ private:
         format_general(moments[0], 6) + " + " + format_general(moments[1], 6) + " < " + format_general(moments[2], 6);
     if (!options_.balance_inertia) {
       fail(where, "inertia violates the triangle inequality (" + sum +
-                      "): MuJoCo cannot simulate it; set the plant's balance_inertia to let MuJoCo balance it");
+                      "): MuJoCo cannot simulate it; set plant.balance_inertia: true (robot.yaml, or the plant YAML's "
+                      "balance_inertia) to let MuJoCo balance it in the plant");
     }
     warnings_.push_back(ConfigError(source_, where, "inertia violates the triangle inequality (" + sum +
                                                         "); the plant uses MuJoCo's balanceinertia (moments changed)")
