@@ -8,6 +8,8 @@
 #include <phri/control/controller.hpp>
 #include <phri/sim/sim_robot.hpp>
 
+#include "pushed_gen3.hpp"
+
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -16,30 +18,9 @@
 
 namespace {
 
-// The scenario, as python/bench/bench_loop.py builds it: the paper demo's posture, 5 % model
-// mismatch, a push on the elbow and one on the tool every 6 s, dual compliance, the custom loop.
-phri::SimRobotConfig plant(double seconds) {
-  const std::string root = PHRI_SOURCE_DIR;
-  phri::SimRobotConfig config = phri::SimRobotConfig::from_yaml_file(root + "/configs/plant_gen3.yaml");
-  config.initial_q_rad = {0.0, 0.58, 3.14, -1.84, 0.0, 0.85, 1.57};
-  config.mismatch.enabled = true;
-  for (double start = 1.0; start < seconds; start += 6.0) {
-    phri::ExternalForce elbow;
-    elbow.body = "forearm_link";
-    elbow.force_N = Eigen::Vector3d(0.0, 30.0, 0.0);
-    elbow.profile = phri::ExternalForce::Profile::kHalfSine;
-    elbow.start_s = start;
-    elbow.duration_s = 1.0;
-    config.disturbances.push_back(elbow);
-    phri::ExternalForce hand = elbow;
-    hand.body = "tool";
-    hand.force_N = Eigen::Vector3d(0.0, -15.0, 0.0);
-    hand.start_s = start + 3.0;
-    config.disturbances.push_back(hand);
-  }
-  return config;
-}
-
+// The scenario, as python/bench/bench_loop.py builds it: the controller benchmarks' pushed Gen3
+// (bench/pushed_gen3.hpp: the paper demo's posture, 5 % model mismatch, a push on the elbow and one on
+// the tool every 6 s), dual compliance, the custom loop.
 phri::ControllerSettings controller_settings() {
   const std::string gen3 = std::string(PHRI_SOURCE_DIR) + "/robots/kinova_gen3/";
   phri::ControllerSettings settings;
@@ -49,7 +30,7 @@ phri::ControllerSettings controller_settings() {
 }
 
 void run_once(double seconds) {
-  phri::SimRobot robot(plant(seconds));
+  phri::SimRobot robot(pushed_gen3_plant(seconds));
   phri::Controller controller(controller_settings());
   phri::RobotCommand command(robot.dof());
   const phri::ControllerTargets targets(robot.dof());
