@@ -427,6 +427,42 @@ TEST(SingularDirectionWeightTest, TrackingTheWeakDirectionGivesTheDecompositions
   EXPECT_LT((tracked.weight() - fresh.weight()).norm(), 1e-12);
 }
 
+// Far from a singularity the weight answers from Weyl's certificate (sigma_i(J) >= sigma_i(J_c) -
+// ||J - J_c||_F) instead of testing: along a path that approaches the threshold, leaves and comes
+// back, its answers and weights equal a fresh weight's (which always tests) at every step, and most
+// steps far from the threshold are certified.
+TEST(SingularDirectionWeightTest, WeylCertificateGivesTheTestsAnswerAlongAPath) {
+  std::mt19937 rng(23);
+  std::normal_distribution<double> normal;
+  const Eigen::MatrixXd v = Eigen::HouseholderQR<Eigen::MatrixXd>(
+                                Eigen::MatrixXd::NullaryExpr(7, 7, [&] { return normal(rng); })).householderQ();
+  const Eigen::MatrixXd u = Eigen::HouseholderQR<Eigen::MatrixXd>(
+                                Eigen::MatrixXd::NullaryExpr(6, 6, [&] { return normal(rng); })).householderQ();
+  const double sigma0 = 0.03;
+  phri::SingularDirectionWeight certified(sigma0, 7);
+  int far_steps = 0;
+  for (double t = 0.0; t < 3.0; t += 1e-3) {
+    // sigma_min sweeps 0.2 -> 0.01 -> 0.2 -> ...: far, near the threshold, below it, and back.
+    const double smallest = 0.105 + 0.095 * std::cos(2.0 * M_PI * t);
+    Eigen::MatrixXd s = Eigen::MatrixXd::Zero(6, 7);
+    s.diagonal() << 1.5, 1.1, 0.8, 0.4, 0.3, smallest;
+    const Eigen::MatrixXd jacobian = u * s * v.transpose() + 0.01 * std::sin(5.0 * t) * u.col(0) * v.col(6).transpose();
+    phri::SingularDirectionWeight fresh(sigma0);
+    const bool expected = fresh.update(jacobian);
+    ASSERT_EQ(certified.update(jacobian), expected) << "t " << t << " sigma_min ~ " << smallest;
+    if (expected) {
+      EXPECT_LT((certified.weight() - fresh.weight()).norm(), 1e-12) << "t " << t;
+    }
+    far_steps += smallest > 2.5 * sigma0;
+  }
+  EXPECT_GT(certified.certified_skips(), far_steps / 2) << "certified on most steps far from the threshold";
+  // A Jacobian of another width: tested every time, never certified from the 7-column one.
+  const long skips = certified.certified_skips();
+  EXPECT_FALSE(certified.update(Eigen::MatrixXd::Identity(6, 6)));
+  EXPECT_FALSE(certified.update(Eigen::MatrixXd::Identity(6, 6)));
+  EXPECT_EQ(certified.certified_skips(), skips);
+}
+
 // Near the Gen3's outstretched elbow (q4 = 0.07: sigma_min ~ 0.01, the arm cannot reach further
 // out) five millimetres of pose error straight out ask the paper's task for ~100 rad/s^2 along the
 // weak joint direction (joints 2, 4, 6: the task amplifies by up to 1 / (2 sqrt(w_0 / w_ee)) = 50);

@@ -332,6 +332,7 @@ bool Controller::apply(const ControllerTargets& targets) {
 
 // Model terms, momentum observer, F/T wrench at the end effector.
 void Controller::estimate(const RobotState& state, double dt) {
+  ft_torque_current_ = false;
   compute_all_terms(model_, data_, q_, qd_);
   coriolis_transpose_times_velocity(model_, data_);
   observer_.update(data_, qd_, state.tau_sensor_Nm, dt);
@@ -342,6 +343,7 @@ void Controller::estimate(const RobotState& state, double dt) {
     q_ = low_level_.position_reference();
     qd_ = low_level_.velocity_reference();
     compute_all_terms(model_, data_, q_, qd_);
+    ft_torque_current_ = false;
   }
 }
 
@@ -372,6 +374,7 @@ void Controller::estimate_wrench(const RobotState& state) {
   if (wrench_supervisor_.usable() && wrench_.calibrated()) {
     frame_jacobian(model_, data_, end_effector_frame_, ReferenceFrame::kLocalWorldAligned, ee_jacobian_);
     ft_torque_.noalias() = ee_jacobian_.transpose() * wrench_.wrench_world();
+    ft_torque_current_ = true;
     wrench_supervisor_.check_consistency(ft_torque_, observer_.external_torque());
   }
   if (wrench_supervisor_.dropped() && !wrench_cleared_) {
@@ -380,6 +383,7 @@ void Controller::estimate_wrench(const RobotState& state) {
     wrench_history_.setZero();
     wrench_samples_ = 0;
     ft_torque_.setZero();
+    ft_torque_current_ = false;
   }
 }
 
@@ -426,9 +430,12 @@ void Controller::select_external_torque() {
     tau_ext_ = observer_.external_torque();
     return;
   }
-  // J^T of the operator's wrench at the end effector (world axes, about its origin).
-  frame_jacobian(model_, data_, end_effector_frame_, ReferenceFrame::kLocalWorldAligned, ee_jacobian_);
-  ft_torque_.noalias() = ee_jacobian_.transpose() * wrench_.wrench_world();
+  // J^T of the operator's wrench at the end effector (world axes, about its origin), unless
+  // estimate_wrench() computed it on the same model terms.
+  if (!ft_torque_current_) {
+    frame_jacobian(model_, data_, end_effector_frame_, ReferenceFrame::kLocalWorldAligned, ee_jacobian_);
+    ft_torque_.noalias() = ee_jacobian_.transpose() * wrench_.wrench_world();
+  }
   if (settings_.external_torque_source == ExternalTorqueSource::kForceTorqueSensor) {
     tau_ext_ = ft_torque_;
   } else {

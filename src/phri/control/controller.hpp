@@ -194,6 +194,7 @@ private:
   long rejected_targets_ = 0;
   Eigen::MatrixXd ee_jacobian_;              // 6 x nv, for J^T F
   Eigen::VectorXd ft_torque_, tau_ext_;
+  bool ft_torque_current_ = false;           // ft_torque_ is J^T F on this cycle's model terms
   Eigen::Matrix<double, 6, 2> wrench_history_ = Eigen::Matrix<double, 6, 2>::Zero();  // the two previous samples
   Vector6d wrench_median_ = Vector6d::Zero();
   long wrench_samples_ = 0;

@@ -35,7 +35,7 @@ EndEffectorTask::EndEffectorTask(const Model& model, int frame_id, double smooth
       weight_(Eigen::VectorXd::Zero(1), smoothing_time_constant),
       gamma_(Eigen::VectorXd::Zero(6), smoothing_time_constant),
       jacobian_(Eigen::MatrixXd::Zero(6, model.nv())),
-      singular_weight_(singular_value_threshold),
+      singular_weight_(singular_value_threshold, model.nv()),
       frame_jacobian_(Eigen::MatrixXd::Zero(6, model.nv())),
       weighted_rows_(Eigen::MatrixXd::Zero(6, model.nv())),
       selected_rows_(Eigen::MatrixXd::Zero(6, model.nv())) {}

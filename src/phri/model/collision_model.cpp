@@ -110,7 +110,22 @@ CollisionData::CollisionData(const Model& model, const CollisionModel& collision
       capsule_center(Eigen::Matrix3Xd::Zero(3, static_cast<Eigen::Index>(collision.capsules().size()))),
       capsule_speed(Eigen::VectorXd::Zero(static_cast<Eigen::Index>(collision.capsules().size()))),
       distance_lower_bound(Eigen::VectorXd::Zero(collision.num_pairs())),
-      approach_speed_bound(Eigen::VectorXd::Zero(collision.num_pairs())) {}
+      approach_speed_bound(Eigen::VectorXd::Zero(collision.num_pairs())),
+      capsule_midpoint(3, static_cast<Eigen::Index>(collision.capsules().size())),
+      capsule_half_length(static_cast<Eigen::Index>(collision.capsules().size())),
+      pair_reach(collision.num_pairs()) {
+  const std::vector<Capsule>& capsules = collision.capsules();
+  for (std::size_t c = 0; c < capsules.size(); ++c) {
+    const auto i = static_cast<Eigen::Index>(c);
+    capsule_midpoint.col(i) = 0.5 * (capsules[c].p0 + capsules[c].p1);
+    capsule_half_length[i] = 0.5 * (capsules[c].p1 - capsules[c].p0).norm();
+  }
+  for (int k = 0; k < collision.num_pairs(); ++k) {
+    const CapsulePair& pair = collision.pairs()[static_cast<std::size_t>(k)];
+    pair_reach[k] = capsule_half_length[pair.first] + capsules[static_cast<std::size_t>(pair.first)].radius +
+                    capsule_half_length[pair.second] + capsules[static_cast<std::size_t>(pair.second)].radius;
+  }
+}
 
 namespace {
 const Eigen::Isometry3d& placement_of(const Model& model, const Data& data, int body) {
@@ -177,24 +192,21 @@ void compute_collision_pair_distance_rate(const Model& model, const Data& data, 
 void compute_collision_bounds(const Model& model, const Data& data, const CollisionModel& collision, CollisionData& out) {
   const std::vector<Capsule>& capsules = collision.capsules();
   for (std::size_t c = 0; c < capsules.size(); ++c) {
-    const Capsule& capsule = capsules[c];
-    const Eigen::Vector3d center = placement_of(model, data, capsule.body) * (0.5 * (capsule.p0 + capsule.p1));
+    const int body = capsules[c].body;
     const auto i = static_cast<Eigen::Index>(c);
+    const Eigen::Vector3d center = placement_of(model, data, body) * out.capsule_midpoint.col(i);
     out.capsule_center.col(i) = center;
-    if (capsule.body < 0) {
+    if (body < 0) {
       out.capsule_speed[i] = 0.0;
       continue;
     }
-    const double angular = data.body_velocities.col(capsule.body).tail<3>().norm();
-    out.capsule_speed[i] = body_point_velocity(model, data, capsule.body, center).norm() +
-                           angular * 0.5 * (capsule.p1 - capsule.p0).norm();
+    const double angular = data.body_velocities.col(body).tail<3>().norm();
+    out.capsule_speed[i] = body_point_velocity(model, data, body, center).norm() + angular * out.capsule_half_length[i];
   }
   for (int k = 0; k < collision.num_pairs(); ++k) {
     const CapsulePair& pair = collision.pairs()[static_cast<std::size_t>(k)];
-    const Capsule& a = capsules[static_cast<std::size_t>(pair.first)];
-    const Capsule& b = capsules[static_cast<std::size_t>(pair.second)];
-    const double reach = 0.5 * (a.p1 - a.p0).norm() + a.radius + 0.5 * (b.p1 - b.p0).norm() + b.radius;
-    out.distance_lower_bound[k] = (out.capsule_center.col(pair.first) - out.capsule_center.col(pair.second)).norm() - reach;
+    out.distance_lower_bound[k] =
+        (out.capsule_center.col(pair.first) - out.capsule_center.col(pair.second)).norm() - out.pair_reach[k];
     out.approach_speed_bound[k] = out.capsule_speed[pair.first] + out.capsule_speed[pair.second];
   }
 }

@@ -63,6 +63,11 @@ struct CollisionData {
   Eigen::VectorXd capsule_speed;
   Eigen::VectorXd distance_lower_bound;
   Eigen::VectorXd approach_speed_bound;
+  // Set at construction from the capsules' shapes: per capsule the axis's midpoint in its body's
+  // frame and half its length; per pair the two bounding spheres' radii summed.
+  Eigen::Matrix3Xd capsule_midpoint;
+  Eigen::VectorXd capsule_half_length;
+  Eigen::VectorXd pair_reach;
 };
 
 /// Distances of every pair from the body placements in `data` (after forward_kinematics).

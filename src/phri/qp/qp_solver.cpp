@@ -194,6 +194,7 @@ void QpSolver::resize(Index n, Index m_eq, Index m_in) {
 
   rows_.setZero(n_, m_rows_);
   row_scale_.setZero(m_rows_);
+  row_peak_.setZero(std::max(m_eq_, m_in_));
   row_values_.setZero(m_in_);
   lower_.setZero(m_all);
   upper_.setZero(m_all);
@@ -312,16 +313,22 @@ void QpSolver::invert_factor() {
 // row_scale_ = 1 / |row| (0 for an all-zero row). Returns the first row holding NaN or Inf, or -1.
 // The squared norms accumulate down the contiguous columns of `a` and the square roots and
 // divisions go through Eigen's vectorised array functions in one batch; one row at a time,
-// their latency dominated the whole load.
+// their latency dominated the whole load. The largest |entry| of each row, accumulated in the
+// same pass, tells an all-zero row (a constraint that bounds nothing this cycle: most
+// self-collision pairs) without reading it again across the columns.
 Index QpSolver::load_rows(const Eigen::MatrixXd& a, Index first) {
   const Index n = n_;
   const Index m = a.rows();
   if (m == 0) return -1;
   double* scale = row_scale_.data() + first;
-  for (Index i = 0; i < m; ++i) scale[i] = 0.0;
+  double* peak = row_peak_.data();  // per row, max |a_ij| (NaN skipped: the sum of squares shows it)
+  for (Index i = 0; i < m; ++i) scale[i] = peak[i] = 0.0;
   for (Index j = 0; j < n; ++j) {
     const double* col = a.col(j).data();
-    for (Index i = 0; i < m; ++i) scale[i] += col[i] * col[i];
+    for (Index i = 0; i < m; ++i) {
+      scale[i] += col[i] * col[i];
+      peak[i] = std::max(peak[i], std::abs(col[i]));
+    }
   }
   auto scales = row_scale_.segment(first, m).array();
   scales = scales.sqrt().inverse();
@@ -334,12 +341,12 @@ Index QpSolver::load_rows(const Eigen::MatrixXd& a, Index first) {
     // small that the squares leave the double range (rare).
     for (Index i = 0; i < m; ++i) {
       if (scale[i] >= min_scale && scale[i] <= max_scale) continue;
-      if (!a.row(i).allFinite()) return i;
-      if ((a.row(i).array() == 0.0).all()) {
+      if (peak[i] == 0.0 && std::isinf(scale[i])) {  // every entry zero (a NaN would make the scale NaN)
         scale[i] = 0.0;
         has_null_rows_ = true;
         continue;
       }
+      if (!a.row(i).allFinite()) return i;
       const double norm = a.row(i).stableNorm();
       scale[i] = norm > 0.0 && norm <= kMax ? 1.0 / norm : 0.0;
       has_null_rows_ |= scale[i] == 0.0;

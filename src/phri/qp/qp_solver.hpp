@@ -133,6 +133,7 @@ private:
   // Rows of A_eq and A, transposed (one contiguous column per row) and scaled to unit length.
   Eigen::MatrixXd rows_;
   Eigen::VectorXd row_scale_;  // 1 / |row|, 0 for an all-zero row
+  Eigen::VectorXd row_peak_;   // load_rows' scratch: max |entry| per row
   Eigen::VectorXd lower_;      // per constraint, in the scaled units; -inf when absent
   Eigen::VectorXd upper_;      // +inf when absent
   Eigen::VectorXd g_;
