@@ -92,26 +92,34 @@ BENCHMARK(ControllerCyclePowerForceLimit)->Arg(0)->Arg(1)->Iterations(1)->Unit(b
 }  // namespace
 
 // What the end-effector task's singular-direction weight adds to a cycle (singular_direction_weight.hpp):
-// the skip test away from singularities (J J^T, a 6 x 6 Cholesky and L^-1) and the weighted path
-// near one (plus the 6 x 6 eigen-decomposition). Gen3 end-effector Jacobians.
+// Arg 0, away from singularities with a Jacobian that stays within Weyl's certificate (42
+// multiply-adds); Arg 2, the same posture alternating with one 0.3 rad away on every joint, so that
+// each update tests (J J^T, the 6 x 6 Cholesky at sigma_0, then at 2 and 4 sigma_0 for a new
+// certificate); Arg 1, the weighted path near a singularity (the weak direction tracked).
+// Gen3 end-effector Jacobians.
 void SingularDirectionWeightTest(benchmark::State& state) {
   const phri::Model model = phri::Model::from_urdf_file(std::string(PHRI_SOURCE_DIR) + "/robots/kinova_gen3/gen3.urdf");
   phri::Data data(model);
+  auto jacobian_at = [&](const Eigen::VectorXd& q) {
+    phri::forward_kinematics(model, data, q);
+    phri::update_frame_placements(model, data);
+    Eigen::MatrixXd jacobian(6, 7);
+    phri::frame_jacobian(model, data, model.frame_id("end_effector_link"), phri::ReferenceFrame::kLocalWorldAligned, jacobian);
+    return jacobian;
+  };
   Eigen::VectorXd q(7);
-  if (state.range(0) == 0) {
-    q << 0.0, 0.58, 3.14, -1.84, 0.0, 0.85, 1.57;  // the demo's posture: sigma_min well above 0.03
-  } else {
+  if (state.range(0) == 1) {
     q << 0.0, 0.4, 0.0, 0.07, 0.0, 0.9, 0.0;  // the outstretched elbow: sigma_min ~ 0.01
+  } else {
+    q << 0.0, 0.58, 3.14, -1.84, 0.0, 0.85, 1.57;  // the demo's posture: sigma_min 0.21
   }
-  phri::forward_kinematics(model, data, q);
-  phri::update_frame_placements(model, data);
-  Eigen::MatrixXd jacobian(6, 7);
-  phri::frame_jacobian(model, data, model.frame_id("end_effector_link"), phri::ReferenceFrame::kLocalWorldAligned, jacobian);
-  phri::SingularDirectionWeight weight(0.03);
+  const Eigen::MatrixXd jacobians[2] = {jacobian_at(q), jacobian_at(q + Eigen::VectorXd::Constant(7, state.range(0) == 2 ? 0.3 : 0.0))};
+  phri::SingularDirectionWeight weight(0.03, 7);
+  int k = 0;
   for (auto _ : state) {
-    benchmark::DoNotOptimize(weight.update(jacobian));
+    benchmark::DoNotOptimize(weight.update(jacobians[k ^= 1]));
     benchmark::DoNotOptimize(weight.weight().data());
   }
-  state.SetLabel(state.range(0) == 0 ? "skip (demo posture)" : "weighted (q4 = 0.07)");
+  state.SetLabel(state.range(0) == 0 ? "certified (demo posture)" : state.range(0) == 2 ? "tested (demo posture, alternating)" : "weighted (q4 = 0.07)");
 }
-BENCHMARK(SingularDirectionWeightTest)->Arg(0)->Arg(1);
+BENCHMARK(SingularDirectionWeightTest)->Arg(0)->Arg(2)->Arg(1);

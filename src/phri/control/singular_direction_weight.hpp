@@ -81,9 +81,9 @@ public:
       if (same_width) {
         for (const double bound : {2.0 * sigma0_, 4.0 * sigma0_}) {
           if (!positive_definite_above(bound)) break;
-          certified_jacobian_ = jacobian;
           certified_margin_ = bound - sigma0_;
         }
+        if (certified_margin_ > 0.0) certified_jacobian_ = jacobian;
       }
       return false;
     }
