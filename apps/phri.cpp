@@ -72,7 +72,6 @@
 #include <fstream>
 #include <sstream>
 #include <iostream>
-#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -187,12 +186,16 @@ void draw_demo_figure(const std::string& log_path, const std::string& png, const
 
 // The plant friction's form (friction_model_form.hpp), on both spellings of the command.
 void add_plant_friction_options(CLI::App& command, phri::FrictionIdentificationOptions& friction) {
-  const std::map<std::string, phri::PlantFrictionForm> forms = {{"model", phri::PlantFrictionForm::kModelForm},
-                                                                {"stribeck-ripple", phri::PlantFrictionForm::kStribeckRipple}};
   phri::StribeckRippleSettings& s = friction.stribeck_ripple;
-  command.add_option("--plant-friction", friction.plant_friction,
-                     "plant friction's form: model (the identified model's) or stribeck-ripple (Stribeck curve + ripple)")
-      ->transform(CLI::CheckedTransformer(forms, CLI::ignore_case));
+  command
+      .add_option_function<std::string>(
+          "--plant-friction",
+          [&friction](const std::string& form) {
+            friction.plant_friction =
+                form == "stribeck-ripple" ? phri::PlantFrictionForm::kStribeckRipple : phri::PlantFrictionForm::kModelForm;
+          },
+          "plant friction's form: model (the identified model's, default) or stribeck-ripple (Stribeck curve + ripple)")
+      ->check(CLI::IsMember({"model", "stribeck-ripple"}));
   command.add_option("--stribeck-velocity", s.stribeck_velocity_rad_s, "stribeck-ripple: v_s [rad/s]")
       ->check(CLI::Range(1e-4, 1.0))
       ->capture_default_str();

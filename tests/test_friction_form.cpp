@@ -15,6 +15,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <random>
 #include <sstream>
 
@@ -138,6 +139,32 @@ TEST(StribeckRippleFriction, OffByDefaultAndBitIdenticalToTheOldModel) {
   }
   EXPECT_GT(slid, 1000);     // the walk did slide
   EXPECT_LT(slid, 19000);    // and did stick
+}
+
+TEST(StribeckRippleFriction, PlantKeysLoadAndAreRangeChecked) {
+  std::ifstream file(kRoot + "/configs/plant_gen3.yaml");
+  std::stringstream text;
+  text << file.rdbuf();
+  const std::string yaml = text.str();
+  const std::string key = "    breakaway_velocity_rad_s: 0.001";
+  const std::size_t at = yaml.find(key);
+  ASSERT_NE(at, std::string::npos);
+  auto with = [&](const std::string& extra) {
+    std::string y = yaml;
+    y.insert(at + key.size(), extra);
+    return y;
+  };
+  const phri::SimRobotConfig c = phri::SimRobotConfig::from_yaml_string(
+      with("\n    stribeck_velocity_rad_s: 0.03\n    stribeck_exponent: 1.5\n    ripple_fraction: 0.1\n"
+           "    ripple_cycles_per_rev: 100\n    ripple_phase_rad: 0.5"),
+      "plant_gen3.yaml", kRoot + "/configs");
+  EXPECT_EQ(c.friction.stribeck_velocity_rad_s, 0.03);
+  EXPECT_EQ(c.friction.stribeck_exponent, 1.5);
+  EXPECT_EQ(c.friction.ripple_fraction, 0.1);
+  EXPECT_EQ(c.friction.ripple_cycles_per_rev, 100.0);
+  EXPECT_EQ(c.friction.ripple_phase_rad, 0.5);
+  EXPECT_THROW(phri::SimRobotConfig::from_yaml_string(with("\n    ripple_fraction: 0.9"), "plant_gen3.yaml", kRoot + "/configs"),
+               phri::ConfigError);
 }
 
 TEST(StribeckRippleFriction, IdentificationReportsTheModelsFormError) {

@@ -421,8 +421,8 @@ void fit_sliding_friction(const std::vector<FrictionLevel>& levels, bool model_f
   e.levels_total = static_cast<int>(levels.size());
   e.levels_used = used;
   if (used < 4 && !model_form) {
-    // On a plant of another form a joint may not slide steadily at constant current (the Stribeck
-    // curve's negative slope): not a result, and said so.
+    // On a plant of another form a joint may not slide steadily at constant current (where the
+    // Stribeck curve falls, or the ripple stalls it): not a result, and said so.
     e.valid = false;
     e.invalid_reason = "only " + std::to_string(used) + " steady levels of " + std::to_string(e.levels_total);
     return;
@@ -593,6 +593,10 @@ std::string friction_identification_yaml(const FrictionIdentificationResult& r, 
     << "# nominal ones (the identification does not measure them).\n"
     << "joints:\n";
   for (const JointFrictionEstimate& e : r.joints) {
+    if (!e.valid) {
+      s << "  # " << e.name << ": INVALID (" << e.invalid_reason << "), not identified\n";
+      continue;
+    }
     const FrictionParameters& f = e.identified;
     const bool raised = f.static_Nm < f.coulomb_Nm;
     s << "  - name: " << e.name << "\n"
