@@ -184,11 +184,44 @@ void draw_demo_figure(const std::string& log_path, const std::string& png, const
   }
 }
 
+// The plant friction's form (friction_model_form.hpp), on both spellings of the command.
+void add_plant_friction_options(CLI::App& command, phri::FrictionIdentificationOptions& friction) {
+  phri::StribeckRippleSettings& s = friction.stribeck_ripple;
+  command
+      .add_option_function<std::string>(
+          "--plant-friction",
+          [&friction](const std::string& form) {
+            friction.plant_friction =
+                form == "stribeck-ripple" ? phri::PlantFrictionForm::kStribeckRipple : phri::PlantFrictionForm::kModelForm;
+          },
+          "plant friction's form: model (the identified model's, default) or stribeck-ripple (Stribeck curve + ripple)")
+      ->check(CLI::IsMember({"model", "stribeck-ripple"}));
+  command.add_option("--stribeck-velocity", s.stribeck_velocity_rad_s, "stribeck-ripple: v_s [rad/s]")
+      ->check(CLI::Range(1e-4, 1.0))
+      ->capture_default_str();
+  command.add_option("--static-ratio", s.static_to_coulomb, "stribeck-ripple: plant static / Coulomb")
+      ->check(CLI::Range(1.0, 3.0))
+      ->capture_default_str();
+  command.add_option("--ripple-fraction", s.ripple_fraction, "stribeck-ripple: ripple amplitude, fraction of Coulomb")
+      ->check(CLI::Range(0.0, 0.5))
+      ->capture_default_str();
+  command.add_option("--stribeck-sweep", s.stribeck_velocity_sweep, "stribeck-ripple: v_s values of the sweep [rad/s]")
+      ->check(CLI::Range(1e-4, 1.0))
+      ->capture_default_str();
+  command.add_option("--ripple-sweep", s.ripple_fraction_sweep, "stribeck-ripple: ripple amplitudes of the sweep (of Coulomb)")
+      ->check(CLI::Range(0.0, 0.5))
+      ->capture_default_str();
+  command.add_option("--sweep-joints", s.sweep_joints, "stribeck-ripple: joints of the sweep (1-based)")
+      ->check(CLI::Range(1, 7))
+      ->capture_default_str();
+}
+
 // `phri experiment friction-identification`: the same as `phri identify-friction`.
 CLI::App* add_friction_alias(CLI::App& experiment, phri::FrictionIdentificationOptions& friction) {
   auto* alias = experiment.add_subcommand("friction-identification", "Same as 'phri identify-friction'");
   alias->add_option("--out", friction.output_dir, "output folder");
   alias->add_option("--seed", friction.seed, "seed");
+  add_plant_friction_options(*alias, friction);
   return alias;
 }
 
@@ -599,6 +632,7 @@ CLI::App* add_identify_command(CLI::App& app, phri::FrictionIdentificationOption
       ->capture_default_str();
   identify->add_option("--joints", friction.joints, "joints to identify (1-based)")->check(CLI::Range(1, 7));
   identify->add_option("--plant", friction.plant_config_path, "plant configuration")->check(CLI::ExistingFile);
+  add_plant_friction_options(*identify, friction);
   return identify;
 }
 

@@ -4,6 +4,7 @@
 #include <phri/qp/qp_solver.hpp>
 
 #include <allocation_counter.hpp>
+#include <qp_kkt.hpp>
 
 #include <Eigen/Cholesky>
 #include <Eigen/LU>
@@ -110,67 +111,10 @@ QpProblem random_problem(Rng& rng, const Shape& s, double log10_cond, bool with_
 
 // ------------------------------------------------------------------------------------ references
 
-struct Kkt {
-  double stationarity = 0.0;
-  double primal = 0.0;
-  double dual = 0.0;
-  double complementarity = 0.0;
-  double worst() const { return std::max({stationarity, primal, dual, complementarity}); }
-};
-
-double lower_of(const VectorXd& v, Index i) { return v.size() == 0 || v(i) <= -1e20 ? -kInf : v(i); }
-double upper_of(const VectorXd& v, Index i) { return v.size() == 0 || v(i) >= 1e20 ? kInf : v(i); }
-
-// Residuals, each relative to the magnitudes of the terms it is made of.
-Kkt kkt_residuals(const QpProblem& p, const QpSolver& s) {
-  Kkt r;
-  const VectorXd& x = s.x();
-  const VectorXd& y_eq = s.equality_multipliers();
-  const VectorXd& y_row = s.row_multipliers();
-  const VectorXd& y_b = s.bound_multipliers();
-  const MatrixXd h = p.H.selfadjointView<Eigen::Lower>();
-  const VectorXd hx = h * x;
-  const VectorXd eq_term = p.A_eq.transpose() * y_eq;
-  const VectorXd row_term = p.A.transpose() * y_row;
-  const VectorXd residual = hx + p.g + eq_term + row_term + y_b;
-  const double grad_scale = std::max({1.0, hx.cwiseAbs().maxCoeff(), p.g.cwiseAbs().maxCoeff(),
-                                      eq_term.size() ? eq_term.cwiseAbs().maxCoeff() : 0.0,
-                                      row_term.cwiseAbs().maxCoeff(), y_b.cwiseAbs().maxCoeff()});
-  r.stationarity = residual.cwiseAbs().maxCoeff() / grad_scale;
-
-  double y_scale = 1.0;
-  if (y_row.size()) y_scale = std::max(y_scale, y_row.cwiseAbs().maxCoeff());
-  y_scale = std::max(y_scale, y_b.cwiseAbs().maxCoeff());
-
-  const auto check = [&](double value, double lo, double hi, double magnitude, double y, QpActiveSide side) {
-    const double below = std::isfinite(lo) ? (lo - value) / (1.0 + std::abs(lo) + magnitude) : -kInf;
-    const double above = std::isfinite(hi) ? (value - hi) / (1.0 + std::abs(hi) + magnitude) : -kInf;
-    r.primal = std::max({r.primal, below, above});
-    // Sign of the multiplier against the reported side; inactive ones are exactly zero.
-    double wrong = 0.0;
-    if (side == QpActiveSide::kInactive) wrong = std::abs(y);
-    if (side == QpActiveSide::kLower) wrong = std::max(y, 0.0);
-    if (side == QpActiveSide::kUpper) wrong = std::max(-y, 0.0);
-    if (side == QpActiveSide::kLower && !std::isfinite(lo)) wrong = kInf;
-    if (side == QpActiveSide::kUpper && !std::isfinite(hi)) wrong = kInf;
-    r.dual = std::max(r.dual, wrong / y_scale);
-    if (y < 0.0) r.complementarity = std::max(r.complementarity, -y / y_scale * std::abs(below));
-    if (y > 0.0) r.complementarity = std::max(r.complementarity, y / y_scale * std::abs(above));
-  };
-  for (Index i = 0; i < p.A_eq.rows(); ++i) {
-    const double v = p.A_eq.row(i).dot(x);
-    const double magnitude = p.A_eq.row(i).cwiseAbs().dot(x.cwiseAbs());
-    r.primal = std::max(r.primal, std::abs(v - p.b_eq(i)) / (1.0 + std::abs(p.b_eq(i)) + magnitude));
-  }
-  for (Index i = 0; i < p.A.rows(); ++i) {
-    check(p.A.row(i).dot(x), lower_of(p.l, i), upper_of(p.u, i), p.A.row(i).cwiseAbs().dot(x.cwiseAbs()), y_row(i),
-          s.active_rows()[static_cast<std::size_t>(i)]);
-  }
-  for (Index j = 0; j < x.size(); ++j) {
-    check(x(j), lower_of(p.lb, j), upper_of(p.ub, j), 0.0, y_b(j), s.active_bounds()[static_cast<std::size_t>(j)]);
-  }
-  return r;
-}
+using test::Kkt;
+using test::kkt_residuals;
+using test::lower_of;
+using test::upper_of;
 
 double objective(const QpProblem& p, const VectorXd& x) {
   const MatrixXd h = p.H.selfadjointView<Eigen::Lower>();

@@ -22,6 +22,7 @@ from drop_test_figure import drop_statistics, fmt, statistics_table  # noqa: E40
 from verdicts import MIN_VALID, claim_paragraph, outcome  # noqa: E402
 from report_common import plt, read_rows, save_figure  # noqa: E402
 from parameter_sources import markdown_table, parameter_rows  # noqa: E402
+from friction_form_report import form_sentences, form_table, sweep_sentences, sweep_table  # noqa: E402
 
 # The paper's friction model, eq. friction-model: tau_f = Fc sign(qd) + Fv qd.
 PAPER_FRICTION = {"large": (2.15, 2.00), "small": (1.60, 1.36)}
@@ -116,11 +117,39 @@ def friction_section(rep, out):
                      f"{float(m['static_Nm']):.3f}", f"{float(m['plant_static_Nm']):.3f}"])
     rep.table(md_table(["joint", "actuator", "Fc identified [N.m]", "Fc plant", "Fc paper", "Fv identified [N.m.s/rad]",
                         "Fv plant", "Fv paper", "Fs identified [N.m]", "Fs plant"], rows))
+    ratios = [float(m["plant_static_Nm"]) / float(m["plant_coulomb_Nm"]) for m in models if float(m["plant_coulomb_Nm"]) > 0]
+    ratio_text = (f"the plant's static / Coulomb ratio is {min(ratios):.3f}-{max(ratios):.3f} over these joints"
+                  if ratios else "no joint was identified")
     rep.p("The plant's friction (a protocol choice, not a finding): the paper's identified model (eq. friction-model) "
           "with every coefficient moved by up to 20 % (seeded), so that the identification has something to find; "
           "the identified values are to be compared with the plant's column, the paper's column is where the plant "
-          "started from. The paper lumps static and Coulomb friction; the plant keeps them equal too.")
+          f"started from. The paper lumps static and Coulomb friction; {ratio_text}.")
     rep.figure(f"{d}/friction_identification.png", "Friction identification: torque error against velocity, fitted models")
+    friction_form_subsection(rep, out)
+
+
+def friction_form_subsection(rep, out):
+    """The identification on a plant whose friction differs in form (friction_form_report.py)."""
+    d = f"{out}/friction_form"
+    rep.h(3, "Plant friction of another form (Stribeck curve + position ripple)")
+    if not os.path.exists(f"{d}/friction_form.csv"):
+        rep.p("Not run (friction_form/friction_form.csv missing).")
+        return
+    rep.p("The default plant's friction has the identified model's own form, so the fit above proves little. Here the "
+          "plant slides with a Stribeck curve, tau_c + (tau_s - tau_c) exp(-(|v|/v_s)^2), and a ripple a_r tau_c "
+          "sin(200 q) (harmonic drive, twice per wave-generator turn); v_s and a_r have no published value for the Gen3 "
+          "(src/phri/experiments/friction_model_form.hpp), so both are swept, one at a time. Metric: the identified model against the "
+          "plant's true mean sliding friction, over the levels' speeds and below them; errors in N.m and % of static.")
+    form = read_rows(f"{d}/friction_form.csv")
+    rep.table(form_table(form))
+    for sentence in form_sentences(form):
+        rep.p(sentence)
+    sweep = read_rows(f"{d}/friction_form_sweep.csv") if os.path.exists(f"{d}/friction_form_sweep.csv") else []
+    if sweep:
+        rep.p("Sweeps over the unknowns, one at a time (sliding levels only, no static search):")
+        rep.table(sweep_table(sweep))
+        for sentence in sweep_sentences(sweep):
+            rep.p(sentence)
 
 
 def torque_tracking_section(rep, out):

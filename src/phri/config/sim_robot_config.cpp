@@ -106,8 +106,16 @@ void parse_actuator_overrides(const YamlReader& o, SimRobotConfig& c) {
 }
 
 void parse_friction(const YamlReader& f, SimRobotConfig::Friction& s) {
-  f.allow_keys({"breakaway_velocity_rad_s"});
+  f.allow_keys({"breakaway_velocity_rad_s", "stribeck_velocity_rad_s", "stribeck_exponent", "ripple_fraction",
+                "ripple_cycles_per_rev", "ripple_phase_rad"});
   s.breakaway_velocity_rad_s = f.number_or("breakaway_velocity_rad_s", 1e-3, 1e-6, 1.0);
+  // The sliding form (StickSlipFriction): v_s 0 (off) to 1 rad/s, delta 0.5..4 (Stribeck exponents
+  // reported in the literature lie in 0.5..2), ripple below half the Coulomb level (the level stays > 0).
+  s.stribeck_velocity_rad_s = f.number_or("stribeck_velocity_rad_s", s.stribeck_velocity_rad_s, 0.0, 1.0);
+  s.stribeck_exponent = f.number_or("stribeck_exponent", s.stribeck_exponent, 0.5, 4.0);
+  s.ripple_fraction = f.number_or("ripple_fraction", s.ripple_fraction, 0.0, 0.5);
+  s.ripple_cycles_per_rev = f.number_or("ripple_cycles_per_rev", s.ripple_cycles_per_rev, 0.0, 10000.0);
+  s.ripple_phase_rad = f.number_or("ripple_phase_rad", s.ripple_phase_rad, -7.0, 7.0);
 }
 
 void parse_noise(const YamlReader& z, int n, SimRobotConfig::Noise& s) {

@@ -87,6 +87,14 @@ struct SimRobotConfig : RobotDescription {
     /// Below this joint speed the friction limit is the static (breakaway) level, above it the
     /// Coulomb level [rad/s].
     double breakaway_velocity_rad_s = 1e-3;
+    // A sliding-friction form other than the identified model's (StickSlipFriction: Stribeck curve
+    // and position-dependent ripple); off by default. Friction identification's
+    // `--plant-friction stribeck-ripple` sets it (see friction_identification.hpp for the values).
+    double stribeck_velocity_rad_s = 0.0;  ///< v_s; 0: off (sliding level = Coulomb)
+    double stribeck_exponent = 2.0;        ///< delta
+    double ripple_fraction = 0.0;          ///< a_r: ripple amplitude as a fraction of each joint's Coulomb level
+    double ripple_cycles_per_rev = 200.0;  ///< n_r: 2 per wave-generator turn x gear ratio 100
+    double ripple_phase_rad = 0.0;         ///< phi
   } friction;
 
   // ---- joint sensors

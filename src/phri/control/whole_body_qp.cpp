@@ -206,12 +206,16 @@ WholeBodyQpStatus WholeBodyQp::update(const Model& model, const Data& data, cons
   for (const auto& constraint : constraints_) constraint->begin_cycle();
   fill_constraints(constraint_context);
 
-  QpStatus qp = solver_.solve(problem_, {.warm_start = warm_, .reuse_hessian_factor = false});
+  last_solve_options_ = {.warm_start = warm_, .reuse_hessian_factor = false};
+  QpStatus qp = solver_.solve(problem_, last_solve_options_);
+  ++solve_count_;
   // A comfort beyond the paper's bounds (a faster return, a braking row) that makes the QP
   // infeasible is dropped for this cycle: the paper's bounds rather than the fallback.
   while (qp == QpStatus::kInfeasible && relax_a_constraint()) {
     fill_constraints(constraint_context);
-    qp = solver_.solve(problem_, {.warm_start = false, .reuse_hessian_factor = false});
+    last_solve_options_ = {.warm_start = false, .reuse_hessian_factor = false};
+    qp = solver_.solve(problem_, last_solve_options_);
+    ++solve_count_;
   }
   if (qp == QpStatus::kOptimal && solver_.x().allFinite()) {
     warm_ = true;

@@ -38,6 +38,7 @@
 #include <phri/qp/qp_problem.hpp>
 #include <phri/qp/qp_solver.hpp>
 
+#include <cstdint>
 #include <memory>
 #include <optional>
 #include <string_view>
@@ -142,6 +143,14 @@ public:
   WholeBodyQpStatus status() const { return status_; }
   QpStatus qp_status() const { return solver_.status(); }
   int qp_iterations() const { return solver_.iterations(); }
+  /// For recorders outside the cycle (bench/record_qps.cpp): the QP as last solved (H, g, rows and
+  /// bounds of the last update; after a relaxation, the relaxed one), the solver (its results, and
+  /// the active set the next warm start begins from), the options of the last solve and the number
+  /// of solves so far (an update that relaxed a constraint solves more than once).
+  const QpProblem& qp_problem() const { return problem_; }
+  const QpSolver& qp_solver() const { return solver_; }
+  const QpSolveOptions& last_solve_options() const { return last_solve_options_; }
+  std::uint64_t solve_count() const { return solve_count_; }
   /// The power-and-force limit, or null when it is off.
   const PowerForceLimitConstraint* power_force_limit() const { return power_force_limit_; }
   const CollisionData* collision_data() const { return self_collision_ ? &self_collision_->data() : nullptr; }
@@ -186,6 +195,8 @@ private:
   Eigen::VectorXd hessian_diagonal_;                // the tasks' diagonal Hessian terms (ObjectiveTerms)
   WholeBodyQpStatus status_ = WholeBodyQpStatus::kOk;
   bool warm_ = false;
+  QpSolveOptions last_solve_options_;
+  std::uint64_t solve_count_ = 0;
 };
 
 }  // namespace phri

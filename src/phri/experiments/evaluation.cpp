@@ -44,6 +44,19 @@ void friction(const EvaluationOptions& o, std::ostream& out) {
   f.output_dir = output_path(o.output_dir, "friction_identification");
   if (o.quick) f.joints = {1, 5};  // one large and one small actuator
   run_friction_identification_command(f, out);
+  // Issue 39: the same protocol on a plant whose friction differs in form from the model (Stribeck
+  // curve + position ripple), kept to a few seconds: one small joint, its v_s sweep with 6 levels per
+  // direction. `phri identify-friction --plant-friction stribeck-ripple` is the full run.
+  out << "-- plant friction of another form (Stribeck + ripple)" << std::endl;
+  FrictionIdentificationOptions g = f;
+  g.plant_friction = PlantFrictionForm::kStribeckRipple;
+  g.joints = {5};
+  g.stribeck_ripple.sweep_joints = {5};
+  g.stribeck_ripple.sweep_speed_levels = 6;
+  g.output_dir = output_path(o.output_dir, "friction_form");
+  g.figure_script.clear();
+  const FrictionIdentificationResult r = identify_friction(g, nullptr);
+  out << model_form_markdown(r) << "\n" << sweep_markdown(r.sweep);
 }
 
 TorqueTrackingOptions tracking_files(const EvaluationOptions& o, const char* folder) {

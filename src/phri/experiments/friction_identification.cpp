@@ -181,9 +181,11 @@ FrictionLevel run_level(FrictionRig& rig, int j, int direction, double speed, co
   for (int k = 0; k < cycles(o.settle_s, dt); ++k) rig.step(j, Drive::kTorque, tau);
   const int n = cycles(o.average_s, dt);
   Mean current, error, first, second;
+  bool in_current_mode = true;
   for (int k = 0; k < n; ++k) {
     const RobotState& s = rig.step(j, Drive::kTorque, tau);
     const double e = kt_gr * s.current_A[j] - s.tau_sensor_Nm[j];
+    in_current_mode = in_current_mode && s.mode == LowLevelMode::kCurrent && !s.stop_requested;
     current.add(s.current_A[j]);
     error.add(e);
     (k < n / 2 ? first : second).add(s.qd_rad_s[j]);
@@ -199,7 +201,8 @@ FrictionLevel run_level(FrictionRig& rig, int j, int direction, double speed, co
   level.torque_error_std_Nm = error.std();
   level.velocity_drift_rad_s = second.mean() - first.mean();
   const bool moving = level.velocity_rad_s * direction > kMovingFraction * speed;
-  level.steady = moving && std::abs(level.velocity_drift_rad_s) < kSteadyRelative * std::abs(level.velocity_rad_s) + kSteadyAbsolute;
+  level.current_mode = in_current_mode;
+  level.steady = in_current_mode && moving && std::abs(level.velocity_drift_rad_s) < kSteadyRelative * std::abs(level.velocity_rad_s) + kSteadyAbsolute;
   return level;
 }
 
@@ -253,6 +256,8 @@ double find_static(FrictionRig& rig, int j, int direction, const FrictionIdentif
   return hi;  // the smallest tried torque that started the joint
 }
 
+void validate(const StribeckRippleSettings& s);
+
 void validate(const FrictionIdentificationOptions& o) {
   const std::string src = "<friction identification options>";
   if (o.joints.empty()) throw ConfigError(src, "joints", "no joint to identify");
@@ -271,6 +276,29 @@ void validate(const FrictionIdentificationOptions& o) {
   if (!(o.static_trial_s > 0.0) || !(o.breakaway_rad > 0.0)) {
     throw ConfigError(src, "static_trial_s/breakaway_rad", "must be > 0");
   }
+  if (o.plant_friction == PlantFrictionForm::kStribeckRipple) validate(o.stribeck_ripple);
+}
+
+// The ranges of the plant's friction keys (sim_robot_config.cpp), and static >= Coulomb.
+void validate(const StribeckRippleSettings& s) {
+  const std::string src = "<friction identification options>";
+  auto stribeck_velocity_ok = [](double v) { return v > 0.0 && v <= 1.0; };
+  if (!stribeck_velocity_ok(s.stribeck_velocity_rad_s)) throw ConfigError(src, "stribeck_velocity_rad_s", "must be in (0, 1] rad/s");
+  for (double v : s.stribeck_velocity_sweep) {
+    if (!stribeck_velocity_ok(v)) throw ConfigError(src, "stribeck_velocity_sweep", "each v_s must be in (0, 1] rad/s");
+  }
+  if (!(s.stribeck_exponent >= 0.5 && s.stribeck_exponent <= 4.0)) throw ConfigError(src, "stribeck_exponent", "must be in [0.5, 4]");
+  if (!(s.static_to_coulomb >= 1.0 && s.static_to_coulomb <= 3.0)) throw ConfigError(src, "static_to_coulomb", "must be in [1, 3]");
+  if (!(s.ripple_fraction >= 0.0 && s.ripple_fraction <= 0.5)) throw ConfigError(src, "ripple_fraction", "must be in [0, 0.5]");
+  if (!(s.ripple_cycles_per_rev >= 0.0 && s.ripple_cycles_per_rev <= 10000.0)) {
+    throw ConfigError(src, "ripple_cycles_per_rev", "must be in [0, 10000]");
+  }
+  if (s.sweep_speed_levels < 2) throw ConfigError(src, "sweep_speed_levels", "must be >= 2");
+  for (double a : s.ripple_fraction_sweep) {
+    if (!(a >= 0.0 && a <= 0.5)) throw ConfigError(src, "ripple_fraction_sweep", "each a_r must be in [0, 0.5]");
+  }
+  const bool sweeps = !s.stribeck_velocity_sweep.empty() || !s.ripple_fraction_sweep.empty();
+  if (sweeps && s.sweep_joints.empty()) throw ConfigError(src, "sweep_joints", "no joint to sweep");
 }
 
 std::string levels_csv(const FrictionIdentificationResult& r) {
@@ -333,6 +361,7 @@ SimRobotConfig identification_plant(const FrictionIdentificationOptions& o) {
   if (o.friction_perturbation > 0.0) {
     config.actuator_overrides = perturbed_friction_overrides(config.actuators, o.friction_perturbation, o.seed);
   }
+  if (o.plant_friction == PlantFrictionForm::kStribeckRipple) apply_stribeck_ripple(o.stribeck_ripple, config);
   return config;
 }
 
@@ -386,11 +415,18 @@ void run_speed_levels(FrictionRig& rig, int j, const FrictionIdentificationOptio
 
 // Least squares on the steady levels: e = c0 + tau_c sign(qd) + tau_v qd. Sets the estimate's
 // offset, Coulomb and viscous coefficients, residual and level counts.
-void fit_sliding_friction(const std::vector<FrictionLevel>& levels, JointFrictionEstimate& e) {
+void fit_sliding_friction(const std::vector<FrictionLevel>& levels, bool model_form, JointFrictionEstimate& e) {
   int used = 0;
   for (const FrictionLevel& l : levels) used += l.steady ? 1 : 0;
   e.levels_total = static_cast<int>(levels.size());
   e.levels_used = used;
+  if (used < 4 && !model_form) {
+    // On a plant of another form a joint may not slide steadily at constant current (where the
+    // Stribeck curve falls, or the ripple stalls it): not a result, and said so.
+    e.valid = false;
+    e.invalid_reason = "only " + std::to_string(used) + " steady levels of " + std::to_string(e.levels_total);
+    return;
+  }
   if (used < 4) {
     throw ExperimentError("friction identification",
                           "joint " + std::to_string(e.joint) + ": only " + std::to_string(used) + " steady levels");
@@ -415,14 +451,17 @@ void fit_sliding_friction(const std::vector<FrictionLevel>& levels, JointFrictio
 
 // The breakaway level of joint j in each direction, from rest at upright; the joint is held where
 // it ends (limited joints: back at upright).
-void identify_static_friction(FrictionRig& rig, int j, const FrictionIdentificationOptions& o, JointFrictionEstimate& e,
-                              std::vector<StaticFrictionTrial>& trials) {
+// Returns where each direction's search started (the breakaway level may depend on position).
+std::pair<double, double> identify_static_friction(FrictionRig& rig, int j, const FrictionIdentificationOptions& o,
+                                                   JointFrictionEstimate& e, std::vector<StaticFrictionTrial>& trials) {
   const bool limited = rig.limited(j);
   if (limited) move_to(rig, j, 0.0, 0.2);
   release(rig, j, 0.2);
+  const double q_positive = rig.state().q_rad[j];
   e.static_positive_Nm = find_static(rig, j, +1, o, trials);
   if (limited) move_to(rig, j, 0.0, 0.2);
   release(rig, j, 0.2);
+  const double q_negative = rig.state().q_rad[j];
   e.static_negative_Nm = find_static(rig, j, -1, o, trials);
   e.identified.static_Nm = 0.5 * (e.static_positive_Nm + e.static_negative_Nm);
   rig.set_hold(j, rig.state().q_rad[j]);
@@ -431,15 +470,19 @@ void identify_static_friction(FrictionRig& rig, int j, const FrictionIdentificat
     rig.set_hold(j, 0.0);
   }
   release(rig, -1, 0.2);
+  return {q_positive, q_negative};
 }
 
-// One joint (1-based): sliding levels and their fit, then the static search.
+// One joint (1-based): sliding levels and their fit, then the static search; on a plant of another
+// form, the identified model against the plant's true friction.
 JointFrictionEstimate identify_joint(FrictionRig& rig, int joint, const FrictionIdentificationOptions& o,
                                      FrictionIdentificationResult& result, std::ostream* progress) {
   const int j = joint - 1;
   const ActuatorParameters& nominal = rig.robot().config().actuators[j];
   const std::size_t first_level = result.levels.size();
   run_speed_levels(rig, j, o, result, progress);
+  const std::vector<FrictionLevel> levels(result.levels.begin() + static_cast<std::ptrdiff_t>(first_level), result.levels.end());
+  const bool model_form = o.plant_friction == PlantFrictionForm::kModelForm;
 
   JointFrictionEstimate e;
   e.joint = joint;
@@ -449,18 +492,27 @@ JointFrictionEstimate identify_joint(FrictionRig& rig, int joint, const Friction
   const std::vector<double>& offsets = rig.robot().config().noise.torque_sensor_offset_Nm;
   e.plant_sensor_offset_Nm = offsets.empty() ? 0.0 : offsets[static_cast<std::size_t>(j)];
   e.identified = nominal.friction;
-  fit_sliding_friction({result.levels.begin() + static_cast<std::ptrdiff_t>(first_level), result.levels.end()}, e);
+  fit_sliding_friction(levels, model_form, e);
+  if (!e.valid) {
+    if (progress) *progress << "  INVALID: " << e.invalid_reason << "; not identified" << std::endl;
+    return e;
+  }
   if (progress) {
     *progress << "  fit on " << e.levels_used << "/" << e.levels_total << " steady levels: Coulomb "
               << format_fixed(e.identified.coulomb_Nm, 4) << " N.m, viscous " << format_fixed(e.identified.viscous_Nms_per_rad, 4)
-              << " N.m.s/rad, offset " << format_fixed(e.offset_Nm, 4) << " N.m; static search..." << std::endl;
+              << " N.m.s/rad, offset " << format_fixed(e.offset_Nm, 4) << " N.m" << (o.static_search ? "; static search..." : "")
+              << std::endl;
   }
-  identify_static_friction(rig, j, o, e, result.static_trials);
-  if (progress) {
+  std::pair<double, double> static_start{0.0, 0.0};
+  if (o.static_search) static_start = identify_static_friction(rig, j, o, e, result.static_trials);
+  if (progress && o.static_search) {
     *progress << "  static " << format_fixed(e.static_positive_Nm, 4) << " / " << format_fixed(e.static_negative_Nm, 4)
               << " N.m (+/-); plant: Coulomb " << format_fixed(e.plant.coulomb_Nm, 4) << ", viscous "
               << format_fixed(e.plant.viscous_Nms_per_rad, 4) << ", static " << format_fixed(e.plant.static_Nm, 4)
               << std::endl;
+  }
+  if (!model_form) {
+    e.form = model_form_error(e, levels, rig.robot().dry_friction_parameters(j), static_start.first, static_start.second);
   }
   return e;
 }
@@ -470,6 +522,7 @@ JointFrictionEstimate identify_joint(FrictionRig& rig, int joint, const Friction
 double FrictionIdentificationResult::worst_relative_error() const {
   double worst = 0.0;
   for (const JointFrictionEstimate& e : joints) {
+    if (!e.valid) continue;
     worst = std::max({worst, std::abs(e.coulomb_error()), std::abs(e.viscous_error()), std::abs(e.static_error())});
   }
   return worst;
@@ -486,13 +539,20 @@ FrictionIdentificationResult identify_friction(const FrictionIdentificationOptio
   release(rig, -1, 0.3);  // everything held at upright
   for (int joint : o.joints) result.joints.push_back(identify_joint(rig, joint, o, result, progress));
   result.simulated_s = rig.time();
+  result.plant_friction = o.plant_friction;
+  if (o.plant_friction == PlantFrictionForm::kStribeckRipple) result.sweep = friction_form_sweeps(o, progress);
   result.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
-  result.files = write_output_files(o.output_dir, {{"friction_levels.csv", levels_csv(result)},
-                                                   {"friction_samples.csv", samples_csv(result)},
-                                                   {"friction_static.csv", static_csv(result)},
-                                                   {"friction_models.csv", models_csv(result)},
-                                                   {"friction_identified.yaml", friction_identification_yaml(result, o)},
-                                                   {"friction_identification.md", friction_identification_table(result)}});
+  std::vector<OutputFile> files = {{"friction_levels.csv", levels_csv(result)},
+                                                            {"friction_samples.csv", samples_csv(result)},
+                                                            {"friction_static.csv", static_csv(result)},
+                                                            {"friction_models.csv", models_csv(result)},
+                                                            {"friction_identified.yaml", friction_identification_yaml(result, o)},
+                                                            {"friction_identification.md", friction_identification_table(result)}};
+  if (o.plant_friction != PlantFrictionForm::kModelForm) {
+    files.push_back({"friction_form.csv", model_form_csv(result)});
+    files.push_back({"friction_form_sweep.csv", sweep_csv(result.sweep)});
+  }
+  result.files = write_output_files(o.output_dir, files);
   return result;
 }
 
@@ -503,6 +563,10 @@ std::string friction_identification_table(const FrictionIdentificationResult& r)
        "(+/-) | err % | offset fit / plant | levels | residual rms |\n";
   s << "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const JointFrictionEstimate& e : r.joints) {
+    if (!e.valid) {
+      s << "| " << e.joint << " | INVALID: " << e.invalid_reason << " |||||||||||\n";
+      continue;
+    }
     s << "| " << e.joint << " | " << format_fixed(e.plant.coulomb_Nm, 4) << " | " << format_fixed(e.identified.coulomb_Nm, 4)
       << " | " << pct(e.coulomb_error()) << " | " << format_fixed(e.plant.viscous_Nms_per_rad, 4) << " | "
       << format_fixed(e.identified.viscous_Nms_per_rad, 4) << " | " << pct(e.viscous_error()) << " | "
@@ -515,6 +579,7 @@ std::string friction_identification_table(const FrictionIdentificationResult& r)
        "The offset is the fit's intercept, expected at minus the torque sensor's zero offset.\n";
   s << "Worst |error|: " << format_fixed(100.0 * r.worst_relative_error(), 2) << " %. Simulated "
     << format_fixed(r.simulated_s, 1) << " s in " << format_fixed(r.wall_s, 2) << " s of wall time.\n";
+  if (r.plant_friction != PlantFrictionForm::kModelForm) s << "\n" << model_form_markdown(r) << "\n" << sweep_markdown(r.sweep);
   return s.str();
 }
 
@@ -528,6 +593,10 @@ std::string friction_identification_yaml(const FrictionIdentificationResult& r, 
     << "# nominal ones (the identification does not measure them).\n"
     << "joints:\n";
   for (const JointFrictionEstimate& e : r.joints) {
+    if (!e.valid) {
+      s << "  # " << e.name << ": INVALID (" << e.invalid_reason << "), not identified\n";
+      continue;
+    }
     const FrictionParameters& f = e.identified;
     const bool raised = f.static_Nm < f.coulomb_Nm;
     s << "  - name: " << e.name << "\n"
@@ -544,8 +613,9 @@ std::string friction_identification_yaml(const FrictionIdentificationResult& r, 
 }
 
 int run_friction_identification_command(const FrictionIdentificationOptions& options, std::ostream& out) {
-  out << "friction identification: plant " << options.plant_config_path << ", friction perturbation "
-      << options.friction_perturbation << ", seed " << options.seed << ", joints";
+  out << "friction identification: plant " << options.plant_config_path
+      << (options.plant_friction == PlantFrictionForm::kStribeckRipple ? " (friction: Stribeck + ripple)" : "")
+      << ", friction perturbation " << options.friction_perturbation << ", seed " << options.seed << ", joints";
   for (int j : options.joints) out << ' ' << j;
   out << std::endl;
   const FrictionIdentificationResult r = identify_friction(options, &out);

@@ -38,6 +38,7 @@
 // The plant may be given friction that differs from actuators.yaml by a seeded random fraction
 // (friction_perturbation.hpp); the result then holds the plant's true values beside the
 // identified ones.
+#include <phri/experiments/friction_model_form.hpp>
 #include <phri/robot/friction_parameters.hpp>
 
 #include <cstdint>
@@ -63,6 +64,10 @@ struct FrictionIdentificationOptions {
   /// friction_perturbation.hpp); 0: the plant YAML's own friction (overrides included).
   double friction_perturbation = 0.2;
   std::uint64_t seed = 1;  ///< friction perturbation and sensor noise
+  /// The plant friction's form: the model's (default) or Stribeck + ripple (friction_model_form.hpp),
+  /// then compared with the identified model and swept over v_s.
+  PlantFrictionForm plant_friction = PlantFrictionForm::kModelForm;
+  StribeckRippleSettings stribeck_ripple;
 
   // ---- protocol
   std::vector<int> joints = {1, 2, 3, 4, 5, 6, 7};  ///< 1-based joint numbers
@@ -76,6 +81,7 @@ struct FrictionIdentificationOptions {
   int static_bisection_steps = 12;     ///< per direction
   double static_trial_s = 0.3;         ///< how long a trial current is applied from rest
   double breakaway_rad = 5e-4;         ///< motion that counts as "started" (20 encoder counts)
+  bool static_search = true;           ///< false: sliding levels only (the v_s sweep)
 };
 
 /// One constant-current level at steady state (means over the averaging window).
@@ -88,6 +94,7 @@ struct FrictionLevel {
   double torque_error_Nm = 0.0;     ///< K_T G_r i - tau_s
   double torque_error_std_Nm = 0.0; ///< over the samples of the window
   double velocity_drift_rad_s = 0.0;  ///< second half minus first half of the window
+  bool current_mode = true;  ///< every cycle of the window ran in current mode (else not steady: invalid)
   bool steady = false;
 };
 
@@ -119,6 +126,11 @@ struct JointFrictionEstimate {
   double residual_rms_Nm = 0.0;   ///< of the fit on the steady levels
   int levels_used = 0;
   int levels_total = 0;
+  /// False when the joint's intended run did not happen (too few steady levels on a plant of another
+  /// form; the model-form plant throws instead): its numbers are not results.
+  bool valid = true;
+  std::string invalid_reason;
+  ModelFormError form;  ///< computed on a plant of another form only
 
   static double relative_error(double identified, double truth) {
     return truth != 0.0 ? (identified - truth) / truth : 0.0;
@@ -136,8 +148,10 @@ struct FrictionIdentificationResult {
   double simulated_s = 0.0;
   double wall_s = 0.0;
   std::vector<std::string> files;  ///< written into the output directory
+  PlantFrictionForm plant_friction = PlantFrictionForm::kModelForm;
+  std::vector<FrictionFormSweepRow> sweep;  ///< the v_s sweep (Stribeck + ripple plant only)
 
-  /// Largest |relative error| over the identified Coulomb, viscous and static values.
+  /// Largest |relative error| over the identified Coulomb, viscous and static values (valid joints).
   double worst_relative_error() const;
 };
 

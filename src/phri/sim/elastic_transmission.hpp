@@ -60,6 +60,7 @@ public:
   /// Friction (dry + viscous) on the rotor over the last step [N.m].
   double friction_torque() const { return friction_; }
   const Parameters& parameters() const { return p_; }
+  const StickSlipFriction& dry_friction() const { return dry_; }
 
 private:
   Parameters p_;

@@ -100,6 +100,20 @@ std::unique_ptr<DriveLoops> make_drive_loops(const SimRobotConfig& c, const std:
   return std::make_unique<KinovaDriveEmulator>(c.actuators, c.vendor, c.physics_step_s(), c.control_period_s);
 }
 
+// A plant drive's dry friction: its levels, the presliding spring-damper for the physics step, and the
+// plant's sliding form (off by default).
+StickSlipFriction::Parameters dry_friction(const SimRobotConfig& c, const ActuatorParameters& a) {
+  StickSlipFriction::Parameters p = StickSlipFriction::presliding(a.friction.coulomb_Nm, a.friction.static_Nm,
+                                                                   a.reflected_inertia_kgm2, c.physics_step_s(),
+                                                                   c.friction.breakaway_velocity_rad_s);
+  p.stribeck_velocity_rad_s = c.friction.stribeck_velocity_rad_s;
+  p.stribeck_exponent = c.friction.stribeck_exponent;
+  p.ripple_Nm = c.friction.ripple_fraction * a.friction.coulomb_Nm;
+  p.ripple_cycles_per_rev = c.friction.ripple_cycles_per_rev;
+  p.ripple_phase_rad = c.friction.ripple_phase_rad;
+  return p;
+}
+
 }  // namespace
 
 SimRobot::SimRobot(const SimRobotConfig& config)
@@ -235,9 +249,7 @@ int SimRobot::bind_joint(int i) {
   // friction through MuJoCo's joint damping, which the Euler step integrates implicitly).
   m_->dof_damping[d] = a.friction.viscous_Nms_per_rad;
   m_->dof_frictionloss[d] = 0.0;
-  dry_.emplace_back(StickSlipFriction::presliding(a.friction.coulomb_Nm, a.friction.static_Nm,
-                                                  a.reflected_inertia_kgm2, config_.physics_step_s(),
-                                                  config_.friction.breakaway_velocity_rad_s));
+  dry_.emplace_back(dry_friction(config_, a));
   return m_->jnt_bodyid[j];
 }
 
@@ -254,8 +266,7 @@ void SimRobot::bind_elastic(int i) {
   p.rotor_inertia_kgm2 = a.reflected_inertia_kgm2;
   p.damping_Nms_per_rad = 2.0 * config_.elasticity.damping_ratio * std::sqrt(p.stiffness_Nm_per_rad * p.rotor_inertia_kgm2);
   p.viscous_Nms_per_rad = a.friction.viscous_Nms_per_rad;
-  elastic_.emplace_back(p, StickSlipFriction::presliding(a.friction.coulomb_Nm, a.friction.static_Nm, a.reflected_inertia_kgm2,
-                                                         config_.physics_step_s(), config_.friction.breakaway_velocity_rad_s));
+  elastic_.emplace_back(p, dry_friction(config_, a));
   dry_.emplace_back();  // unused: keeps the joint indexing of the rigid path
 }
 
@@ -1004,6 +1015,11 @@ double SimRobot::floor_normal_force() const {
     total += force[0];
   }
   return total;
+}
+
+const StickSlipFriction::Parameters& SimRobot::dry_friction_parameters(int i) const {
+  const auto k = static_cast<std::size_t>(i);
+  return elastic() ? elastic_[k].dry_friction().parameters() : dry_[k].parameters();
 }
 
 }  // namespace phri

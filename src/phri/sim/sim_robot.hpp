@@ -109,6 +109,8 @@ public:
   const SimRobotConfig& config() const { return config_; }
   /// The drives as simulated (actuators.yaml with the plant overrides).
   const ActuatorTable& plant_actuators() const { return plant_actuators_; }
+  /// Joint i's dry friction as the plant applies it (levels, presliding, sliding form): ground truth.
+  const StickSlipFriction::Parameters& dry_friction_parameters(int i) const;
   /// Position limits used to validate kPosition set-points (+-100 rad for continuous joints).
   const Eigen::VectorXd& position_lower_rad() const { return lower_; }
   const Eigen::VectorXd& position_upper_rad() const { return upper_; }
