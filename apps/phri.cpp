@@ -654,6 +654,9 @@ CLI::App* add_torque_tracking_command(CLI::App& experiment, TrackingArguments& a
   tracking->add_option("--static-s", torque.static_duration_s, "static scenario duration")->check(CLI::Range(1.0, 600.0));
   tracking->add_option("--dynamic-s", torque.dynamic_duration_s, "dynamic scenario duration")->check(CLI::Range(1.0, 600.0));
   tracking->add_option("--plant", torque.plant_config_path, "plant configuration")->check(CLI::ExistingFile);
+  tracking->add_flag("--elastic", torque.elastic,
+                     "on the plant `phri evaluate` uses: elastic joints (plant.elasticity) and the paper's open-loop "
+                     "position mode; writes each run's elastic_modes_<scenario>_<loop>.csv");
   tracking->add_flag("--static-ft", args.static_ft,
                      "static scenario as in the paper: the weight is hung after the switch and compensated through the "
                      "F/T sensor (J^T F), not the joint-torque observer");
@@ -911,6 +914,7 @@ int torque_tracking_command(TrackingArguments& args) {
     torque.payload_mode = phri::PayloadMode::kHungAfterSwitch;
   }
   if (args.mismatch_seed_option->count() > 0) torque.mismatch_seed = args.mismatch_seed;
+  if (torque.elastic) phri::use_evaluation_plant(torque);
   for (std::string* path : {&torque.plant_config_path, &torque.urdf_path, &torque.actuators_path, &torque.collision_path,
                             &torque.figure_script, &args.sweep.figure_script}) {
     *path = locate(*path);

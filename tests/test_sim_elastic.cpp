@@ -4,17 +4,21 @@
 // link (qfrc_bias), the torque sensor reads it, and the link sags by tau / K behind a motor-side
 // servo while a link-side servo holds the link itself at its set-point.
 #include <phri/control/controller.hpp>
+#include <phri/experiments/elastic_modes.hpp>
 #include <phri/sim/sim_robot.hpp>
 
 #include "gen3_settings.hpp"
 
 #include <mujoco/mujoco.h>
 
+#include <Eigen/Eigenvalues>
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <numbers>
 #include <cstdio>
 #include <string>
+#include <tuple>
 #include <vector>
 
 namespace {
@@ -110,6 +114,44 @@ TEST(SimElastic, OpenLoopPositionModeLeavesTheSpringDeflectionUncorrected) {
         << "joint " << i + 1;
   }
   EXPECT_FALSE(robot.state().fault);
+}
+
+// The ringing figure of issue 39 (elastic_modes.hpp): rotor B and link J on a spring K have one
+// non-zero mode, the generalized eigenvalue of K [[1, -1], [-1, 1]] x = w^2 diag(J, B) x; the closed
+// form sqrt(K (1/J + 1/B)) / 2 pi must equal it, and the plant's figure must use the plant's own K, B
+// and link-side M_ii (MuJoCo's full inertia matrix's diagonal: the rotor is off the link).
+TEST(SimElastic, TwoMassModeIsTheSpringsEigenvalueOnThePlantsInertia) {
+  for (const auto& [k, j, b] : {std::tuple{13000.0, 2.5, 0.03}, std::tuple{5500.0, 0.012, 0.03}, std::tuple{4000.0, 0.3, 0.3}}) {
+    Eigen::Matrix2d stiffness, inertia;
+    stiffness << k, -k, -k, k;
+    inertia << j, 0.0, 0.0, b;
+    const Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::Matrix2d> modes(stiffness, inertia);
+    const double eigen_hz = std::sqrt(modes.eigenvalues().maxCoeff()) / (2.0 * std::numbers::pi);
+    EXPECT_NEAR(phri::two_mass_mode_hz(k, j, b), eigen_hz, 1e-9 * eigen_hz);
+    EXPECT_LT(std::abs(modes.eigenvalues().minCoeff()), 1e-9 * modes.eigenvalues().maxCoeff());  // the rigid motion
+  }
+  EXPECT_EQ(phri::two_mass_mode_hz(1000.0, 0.0, 0.03), 0.0);
+
+  phri::SimRobotConfig c = phri::SimRobotConfig::from_yaml_file(kRoot + "/configs/plant_gen3.yaml");
+  c.initial_q_rad = kPose;
+  c.elasticity.enabled = true;
+  phri::SimRobot robot(c);
+  robot.read();
+  const std::vector<phri::ElasticJointMode> plant = phri::elastic_joint_modes(robot);
+  ASSERT_EQ(plant.size(), 7u);
+  const mjModel* m = robot.mujoco_model();
+  std::vector<mjtNum> full(static_cast<std::size_t>(m->nv * m->nv));
+  mj_fullM(m, full.data(), robot.mujoco_data()->qM);
+  for (int i = 0; i < 7; ++i) {  // the arm's 7 hinges come first in the scene
+    const phri::ElasticJointMode& mode = plant[static_cast<std::size_t>(i)];
+    EXPECT_DOUBLE_EQ(mode.stiffness_Nm_per_rad, c.elasticity.stiffness_Nm_per_rad[static_cast<std::size_t>(i)]);
+    EXPECT_DOUBLE_EQ(mode.rotor_inertia_kgm2, robot.plant_actuators()[i].reflected_inertia_kgm2);
+    EXPECT_NEAR(mode.link_inertia_kgm2, full[static_cast<std::size_t>(i * m->nv + i)], 1e-12);
+    EXPECT_NEAR(mode.mode_hz, phri::two_mass_mode_hz(mode.stiffness_Nm_per_rad, mode.link_inertia_kgm2, mode.rotor_inertia_kgm2), 1e-12);
+    EXPECT_GT(mode.mode_hz, mode.locked_link_hz);  // the link's inertia only adds to 1/B
+  }
+  c.elasticity.enabled = false;
+  EXPECT_TRUE(phri::elastic_joint_modes(phri::SimRobot(c)).empty());
 }
 
 }  // namespace

@@ -5,11 +5,16 @@ loses every metric (plus an invalid drop and censored drops in each), runs the r
 (tools/report/evaluation_report.py) on each, and checks that the verdict sentences differ
 accordingly: REPRODUCED with the signs + in the first, NOT REPRODUCED with the signs - in the
 second; the invalid drop is counted and left out; the censored drops are counted, not averaged.
+Sensitivity rows grouped by parameter (sensitivity/variants.csv): a cable-stiffness row where the
+outcome flips makes every claim say "depends on cable stiffness", a joint-stiffness row that agrees
+does not. Torque-tracking summaries with an INVALID run: the run is flagged, its scenario gets no
+verdict, the valid scenario gets one.
 
 Usage: test_verdicts.py REPORT_SCRIPT WORK_DIR
 """
 import os
 import re
+import shutil
 import subprocess
 import sys
 
@@ -45,6 +50,34 @@ def write_runs(path, torque_better, seed):
         f.write("\n".join(lines) + "\n")
 
 
+def write_sensitivity(out):
+    """Three rows: cable stiffness (same data, then the opposite data) and joint stiffness (same data)."""
+    rows = [("cable_a", "cable stiffness", "cable 8000 N/m", True), ("cable_b", "cable stiffness", "cable 40000 N/m", False),
+            ("joints_soft", "joint stiffness", "joints 4000 / 3500", True)]
+    for name, _, _, better in rows:
+        write_runs(f"{out}/sensitivity/{name}/drop_test_runs.csv", better, seed=11)
+    with open(f"{out}/sensitivity/variants.csv", "w") as f:
+        f.write("name,parameter,setting,source\n")
+        for name, parameter, setting, _ in rows:
+            f.write(f'{name},{parameter},"{setting}","no source, synthetic"\n')
+
+
+def write_tracking(out):
+    """Torque-tracking summary on elastic joints: static valid, dynamic with an INVALID custom run."""
+    os.makedirs(f"{out}/torque_tracking", exist_ok=True)
+    head = ("scenario,loop,rms_Nm,p95_Nm,max_Nm,bias_Nm,rms_true_Nm,p95_true_Nm,window_start_s,samples,ee_rms_mm,"
+            "ee_y_rms_mm,ee_z_rms_mm,ee_vy_rms_mm_s,ee_vz_rms_mm_s,elastic,qp_fallbacks,safe_stop,loop_mismatch_cycles,"
+            "loop_ran,valid,invalid_reason")
+    lines = [head]
+    for scen, loop, rms, valid in (("static", "custom", 0.1, 1), ("static", "kinova_torque_high_velocity", 0.3, 1),
+                                   ("dynamic", "custom", 0.5, 0), ("dynamic", "kinova_torque_high_velocity", 0.9, 1)):
+        why = "" if valid else "safe stop at 2.000 s (tracking_error; joint 4)"
+        lines.append(f"{scen},{loop},{rms},{rms},{rms},0,{rms},{rms},0.5,1000,1,1,1,1,1,1,0,{1 - valid},0,"
+                     f"{loop if valid else 'position'},{valid},{why}")
+    with open(f"{out}/torque_tracking/torque_tracking_summary.csv", "w") as f:
+        f.write("\n".join(lines) + "\n")
+
+
 def run_report(script, out):
     run = subprocess.run(["/usr/bin/python3", script, out, "quick", "1.0"], capture_output=True, text=True, timeout=300)
     if run.returncode != 0:
@@ -60,11 +93,17 @@ def claims(md):
 
 def main(argv):
     script, work = argv[1], argv[2]
+    shutil.rmtree(work, ignore_errors=True)  # no rows of an earlier run
     reports = {}
     for name, better in (("torque_wins", True), ("torque_loses", False)):
         out = f"{work}/{name}"
         write_runs(f"{out}/drop_test/drop_test_runs.csv", better, seed=7)
         reports[name] = run_report(script, out)
+    ranges = f"{work}/ranges"  # torque wins in the main table; sensitivity rows and tracking runs
+    write_runs(f"{ranges}/drop_test/drop_test_runs.csv", True, seed=7)
+    write_sensitivity(ranges)
+    write_tracking(ranges)
+    ranges_md = run_report(script, ranges)
     failures = []
     win, lose = claims(reports["torque_wins"]), claims(reports["torque_loses"])
     drop_win = [c for c in win if "torque mode" in c]
@@ -82,6 +121,17 @@ def main(argv):
             failures.append(f"torque wins without a positive signed effect: {a[:200]}")
         if not re.search(r"effect size -\d", b) or "against torque mode" not in b:
             failures.append(f"torque loses without a negative signed effect: {b[:200]}")
+    for c in [c for c in claims(ranges_md) if "torque mode" in c]:
+        if "depends on cable stiffness (main setting: reproduced" not in c or "cable 40000 N/m: reversed" not in c:
+            failures.append(f"a flip inside the cable-stiffness range not stated: {c[-400:]}")
+        if "No flip of the main outcome (reproduced) over joint stiffness (1 row" not in c:
+            failures.append(f"an agreeing joint-stiffness row not stated as holding: {c[-400:]}")
+    md = ranges_md
+    tracking = [line for line in md.splitlines() if line.startswith("Claim 'the custom loop")]
+    if len(tracking) != 1 or "(static, elastic joints)" not in tracking[0] or "HV / custom = 3.00" not in tracking[0]:
+        failures.append(f"expected one torque-tracking verdict, static on elastic joints: {tracking}")
+    if "INVALID: custom torque: safe stop at 2.000 s" not in md or "Tracking runs: 1 of 4 INVALID" not in md:
+        failures.append("the invalid dynamic custom run is not flagged in the table and the header")
     for name, md in reports.items():
         if "1 of 24 drops INVALID" not in md:
             failures.append(f"{name}: the header does not count the invalid drop")

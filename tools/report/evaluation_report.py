@@ -19,10 +19,11 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from drop_test_figure import PAPER as DROP_PAPER  # noqa: E402
 from drop_test_figure import draw as draw_drop  # noqa: E402
 from drop_test_figure import drop_statistics, fmt, statistics_table  # noqa: E402
-from verdicts import MIN_VALID, claim_paragraph, outcome  # noqa: E402
+from verdicts import MIN_VALID, claim_paragraph, outcome, parameter_range_sentence  # noqa: E402
 from report_common import plt, read_rows, save_figure  # noqa: E402
 from parameter_sources import markdown_table, parameter_rows  # noqa: E402
 from friction_form_report import form_sentences, form_table, sweep_sentences, sweep_table  # noqa: E402
+from ringing import MIN_HZ, measure_ringing, ringing_sentence  # noqa: E402
 
 # The paper's friction model, eq. friction-model: tau_f = Fc sign(qd) + Fv qd.
 PAPER_FRICTION = {"large": (2.15, 2.00), "small": (1.60, 1.36)}
@@ -152,65 +153,97 @@ def friction_form_subsection(rep, out):
             rep.p(sentence)
 
 
+def plant_words(row):
+    """The plant a tracking run ran on, from its summary row."""
+    return "elastic joints" if row.get("elastic") == "1" else "rigid joints"
+
+
+def run_valid(row):
+    return row.get("valid", "1") == "1"
+
+
+def tracking_summary(path):
+    return read_rows(path) if os.path.exists(path) else []
+
+
 def torque_tracking_section(rep, out):
     d = f"{out}/torque_tracking"
     rep.h(2, "2. Torque tracking (static and dynamic)")
     rep.p("Metric: ||tau_d[k] - tau_s[k+1]|| over the 7 joints (the QP's desired torque against the torque sensors at "
           "the end of the period it was in force), RMS and 95th percentile after a 0.5 s transient; static: demo "
           "posture, 1.25 kg on the tool, stiff end effector; dynamic: the demo's y-z scenario (z sine 0.1 m at 3 rad/s, "
-          "y triangle at 0.1 m/s), null-space compliance.")
-    summary = read_rows(f"{d}/torque_tracking_summary.csv") if os.path.exists(f"{d}/torque_tracking_summary.csv") else []
-    by = {(r["scenario"], r["loop"]): r for r in summary}
-    rows = []
-    for scen in ("static", "dynamic"):
-        c, hv = by.get((scen, "custom")), by.get((scen, "kinova_torque_high_velocity"))
-        if c is None or hv is None:
-            continue
-        ratio = float(hv["rms_Nm"]) / float(c["rms_Nm"])
-        rows.append([scen, f"{float(c['rms_Nm']):.4f}", f"{float(c['p95_Nm']):.4f}", f"{float(hv['rms_Nm']):.4f}",
-                     f"{float(hv['p95_Nm']):.4f}", f"{ratio:.2f}", "custom below Kinova HV (Fig. torque-control-results, "
-                     "log scale; no numbers given)"])
-    elastic = f"{out}/torque_tracking_elastic/torque_tracking_summary.csv"
-    if os.path.exists(elastic):
-        e = {(r["scenario"], r["loop"]): r for r in read_rows(elastic)}
-        c, hv = e.get(("static", "custom")), e.get(("static", "kinova_torque_high_velocity"))
-        if c is not None and hv is not None:
+          "y triangle at 0.1 m/s), null-space compliance. A run in which the supervisor stopped, the QP fell back or "
+          "another loop ran than the row names is INVALID and left out of the verdicts.")
+    summary = tracking_summary(f"{d}/torque_tracking_summary.csv")
+    rows, verdict_rows = [], []
+    for label, runs in (("", summary), (" (sensitivity)", tracking_summary(f"{out}/torque_tracking_rigid/torque_tracking_summary.csv"))):
+        by = {(r["scenario"], r["loop"]): r for r in runs}
+        for scen in ("static", "dynamic"):
+            c, hv = by.get((scen, "custom")), by.get((scen, "kinova_torque_high_velocity"))
+            if c is None or hv is None:
+                continue
+            name = f"{scen}, {plant_words(c)}{label}"
+            invalid = [f"{LOOP_NAMES[r['loop']]}: {r['invalid_reason']}" for r in (c, hv) if not run_valid(r)]
             ratio = float(hv["rms_Nm"]) / float(c["rms_Nm"])
-            rows.append(["static, elastic joints", f"{float(c['rms_Nm']):.4f}", f"{float(c['p95_Nm']):.4f}",
-                         f"{float(hv['rms_Nm']):.4f}", f"{float(hv['p95_Nm']):.4f}", f"{ratio:.2f}", "(same figure)"])
-    rep.table(md_table(["scenario", "custom RMS [N.m]", "custom p95", "Kinova HV RMS", "Kinova HV p95", "HV / custom",
-                        "paper"], rows))
-    for r in rows:
-        ratio = float(r[5])
+            rows.append([name, f"{float(c['rms_Nm']):.4f}", f"{float(c['p95_Nm']):.4f}", f"{float(hv['rms_Nm']):.4f}",
+                         f"{float(hv['p95_Nm']):.4f}", f"{ratio:.2f}",
+                         "INVALID: " + "; ".join(invalid) if invalid else "yes"])
+            if not invalid:
+                verdict_rows.append((name, c, hv, ratio))
+    rep.table(md_table(["scenario, plant", "custom RMS [N.m]", "custom p95", "Kinova HV RMS", "Kinova HV p95",
+                        "HV / custom", "valid"], rows))
+    rep.p("Paper (Fig. torque-control-results, log scale, no numbers): custom below Kinova HV in both scenarios.")
+    for name, c, hv, ratio in verdict_rows:
         if ratio > 1.0 + GAP:
             verdict, direction = "REPRODUCED in direction", "custom lower than Kinova HV: the paper's direction"
         elif ratio < 1.0 - GAP:
             verdict, direction = "NOT REPRODUCED", "custom higher than Kinova HV: the opposite of the paper's direction"
         else:
             verdict, direction = "NOT REPRODUCED", f"the two within {100 * GAP:.0f} % of each other: no gap"
-        rep.p(f"Claim 'the custom loop tracks torque better than Kinova's high-velocity loop' ({r[0]}): {verdict}: RMS "
-              f"custom {r[1]} vs Kinova HV {r[3]} N.m, HV / custom = {ratio:.2f} ({direction}); one run per loop, so no "
-              f"test (a gap counts from {100 * GAP:.0f} %, a margin with no source); the paper gives no numbers to compare "
-              "the magnitude with.")
+        rep.p(f"Claim 'the custom loop tracks torque better than Kinova's high-velocity loop' ({name}): {verdict}: RMS "
+              f"custom {float(c['rms_Nm']):.4f} vs Kinova HV {float(hv['rms_Nm']):.4f} N.m, HV / custom = {ratio:.2f} "
+              f"({direction}); one run per loop, so no test (a gap counts from {100 * GAP:.0f} %, a margin with no "
+              "source); the paper gives no numbers to compare the magnitude with.")
     rep.figure(f"{d}/torque_tracking.png", "Torque tracking error, custom vs Kinova high-velocity loop")
+    ringing_subsection(rep, d)
 
 
-# What each sensitivity variant changes (protocol, as evaluation.cpp sets it), named in verdicts.
-VARIANT_SETTING = {
-    "observer_only_K10": "external torque from the observer alone (K_O 10)",
-    "observer_only_K50": "external torque from the observer alone (K_O 50)",
-    "ft_only": "external torque from the F/T sensor alone",
-    "cable_damping_50": "cable damping 50 N.s/m",
-    "cable_stiffness_8000": "cable stiffness 8000 N/m (damping ratio 0.1)",
-    "cable_stiffness_32620": "cable stiffness 32620 N/m (the reference's paracord estimate, damping ratio 0.1)",
-    "vendor_gains_x0.5": "vendor servo gains x 0.5",
-    "no_release_spread": "no release spread",
-    "weight_latched_on_tool": "weight latched on the tool",
-    "rigid_joints": "rigid joints",
-    "servo_on_link_encoder": "vendor servo on the link encoder",
-    "soft_joints_4000_3500": "joint stiffness 4000 / 3500 N.m/rad",
-    "position_qp_on_measured_state": "position-mode QP on the measured state",
-}
+def ringing_subsection(rep, d):
+    """Each elastic run's ringing, measured from its log, beside the plant's computed two-mass modes
+    at that run's final posture (ringing.py, elastic_modes.hpp)."""
+    rep.h(3, "Ringing on elastic joints: measured vs computed")
+    runs = []
+    for scen in ("static", "dynamic"):
+        for loop in ("custom", "kinova_torque_high_velocity"):
+            log, modes = f"{d}/torque_tracking_{scen}_{loop}.csv", f"{d}/elastic_modes_{scen}_{loop}.csv"
+            if os.path.exists(log) and os.path.exists(modes):
+                runs.append((scen, loop, measure_ringing(read_rows(log)), read_rows(modes)))
+    if not runs:
+        rep.p("Not measured (no elastic run's log and modes in torque_tracking/).")
+        return
+    rep.p("Computed from the plant, per joint: rotor (reflected inertia B) and link (the plant's own M_ii at the run's "
+          "final posture, the other joints held) on the joint's spring K, f = sqrt(K (1/M_ii + 1/B)) / 2 pi "
+          "(src/phri/experiments/elastic_modes.hpp), and the locked-link sqrt(K/B) / 2 pi; the static run's posture:")
+    static = next((m for scen, _, _, m in runs if scen == "static"), runs[0][3])
+    rep.table(md_table(["joint", "K [N.m/rad]", "B [kg.m^2]", "M_ii [kg.m^2]", "locked-link [Hz]", "two-mass mode [Hz]"],
+                       [[m["joint"], f"{float(m['stiffness_Nm_per_rad']):.0f}", f"{float(m['rotor_inertia_kgm2']):.3f}",
+                         f"{float(m['link_inertia_kgm2']):.4f}", f"{float(m['locked_link_hz']):.1f}",
+                         f"{float(m['mode_hz']):.1f}"] for m in static]))
+    rep.p(f"Measured from each run's log, per joint: the spectrum (Hann window) of the measured torque error "
+          f"tau_d - tau_s after the transient, mean removed, above {MIN_HZ:g} Hz; cells: the dominant peak's frequency "
+          "[Hz] / amplitude [N.m] / peak over the spectrum's median (the noise floor: the plant's 0.05 N.m sensor noise "
+          "is white); beside it the joint's computed two-mass mode at that run's posture [Hz].")
+    rows = []
+    for scen, loop, ring, modes in runs:
+        computed = {int(m["joint"]): float(m["mode_hz"]) for m in modes}
+        rows.append([f"{scen}, {LOOP_NAMES[loop]}"] +
+                    [f"{r['peak_hz']:.1f} / {r['peak_amplitude_Nm']:.3f} / {r['peak_over_floor']:.0f}x "
+                     f"({computed.get(r['joint'], float('nan')):.1f})" for r in ring])
+    rep.table(md_table(["run"] + [f"joint {r['joint']}" for r in runs[0][2]], rows))
+    for scen, loop, ring, modes in runs:
+        rep.p(f"{scen.capitalize()} scenario, " + ringing_sentence(LOOP_NAMES[loop], ring, modes))
+
+
 DROP_CLAIMS = [("peak_mm", "peak error after the catch is lower in torque mode", "mm"),
                ("stabilisation_s", "torque mode stabilises faster", "s"),
                ("residual_mm", "the residual error is lower in torque mode", "mm")]
@@ -254,10 +287,14 @@ def drop_section(rep, out, sensitivity):
             alternatives += [(f"band {b['band_mm']:g} mm", b, True) for b in st["bands"][1:]]
         if key == "residual_mm" and "residual_shift_mm" in st:
             alternatives.append(("the residual measured from the error before the drop", st["residual_shift_mm"], True))
+        by_parameter = {}
         for name, vs in sorted(sensitivity.items()):
             if key in vs:
-                alternatives.append((VARIANT_SETTING.get(name, name), vs[key], False))
-        rep.p(claim_paragraph(claim, main, alternatives, DROP_PAPER.get(key), unit))
+                alternatives.append((vs["setting"], vs[key], False))
+                by_parameter.setdefault(vs["parameter"], []).append((vs["setting"], vs[key]))
+        text = claim_paragraph(claim, main, alternatives, DROP_PAPER.get(key), unit)
+        ranges = parameter_range_sentence(main, by_parameter)
+        rep.p(text + (" " + ranges if ranges else ""))
     traces = f"{d}/drop_test_traces.csv"
     if os.path.exists(traces):
         tr = trace_summary(d)
@@ -286,13 +323,23 @@ def trace_summary(d):
 
 
 def sensitivity_statistics(out):
+    """Per variant folder: its drop statistics with the setting, parameter and source that
+    sensitivity/variants.csv (written by phri evaluate) names for it."""
     base = f"{out}/sensitivity"
+    index = {}
+    if os.path.exists(f"{base}/variants.csv"):
+        index = {r["name"]: r for r in read_rows(f"{base}/variants.csv")}
     by_name = {}
     if os.path.isdir(base):
         for name in sorted(os.listdir(base)):
             path = f"{base}/{name}/drop_test_runs.csv"
             if os.path.exists(path):
-                by_name[name] = drop_statistics(read_rows(path))
+                st = drop_statistics(read_rows(path))
+                row = index.get(name, {})
+                st["setting"] = row.get("setting", name)
+                st["parameter"] = row.get("parameter", name)
+                st["source"] = row.get("source", "not stated (variants.csv missing)")
+                by_name[name] = st
     return by_name
 
 
@@ -306,19 +353,19 @@ def sensitivity_section(rep, by_name):
           f"{MIN_VALID} valid drops per mode is not tested. Cells: torque / position (mean, or Kaplan-Meier median for "
           "stabilisation), p, outcome.")
     rows = []
-    for name, st in by_name.items():
+    for name, st in sorted(by_name.items(), key=lambda kv: kv[1]["parameter"]):
         v = st["validity"]
         valid = f"{v['torque']} / {v['position']}"
         if v["invalid"]:
-            valid += f" (INVALID {len(v['invalid'])}: {v['invalid'][0][2]})"
-        row = [name, VARIANT_SETTING.get(name, name), valid]
+            valid += f" (INVALID {len(v['invalid'])}, excluded: {v['invalid'][0][2]})"
+        row = [st["parameter"], st["setting"], st["source"], valid]
         for key, _, _ in DROP_CLAIMS:
             s = st[key]
             cens = f", censored {s['censored_torque']} / {s['censored_position']}" if key == "stabilisation_s" else ""
             row.append(f"{fmt(s['torque_centre'])} / {fmt(s['position_centre'])} (p {fmt(s['p'])}{cens}): {outcome(s)}")
         rows.append(row)
-    rep.table(md_table(["variant", "setting", "valid drops torque / position", "peak [mm]", "stabilisation [s]",
-                        "residual [mm]"], rows))
+    rep.table(md_table(["parameter", "setting", "source", "valid drops torque / position", "peak [mm]",
+                        "stabilisation [s]", "residual [mm]"], rows))
 
 
 def dynamic_section(rep, out):
@@ -329,12 +376,16 @@ def dynamic_section(rep, out):
           "Errors: position = task target - plant end effector, velocity = the target's reference velocity - plant "
           "end-effector velocity (J q_dot from the plant's true joint velocities: no numerical derivative), RMS over "
           "the run after a 0.5 s transient.")
-    summary = read_rows(f"{d}/torque_tracking_summary.csv") if os.path.exists(f"{d}/torque_tracking_summary.csv") else []
+    summary = tracking_summary(f"{d}/torque_tracking_summary.csv")
     rows = [[LOOP_NAMES.get(r["loop"], r["loop"]), f"{float(r['ee_y_rms_mm']):.3f}", f"{float(r['ee_z_rms_mm']):.3f}",
-             f"{float(r['ee_vy_rms_mm_s']):.2f}", f"{float(r['ee_vz_rms_mm_s']):.2f}", f"{float(r['rms_Nm']):.3f}"]
-            for r in summary]
-    rep.table(md_table(["loop", "y RMS [mm]", "z RMS [mm]", "v_y RMS [mm/s]", "v_z RMS [mm/s]", "torque RMS [N.m]"], rows))
-    rms = {r["loop"]: math.hypot(float(r["ee_y_rms_mm"]), float(r["ee_z_rms_mm"])) for r in summary}
+             f"{float(r['ee_vy_rms_mm_s']):.2f}", f"{float(r['ee_vz_rms_mm_s']):.2f}", f"{float(r['rms_Nm']):.3f}",
+             "yes" if run_valid(r) else "INVALID: " + r["invalid_reason"]] for r in summary]
+    rep.table(md_table(["loop", "y RMS [mm]", "z RMS [mm]", "v_y RMS [mm/s]", "v_z RMS [mm/s]", "torque RMS [N.m]",
+                        "valid"], rows))
+    if summary:
+        rep.p(f"Plant: {', '.join(sorted({plant_words(r) for r in summary}))}; invalid runs (excluded below): "
+              f"{sum(1 for r in summary if not run_valid(r))} of {len(summary)}.")
+    rms = {r["loop"]: math.hypot(float(r["ee_y_rms_mm"]), float(r["ee_z_rms_mm"])) for r in summary if run_valid(r)}
     if {"custom", "position", "kinova_torque"} <= rms.keys():
         c, pos, kt = rms["custom"], rms["position"], rms["kinova_torque"]
         paper_dir = "the paper's direction" if kt > c else "the opposite of the paper"
@@ -344,11 +395,19 @@ def dynamic_section(rep, out):
               f"(Kinova torque / custom = {kt / c:.2f}): custom is "
               f"{'more' if kt > c else 'less'} precise than Kinova's torque loop "
               f"({paper_dir}), and "
-              f"{'within a factor 2 of' if 0.5 <= c / pos <= 2.0 else 'more than a factor 2 from'} position control. "
-              "This section runs the rigid plant with the position-mode QP on the measured state, not the drop test's "
-              "elastic plant and open-loop position mode.")
+              f"{position_words(c / pos)}.")
+    elif summary:
+        rep.p("No comparison with the paper: the custom, position or Kinova torque run is missing or INVALID.")
     draw_dynamic(d, f"{d}/dynamic_tracking.png")
     rep.figure(f"{d}/dynamic_tracking.png", "Dynamic tracking: y and z position and velocity errors per loop")
+
+
+def position_words(ratio):
+    """Custom against position control, from custom / position of the y-z RMS error."""
+    if 0.5 <= ratio <= 2.0:
+        return "within a factor 2 of position control"
+    side = "more" if ratio < 0.5 else "less"
+    return f"{side} precise than position control by more than a factor 2"
 
 
 def draw_dynamic(d, output):
@@ -411,6 +470,18 @@ def draw_dual(d, output):
     save_figure(fig, output, 110, "Dual compliance", 11)
 
 
+def plant_header(out):
+    """Which plant the tracking evaluations ran on, from their summaries (the drop test's is elastic
+    unless a sensitivity row says otherwise)."""
+    runs = [r for sub in ("torque_tracking", "dynamic_tracking")
+            for r in tracking_summary(f"{out}/{sub}/torque_tracking_summary.csv")]
+    if not runs:
+        return "no tracking runs found"
+    plants = sorted({plant_words(r) for r in runs})
+    return (f"torque and dynamic tracking on {' and '.join(plants)}, the drop test on elastic joints; rigid joints only "
+            "in rows labelled sensitivity")
+
+
 def validity_header(rep, out, sensitivity):
     """The report's header line on validity: invalid drops over the main table and every variant."""
     sets = {}
@@ -423,6 +494,12 @@ def validity_header(rep, out, sensitivity):
     text = (f"Validity: {sum(invalid.values())} of {total} drops INVALID (supervisor safe stop, QP fallback, or a "
             "low-level loop other than the one the row names) and excluded from the statistics")
     text += (": " + ", ".join(f"{n}: {k}" for n, k in invalid.items()) + "." if invalid else ".")
+    tracking = [(sub, r) for sub in ("torque_tracking", "torque_tracking_rigid", "dynamic_tracking")
+                for r in tracking_summary(f"{out}/{sub}/torque_tracking_summary.csv")]
+    if tracking:
+        bad = [f"{sub} {r['scenario']} / {r['loop']} ({r['invalid_reason']})" for sub, r in tracking if not run_valid(r)]
+        text += (f" Tracking runs: {len(bad)} of {len(tracking)} INVALID and excluded from the verdicts"
+                 + (": " + "; ".join(bad) + "." if bad else "."))
     rep.p(text)
 
 
@@ -449,8 +526,7 @@ def main(argv):
     rep.p(f"Protocol: {'QUICK (shortened protocols: a smoke test, not the paper numbers)' if mode == 'quick' else 'full'}; "
           f"experiments took {seconds:.1f} s of wall time. Reproduce: phri evaluate --out {out}"
           f"{' --quick' if mode == 'quick' else ''}. Plant: MuJoCo Gen3 with drive friction, rotor inertia, sensor "
-          "noise, 5 % link and drive-gain mismatch; rigid joints except in the drop test, which enables the plant's joint "
-          "elasticity (plant.elasticity).")
+          f"noise, 5 % link and drive-gain mismatch; {plant_header(out)}.")
     sensitivity = sensitivity_statistics(out)
     validity_header(rep, out, sensitivity)
     parameters_section(rep, argv[4:])

@@ -131,3 +131,26 @@ def claim_paragraph(claim, main, alternatives, paper, unit):
     if others:
         text.append("Other settings: " + "; ".join(others) + ".")
     return " ".join(text)
+
+
+def parameter_range_sentence(main, by_parameter):
+    """Per parameter swept over its plausible range (sensitivity rows grouped by parameter), whether
+    the claim's outcome holds over the rows or flips: 'depends on <parameter>'. by_parameter maps a
+    parameter to [(setting, statistics)]. A row whose outcome differs only by being inconclusive
+    (fewer drops than the main table) does not count as a flip, as in verdict_word."""
+    base = outcome(main)
+    flips, holds = [], []
+    for parameter, rows in by_parameter.items():
+        outcomes = [(setting, outcome(s)) for setting, s in rows]
+        differing = [(setting, o) for setting, o in outcomes if o != base and o != "inconclusive"]
+        detail = ", ".join(f"{setting}: {o}" for setting, o in outcomes)
+        if differing:
+            flips.append(f"depends on {parameter} (main setting: {base}; {detail})")
+        else:
+            holds.append(f"{parameter} ({len(rows)} row{'s' if len(rows) != 1 else ''}: {detail})")
+    parts = []
+    if flips:
+        parts.append("Over the plausible ranges: " + "; ".join(flips) + ".")
+    if holds:
+        parts.append(f"No flip of the main outcome ({base}) over " + "; ".join(holds) + ".")
+    return " ".join(parts)

@@ -75,22 +75,6 @@ LowLevelMode expected_loop(const DropTestOptions& o, DropMode mode) {
   return mode == DropMode::kTorque ? o.torque_loop : LowLevelMode::kPosition;
 }
 
-// Validity bookkeeping of one cycle: QP fallbacks, the supervisor's safe stop, the loop that ran.
-void check_cycle(const DropTestOptions& o, DropMode mode, bool switched, CycleStatus status, const Controller& cycle,
-                 const RobotCommand& command, DropRun& run) {
-  if (status == CycleStatus::kQpFallback) ++run.qp_fallbacks;
-  if (!run.safe_stop && cycle.supervisor().safe_stop()) {
-    const SafetyTransition& t = cycle.supervisor().safe_stop_transition();
-    run.safe_stop = true;
-    run.safe_stop_s = t.time_s;
-    run.safe_stop_reason = std::string(to_string(t.reason)) + (t.joint >= 0 ? ", joint " + std::to_string(t.joint + 1) : "");
-  }
-  if (switched && (command.mode != expected_loop(o, mode) || cycle.low_level().loop() != expected_loop(o, mode))) {
-    ++run.loop_mismatch_cycles;
-  }
-  run.loop_ran = std::string(to_string(command.mode));
-}
-
 // The metrics of a finished drop: peak, residual, its shift from before the drop, stabilisation per band.
 void finish_drop(const DropTestOptions& o, double dt, DropRun& run) {
   drop_metrics(run.error_mm, dt, o.residual_window_s, run.peak_mm, run.residual_mm);
@@ -139,7 +123,7 @@ DropRun run_drop(const DropShared& sh, DropMode mode, int index) {
     targets.clear();
     if (mode == DropMode::kTorque && k == switch_k) targets.low_level_mode = o.torque_loop;
     const CycleStatus status = cycle.step(state, targets, command);
-    check_cycle(o, mode, k >= switch_k + 1, status, cycle, command, run);
+    run.check_cycle(status, cycle, command, k >= switch_k + 1, expected_loop(o, mode));
     robot.write(command);
     record_true_contact(contact, cycle, robot);
     const SimRobot::Truth& t = robot.truth();
@@ -204,10 +188,8 @@ std::string runs_csv(const DropTestResult& r, const DropTestOptions& o) {
     for (std::size_t b = 0; b < d.band_stabilisation_s.size(); ++b) {
       s << ',' << format_fixed(d.band_stabilisation_s[b], 3) << ',' << static_cast<int>(d.band_censored[b]);
     }
-    std::string why = d.invalid_reason();
-    std::replace(why.begin(), why.end(), ',', ';');  // one CSV field
     s << ',' << d.qp_fallbacks << ',' << (d.safe_stop ? 1 : 0) << ',' << d.loop_mismatch_cycles << ',' << d.loop_ran << ','
-      << (why.empty() ? 1 : 0) << ',' << why << '\n';
+      << (d.valid() ? 1 : 0) << ',' << d.invalid_reason_csv() << '\n';
   }
   return s.str();
 }
@@ -236,15 +218,6 @@ void mean_sd(const std::vector<double>& v, double& mean, double& sd) {
 }
 
 }  // namespace
-
-std::string DropRun::invalid_reason() const {
-  std::string why;
-  auto add = [&why](const std::string& x) { why += (why.empty() ? "" : "; ") + x; };
-  if (safe_stop) add("safe stop at " + format_fixed(safe_stop_s, 3) + " s (" + safe_stop_reason + ")");
-  if (qp_fallbacks > 0) add(std::to_string(qp_fallbacks) + " QP fallbacks");
-  if (loop_mismatch_cycles > 0) add(std::to_string(loop_mismatch_cycles) + " cycles in another loop (" + loop_ran + " at the end)");
-  return why;
-}
 
 void drop_metrics(const std::vector<float>& e, double dt, double residual_window_s, double& peak_mm, double& residual_mm) {
   peak_mm = 0.0;

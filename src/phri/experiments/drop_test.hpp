@@ -29,6 +29,7 @@
 #include <phri/control/controller_settings.hpp>
 #include <phri/robot/low_level_mode.hpp>
 #include <phri/config/sim_robot_config.hpp>
+#include <phri/experiments/run_validity.hpp>
 
 #include <cstdint>
 #include <iosfwd>
@@ -106,7 +107,8 @@ struct DropTestOptions {
   std::optional<double> release_spread_scale;  ///< x both release spreads
 };
 
-struct DropRun {
+/// A drop: its metrics and its validity (RunValidity: safe stop, QP fallback, the loop that ran).
+struct DropRun : RunValidity {
   DropMode mode = DropMode::kTorque;
   int index = 0;
   std::uint64_t seed = 0;
@@ -119,17 +121,8 @@ struct DropRun {
   double residual_mm = 0.0;
   double before_mm = 0.0;          ///< mean e over pre_release_s before the release
   double residual_shift_mm = 0.0;  ///< |final mean - before_mm|
-  // ---- validity
-  long qp_fallbacks = 0;
-  bool safe_stop = false;
-  double safe_stop_s = 0.0;
-  std::string safe_stop_reason;  ///< the supervisor's fault, with its joint
-  long loop_mismatch_cycles = 0;  ///< cycles the command's loop was not the loop the mode names
-  std::string loop_ran;          ///< the loop commanded at the end of the window
   std::vector<float> error_mm;  ///< e over the window, one sample per control period
   std::vector<ContactLinkSummary> contact;  ///< per link, the whole drop (experiment_contact.hpp)
-  /// Empty: valid; else why not (safe stop, QP fallback, wrong loop), for the table.
-  std::string invalid_reason() const;
 };
 
 struct DropTestResult {

@@ -85,6 +85,7 @@ ControllerSettings cycle_settings(const TorqueTrackingOptions& o, TrackingScenar
   s.initial_loop = LowLevelMode::kPosition;
   s.custom_torque = o.custom_torque;
   if (scenario == TrackingScenario::kStatic) s.external_torque_source = o.static_external_torque;
+  s.position_mode_open_loop = o.position_open_loop;
   return s;
 }
 
@@ -238,10 +239,10 @@ EeErrors true_ee_error(const Controller& cycle, const SimRobot& robot, Data& tru
 }
 
 // Runs the schedule: position control, the switch to `loop`, the dynamic scenario's trajectory;
-// records the errors. Returns the number of QP fallbacks.
-long drive_run(const TorqueTrackingOptions& o, TrackingScenario scenario, LowLevelMode loop, const RunSchedule& schedule,
+// records the errors and the run's validity.
+void drive_run(const TorqueTrackingOptions& o, TrackingScenario scenario, LowLevelMode loop, const RunSchedule& schedule,
                SimRobot& robot, Controller& cycle, TrackingRecorder& recorder, std::optional<ContactRecorder>& contact,
-               std::ostream* progress) {
+               RunValidity& validity, std::ostream* progress) {
   const int n = robot.dof();
   const double dt = robot.period_s();
   const Trajectory trajectory{o.sine_amplitude_m, o.sine_omega_rad_s, o.triangle_speed_m_s,
@@ -251,7 +252,6 @@ long drive_run(const TorqueTrackingOptions& o, TrackingScenario scenario, LowLev
   Data truth_data(cycle.model());  // FK of the plant's true joint angles (same kinematics)
   Eigen::VectorXd tau_desired_prev = Eigen::VectorXd::Zero(n);
   Eigen::Isometry3d start = Eigen::Isometry3d::Identity();
-  long fallbacks = 0;
   for (int k = 0; k < schedule.position_cycles + schedule.test_cycles + 1; ++k) {
     const RobotState& state = robot.read();
     targets.clear();
@@ -277,13 +277,12 @@ long drive_run(const TorqueTrackingOptions& o, TrackingScenario scenario, LowLev
       targets.has_pose = true;
       targets.pose = {target, velocity, acceleration};
     }
-    if (cycle.step(state, targets, command) == CycleStatus::kQpFallback) ++fallbacks;
+    validity.check_cycle(cycle.step(state, targets, command), cycle, command, after >= 1, loop);
     if (after >= 0) record_true_contact(contact, cycle, robot);
     tau_desired_prev = cycle.qp().desired_torque();
     robot.write(command);
     if (state.fault) throw ExperimentError("torque tracking", "the simulated plant faulted");
   }
-  return fallbacks;
 }
 
 // One scenario with one loop on a fresh plant and controller; its time series goes to the output folder.
@@ -299,19 +298,24 @@ TorqueTrackingRun run_one(const TorqueTrackingOptions& o, TrackingScenario scena
   run.scenario = scenario;
   run.loop = loop;
   std::optional<ContactRecorder> contact = experiment_contact(cycle, experiment_body_regions(o.regions_file, o.plant_config_path));
-  run.qp_fallbacks = drive_run(o, scenario, loop, schedule, robot, cycle, recorder, contact, progress);
+  drive_run(o, scenario, loop, schedule, robot, cycle, recorder, contact, run, progress);
+  run.elastic_modes = elastic_joint_modes(robot);
   if (contact) run.contact = contact->links();
   simulated += robot.state().time_s;
   recorder.fill_statistics(run);
   if (!o.output_dir.empty()) {
     const std::string name = std::string("torque_tracking_") + to_string(scenario) + "_" + loop_name(loop) + ".csv";
     run.csv_path = write_output_files(o.output_dir, {{name, recorder.csv()}}).front();
+    if (!run.elastic_modes.empty()) {
+      const std::string modes = std::string("elastic_modes_") + to_string(scenario) + "_" + loop_name(loop) + ".csv";
+      write_output_files(o.output_dir, {{modes, elastic_modes_csv(run.elastic_modes)}});
+    }
   }
   if (progress) {
     *progress << "  " << to_string(scenario) << " / " << loop_name(loop) << ": ||tau_d - tau_s|| RMS "
               << format_fixed(run.rms_Nm, 4) << " N.m, p95 " << format_fixed(run.p95_Nm, 4) << " N.m (true: RMS "
               << format_fixed(run.rms_true_Nm, 4) << "), EE error RMS " << format_fixed(run.ee_position_rms_mm, 2)
-              << " mm" << std::endl;
+              << " mm" << (run.valid() ? "" : ", INVALID: " + run.invalid_reason()) << std::endl;
   }
   return run;
 }
@@ -320,14 +324,17 @@ TorqueTrackingRun run_one(const TorqueTrackingOptions& o, TrackingScenario scena
 std::string summary_csv(const TorqueTrackingResult& result, const TorqueTrackingOptions& o) {
   std::ostringstream summary;
   summary << "scenario,loop,rms_Nm,p95_Nm,max_Nm,bias_Nm,rms_true_Nm,p95_true_Nm,window_start_s,samples,"
-             "ee_rms_mm,ee_y_rms_mm,ee_z_rms_mm,ee_vy_rms_mm_s,ee_vz_rms_mm_s\n";
+             "ee_rms_mm,ee_y_rms_mm,ee_z_rms_mm,ee_vy_rms_mm_s,ee_vz_rms_mm_s,elastic,qp_fallbacks,safe_stop,"
+             "loop_mismatch_cycles,loop_ran,valid,invalid_reason\n";
   for (const TorqueTrackingRun& run : result.runs) {
     summary << to_string(run.scenario) << ',' << loop_name(run.loop) << ',' << format_fixed(run.rms_Nm, 6) << ','
             << format_fixed(run.p95_Nm, 6) << ',' << format_fixed(run.max_Nm, 6) << ',' << format_fixed(run.bias_Nm, 6) << ','
             << format_fixed(run.rms_true_Nm, 6) << ',' << format_fixed(run.p95_true_Nm, 6) << ','
             << format_fixed(o.transient_s, 3) << ',' << run.samples << ',' << format_fixed(run.ee_position_rms_mm, 4) << ','
             << format_fixed(run.ee_y_rms_mm, 4) << ',' << format_fixed(run.ee_z_rms_mm, 4) << ','
-            << format_fixed(run.ee_vy_rms_mm_s, 3) << ',' << format_fixed(run.ee_vz_rms_mm_s, 3) << '\n';
+            << format_fixed(run.ee_vy_rms_mm_s, 3) << ',' << format_fixed(run.ee_vz_rms_mm_s, 3) << ',' << (o.elastic ? 1 : 0)
+            << ',' << run.qp_fallbacks << ',' << (run.safe_stop ? 1 : 0) << ',' << run.loop_mismatch_cycles << ','
+            << run.loop_ran << ',' << (run.valid() ? 1 : 0) << ',' << run.invalid_reason_csv() << '\n';
   }
   return summary.str();
 }
@@ -394,14 +401,15 @@ TorqueTrackingResult run_torque_tracking(const TorqueTrackingOptions& o, std::os
 std::string torque_tracking_table(const TorqueTrackingResult& r, const TorqueTrackingOptions& o) {
   std::ostringstream s;
   s << "| scenario | loop | RMS [N.m] | p95 [N.m] | max [N.m] | bias [N.m] | RMS true [N.m] | p95 true [N.m] | EE RMS [mm] | "
-       "EE max [mm] |\n";
-  s << "|---|---|---|---|---|---|---|---|---|---|\n";
+       "EE max [mm] | valid |\n";
+  s << "|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const TorqueTrackingRun& run : r.runs) {
     s << "| " << to_string(run.scenario) << " | " << loop_name(run.loop) << " | " << format_fixed(run.rms_Nm, 4) << " | "
       << format_fixed(run.p95_Nm, 4) << " | " << format_fixed(run.max_Nm, 3) << " | " << format_fixed(run.bias_Nm, 4) << " | "
       << format_fixed(run.rms_true_Nm, 4)
       << " | " << format_fixed(run.p95_true_Nm, 4) << " | " << format_fixed(run.ee_position_rms_mm, 2) << " | "
-      << format_fixed(run.ee_position_max_mm, 2) << " |\n";
+      << format_fixed(run.ee_position_max_mm, 2) << " | " << (run.valid() ? "yes" : "INVALID: " + run.invalid_reason())
+      << " |\n";
   }
   std::vector<std::pair<std::string, std::vector<ContactLinkSummary>>> contact;
   for (const TorqueTrackingRun& run : r.runs) contact.emplace_back(std::string(to_string(run.scenario)) + " / " + loop_name(run.loop), run.contact);
@@ -409,7 +417,7 @@ std::string torque_tracking_table(const TorqueTrackingResult& r, const TorqueTra
   for (TrackingScenario scenario : o.scenarios) {
     const TorqueTrackingRun* c = r.find(scenario, LowLevelMode::kCurrent);
     const TorqueTrackingRun* h = r.find(scenario, LowLevelMode::kKinovaTorqueHighVelocity);
-    if (c == nullptr || h == nullptr) continue;
+    if (c == nullptr || h == nullptr || !c->valid() || !h->valid()) continue;  // invalid runs: no ratio
     s << "- " << to_string(scenario) << ": high-velocity / custom = " << format_fixed(h->rms_Nm / c->rms_Nm, 2)
       << " (RMS), " << format_fixed(h->p95_Nm / c->p95_Nm, 2) << " (p95); true torque: "
       << format_fixed(h->rms_true_Nm / c->rms_true_Nm, 2) << " (RMS), " << format_fixed(h->p95_true_Nm / c->p95_true_Nm, 2)
@@ -431,7 +439,8 @@ std::string torque_tracking_table(const TorqueTrackingResult& r, const TorqueTra
             ? " (drive gain error up to " + format_fixed(100.0 * o.torque_constant_error, 0) + " %)"
             : std::string())
     << ", friction perturbation " << o.friction_perturbation << ", seed " << o.seed << ", static payload "
-    << o.payload_kg << " kg. Simulated " << format_fixed(r.simulated_s, 1) << " s in " << format_fixed(r.wall_s, 1)
+    << o.payload_kg << " kg, " << (o.elastic ? "elastic" : "rigid") << " joints, position loop "
+    << (o.position_open_loop ? "open loop (the paper's)" : "on the measured state") << ". Simulated " << format_fixed(r.simulated_s, 1) << " s in " << format_fixed(r.wall_s, 1)
     << " s of wall time.\n";
   return s.str();
 }

@@ -22,7 +22,11 @@
 // the norm) are taken from `transient_s` after the switch to the loop under test to the end.
 //
 // Each run builds a fresh plant (same seed: same noise and mismatch) and a fresh Controller, from
-// the model, actuator table and collision model loaded once from the options' files.
+// the model, actuator table and collision model loaded once from the options' files. A run in which
+// the supervisor safe-stopped, the QP fell back or another loop ran after the switch is marked
+// invalid (RunValidity), in the table and the summary CSV. With `elastic`, each run also records
+// the plant's computed two-mass modes at its final posture (elastic_modes.hpp), the figure the
+// report sets beside the ringing it measures in the run's log.
 //
 // What to expect from the static scenario in this framework: the inverse dynamics subtracts the
 // momentum observer's tau_ext, which at rest converges to g - tau_s, so tau_d = M qdd_d + tau_s
@@ -42,6 +46,8 @@
 #include <phri/control/compliance_mode.hpp>
 #include <phri/lowlevel/custom_torque_controller.hpp>
 #include <phri/lowlevel/low_level_controller.hpp>
+#include <phri/experiments/elastic_modes.hpp>
+#include <phri/experiments/run_validity.hpp>
 
 #include <cstdint>
 #include <iosfwd>
@@ -108,6 +114,10 @@ struct TorqueTrackingOptions {
   double trajectory_delay_s = 0.5;  ///< after the switch, before the trajectory starts
   double fade_in_s = 1.0;           ///< the sine's amplitude rises smoothly over this time
 
+  /// The position loop as the paper runs it: the QP integrates its own state open loop into the
+  /// vendor servo (ControllerSettings::position_mode_open_loop); false: the QP on the measured state.
+  bool position_open_loop = false;
+
   /// External torque of the static scenario's controller: the observer (default), or, as in the
   /// paper's static experiment, the F/T sensor only (use with PayloadMode::kHungAfterSwitch so the
   /// sensor, zeroed without the weight, measures it).
@@ -129,8 +139,9 @@ struct TorqueTrackingOptions {
   std::optional<std::uint64_t> mismatch_seed;
 };
 
-/// Statistics of one run (scenario x loop) over its statistics window.
-struct TorqueTrackingRun {
+/// Statistics of one run (scenario x loop) over its statistics window, and its validity
+/// (RunValidity: a safe stop, a QP fallback or another loop than `loop` after the switch).
+struct TorqueTrackingRun : RunValidity {
   TrackingScenario scenario = TrackingScenario::kStatic;
   LowLevelMode loop = LowLevelMode::kCurrent;
   double rms_Nm = 0.0;        ///< of ||tau_d - tau_s|| (measured)
@@ -146,7 +157,8 @@ struct TorqueTrackingRun {
   /// (the target's reference velocity - plant), the axes of the paper's Fig. dynamic-comparison.
   double ee_y_rms_mm = 0.0, ee_z_rms_mm = 0.0, ee_vy_rms_mm_s = 0.0, ee_vz_rms_mm_s = 0.0;
   int samples = 0;
-  long qp_fallbacks = 0;      ///< cycles where the QP failed (should be 0)
+  /// Elastic plant: each joint's two-mass mode at the run's final posture (elastic_modes.hpp).
+  std::vector<ElasticJointMode> elastic_modes;
   std::string csv_path;       ///< time series, when written
   std::vector<ContactLinkSummary> contact;  ///< per link, after the switch (experiment_contact.hpp)
 };

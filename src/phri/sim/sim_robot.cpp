@@ -667,6 +667,12 @@ const RobotState& SimRobot::read() {
   return state_;
 }
 
+Eigen::VectorXd SimRobot::joint_inertia_diagonal() const {
+  Eigen::VectorXd m(n_);
+  for (int i = 0; i < n_; ++i) m[i] = d_->qM[m_->dof_Madr[dadr_[static_cast<std::size_t>(i)]]];
+  return m;
+}
+
 double SimRobot::servo_position(int i) const {
   return motor_encoder_ ? elastic_[static_cast<std::size_t>(i)].position() : d_->qpos[qadr_[static_cast<std::size_t>(i)]];
 }

@@ -149,6 +149,11 @@ public:
   const Eigen::VectorXd& true_joint_positions() const override { return truth_.q_rad; }
   const Eigen::VectorXd& true_joint_velocities() const override { return truth_.qd_rad_s; }
 
+  /// Each arm joint's diagonal of the plant's joint-space inertia M_ii at the current posture
+  /// (MuJoCo's qM of the last step: the true, mismatched inertials and any payload). With elastic
+  /// joints the rotor is off the link, so this is the link side alone; rigid: armature included.
+  Eigen::VectorXd joint_inertia_diagonal() const;
+
   /// MuJoCo model and data, read-only (viewers, tests comparing with MuJoCo's own quantities). The
   /// cycle runs without MuJoCo's sensor stage: sensordata, cacc and cfrc_* keep their values of the
   /// initial F/T sample (the cycle's samples are in truth().wrench_sensor).
