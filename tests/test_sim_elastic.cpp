@@ -30,7 +30,9 @@ struct Held {
   Eigen::VectorXd q_link, q_motor, tau_sensor, gravity, command;
 };
 
-Held hold_at_rest(phri::SimRobotConfig::Elasticity::Encoder encoder) {
+// The elastic Gen3 plant at kPose without noise, quantisation or sensor offsets (an offset the drive
+// would read as deflection).
+phri::SimRobotConfig quiet_elastic_plant(phri::SimRobotConfig::Elasticity::Encoder encoder) {
   phri::SimRobotConfig c = phri::SimRobotConfig::from_yaml_file(kRoot + "/configs/plant_gen3.yaml");
   c.initial_q_rad = kPose;
   c.noise.torque_sensor_std_Nm = 0.0;
@@ -40,7 +42,11 @@ Held hold_at_rest(phri::SimRobotConfig::Elasticity::Encoder encoder) {
   c.noise.torque_sensor_offset_Nm.assign(7, 0.0);
   c.elasticity.enabled = true;
   c.elasticity.position_loop_encoder = encoder;
-  phri::SimRobot robot(c);
+  return c;
+}
+
+Held hold_at_rest(phri::SimRobotConfig::Elasticity::Encoder encoder) {
+  phri::SimRobot robot(quiet_elastic_plant(encoder));
   phri::RobotCommand hold(7);
   hold.mode = phri::LowLevelMode::kPosition;
   hold.q_rad = Eigen::Map<const Eigen::VectorXd>(kPose.data(), 7);
@@ -82,6 +88,54 @@ TEST(SimElastic, LinkSideServoHoldsTheLinkItself) {
   for (int i = 0; i < 7; ++i) {
     EXPECT_NEAR(h.q_link[i], h.command[i], 2e-5) << "joint " << i + 1;
     EXPECT_NEAR(h.tau_sensor[i], h.gravity[i], 0.02 + 1e-3 * std::abs(h.gravity[i])) << "joint " << i + 1;
+  }
+}
+
+TEST(SimElastic, MotorServoLessTheMeasuredDeflectionHoldsTheLinkAtTheCommand) {
+  const Held h = hold_at_rest(phri::SimRobotConfig::Elasticity::Encoder::kMotorCompensated);
+  const phri::SimRobotConfig c = phri::SimRobotConfig::from_yaml_file(kRoot + "/configs/plant_gen3.yaml");
+  for (int i = 0; i < 7; ++i) {
+    const double k = c.elasticity.stiffness_Nm_per_rad[static_cast<std::size_t>(i)];
+    EXPECT_NEAR(h.q_link[i], h.command[i], 2e-5) << "joint " << i + 1;
+    // The rotor leads the link by the spring's deflection tau / K.
+    EXPECT_NEAR(h.q_motor[i] - h.q_link[i], h.gravity[i] / k, 2e-5 + 1e-3 * std::abs(h.gravity[i] / k)) << "joint " << i + 1;
+    EXPECT_NEAR(h.tau_sensor[i], h.gravity[i], 0.02 + 1e-3 * std::abs(h.gravity[i])) << "joint " << i + 1;
+  }
+}
+
+// Kinova's low-level examples start by commanding each actuator's measured position, which holds the
+// arm still (reference kortex_lowlevel.md section 5, step 3). The largest change of the motor torque
+// K_T i over the first 50 ms of that command, from the plant's own hold.
+double motor_torque_jump_on_measured_position(phri::SimRobotConfig::Elasticity::Encoder encoder, double stiffness) {
+  phri::SimRobotConfig c = quiet_elastic_plant(encoder);
+  c.elasticity.stiffness_Nm_per_rad.assign(7, stiffness);
+  phri::SimRobot robot(c);
+  const phri::RobotState start = robot.read();
+  phri::RobotCommand hold(7);
+  hold.mode = phri::LowLevelMode::kPosition;
+  hold.q_rad = start.q_rad;
+  const phri::ActuatorTable drives = robot.config().plant_actuators();
+  double jump = 0.0;
+  for (int k = 0; k < 50; ++k) {
+    robot.write(hold);
+    const phri::RobotState& s = robot.read();
+    for (int i = 0; i < 7; ++i) {
+      jump = std::max(jump, std::abs(drives[static_cast<std::size_t>(i)].torque_per_amp() * (s.current_A[i] - start.current_A[i])));
+    }
+  }
+  return jump;
+}
+
+TEST(SimElastic, CommandingTheMeasuredPositionHoldsStillOnlyWhenTheServoCompensatesTheDeflection) {
+  using Encoder = phri::SimRobotConfig::Elasticity::Encoder;
+  for (const double k : {4000.0, 13000.0}) {
+    const double motor = motor_torque_jump_on_measured_position(Encoder::kMotor, k);
+    const double compensated = motor_torque_jump_on_measured_position(Encoder::kMotorCompensated, k);
+    std::printf("K %.0f N.m/rad: motor torque jump %.2f N.m on the rotor encoder, %.3f N.m less the deflection\n", k,
+                motor, compensated);
+    // Joint 2 holds about 17 N.m at this pose: the rotor encoder's servo steps by kp tau / K.
+    EXPECT_GT(motor, 5.0) << "K " << k;
+    EXPECT_LT(compensated, 0.5) << "K " << k;
   }
 }
 

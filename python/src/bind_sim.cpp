@@ -119,6 +119,7 @@ void bind_config_parts(py::class_<SimRobotConfig>& c) {
       .def_readwrite("held_by_hand", &C::DropTest::held_by_hand, "True: a hand, not the tool, holds the mass until release.");
   py::enum_<C::Elasticity::Encoder>(c, "Encoder", "The encoder the vendor position servo closes on.")
       .value("motor", C::Elasticity::Encoder::kMotor)
+      .value("motor_compensated", C::Elasticity::Encoder::kMotorCompensated)
       .value("link", C::Elasticity::Encoder::kLink);
   py::class_<C::Elasticity>(c, "Elasticity", "Joint elasticity: rotor -- torsional spring -- link.")
       .def_readwrite("enabled", &C::Elasticity::enabled)

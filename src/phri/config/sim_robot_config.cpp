@@ -292,13 +292,15 @@ void parse_random_pushes(const YamlReader& r, RandomPushSettings& s) {
 }
 
 void parse_elasticity(const YamlReader& e, int n, SimRobotConfig::Elasticity& s) {
-  e.allow_keys({"enabled", "stiffness_Nm_per_rad", "damping_ratio", "position_loop_encoder"});
+  e.allow_keys({"enabled", "stiffness_Nm_per_rad", "damping_ratio", "position_loop_encoder", "deflection_filter_s"});
   s.enabled = e.boolean_or("enabled", false);
   if (e.has("stiffness_Nm_per_rad")) s.stiffness_Nm_per_rad = e.per_joint("stiffness_Nm_per_rad", n, 100.0, 1e7);
   s.damping_ratio = e.number_or("damping_ratio", s.damping_ratio, 0.0, 2.0);
-  s.position_loop_encoder = e.choice_or("position_loop_encoder", "motor", {"motor", "link"}) == "motor"
-                                ? SimRobotConfig::Elasticity::Encoder::kMotor
-                                : SimRobotConfig::Elasticity::Encoder::kLink;
+  s.deflection_filter_s = e.number_or("deflection_filter_s", s.deflection_filter_s, 0.0, 10.0);
+  const std::string encoder = e.choice_or("position_loop_encoder", "motor", {"motor", "motor_compensated", "link"});
+  s.position_loop_encoder = encoder == "motor"               ? SimRobotConfig::Elasticity::Encoder::kMotor
+                            : encoder == "motor_compensated" ? SimRobotConfig::Elasticity::Encoder::kMotorCompensated
+                                                             : SimRobotConfig::Elasticity::Encoder::kLink;
 }
 
 SimRobotConfig parse(const YamlReader& root, const std::string& base_dir) {

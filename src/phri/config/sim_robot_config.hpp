@@ -140,8 +140,16 @@ struct SimRobotConfig : RobotDescription {
     std::vector<double> stiffness_Nm_per_rad;
     /// D = 2 ratio sqrt(K B) in parallel with K (B the reflected rotor inertia).
     double damping_ratio = 0.05;
-    /// Which encoder the vendor position servo closes on; the arm reports the link side.
-    enum class Encoder { kMotor, kLink } position_loop_encoder = Encoder::kMotor;
+    /// Which position the vendor position servo closes on; the arm reports the link side. kMotor: the
+    /// rotor's encoder (collocated; the link sits tau / K off the command, and commanding the measured
+    /// position steps the servo by kp tau / K). kMotorCompensated: the rotor's encoder less the static
+    /// deflection, theta - LP(tau_s) / K with the drive's torque reading low-passed over
+    /// deflection_filter_s: commanding the measured position holds the arm still (as Kinova's low-level
+    /// examples rely on) while the servo stays collocated at the elastic modes (the deflection
+    /// compensation of Albu-Schaeffer and Hirzinger's motor-side position control, with the sensor's
+    /// torque in place of a gravity model; 0 s: unfiltered, the link position). kLink: the link's encoder.
+    enum class Encoder { kMotor, kMotorCompensated, kLink } position_loop_encoder = Encoder::kMotor;
+    double deflection_filter_s = 0.05;
   } elasticity;
 
   // ---- the paper's drop test: a mass on a slack cable under the tool, released at a given time

@@ -53,7 +53,7 @@ SimRobotConfig drop_plant(const DropShared& sh, int index) {
   c.drop_test.release_time_s = o.release_s;
   c.drop_test.held_by_hand = o.held_by_hand;
   c.elasticity.enabled = o.elastic;
-  c.elasticity.position_loop_encoder = o.servo_encoder;
+  if (o.servo_encoder) c.elasticity.position_loop_encoder = *o.servo_encoder;
   if (o.joint_stiffness_Nm_per_rad) c.elasticity.stiffness_Nm_per_rad = *o.joint_stiffness_Nm_per_rad;
   if (o.cable_damping_Ns_per_m) c.drop_test.cable_damping_Ns_per_m = *o.cable_damping_Ns_per_m;
   if (o.cable_stiffness_N_per_m) c.drop_test.cable_stiffness_N_per_m = *o.cable_stiffness_N_per_m;
@@ -68,6 +68,15 @@ SimRobotConfig drop_plant(const DropShared& sh, int index) {
     }
   }
   return c;
+}
+
+const char* servo_encoder_words(SimRobotConfig::Elasticity::Encoder e) {
+  switch (e) {
+    case SimRobotConfig::Elasticity::Encoder::kMotor: return "motor encoder";
+    case SimRobotConfig::Elasticity::Encoder::kMotorCompensated: return "motor encoder less the measured deflection";
+    case SimRobotConfig::Elasticity::Encoder::kLink: return "link encoder";
+  }
+  return "?";
 }
 
 // The loop the row names: torque mode runs torque_loop from switch_s on, position mode the position loop.
@@ -259,6 +268,7 @@ DropTestResult run_drop_test(const DropTestOptions& o, std::ostream* progress) {
                           ActuatorTable::from_yaml_file(o.actuators_path), std::move(collision),
                           experiment_body_regions(o.regions_file, o.plant_config_path)};
   DropTestResult result;
+  result.servo_encoder = o.servo_encoder.value_or(shared.plant.elasticity.position_loop_encoder);
   result.runs.resize(static_cast<std::size_t>(2 * o.drops));
   std::mutex mutex;
   int done = 0;
@@ -323,8 +333,7 @@ std::string drop_test_table(const DropTestResult& r, const DropTestOptions& o) {
     << to_string(o.torque_compliance) << " compliance, external torque " << to_string(o.external_torque_source)
     << ", K_O " << format_fixed(o.observer_gain, 0) << " 1/s; position mode "
     << (o.position_open_loop ? "open loop (the paper's)" : "on the measured state") << "; "
-    << (o.elastic ? std::string("elastic joints, servo on the ") +
-                        (o.servo_encoder == SimRobotConfig::Elasticity::Encoder::kMotor ? "motor" : "link") + " encoder"
+    << (o.elastic ? std::string("elastic joints, servo on the ") + servo_encoder_words(r.servo_encoder)
                   : std::string("rigid joints"))
     << "; release at " << format_fixed(o.release_s, 1)
     << " s, metrics over " << format_fixed(o.window_s, 1) << " s after the catch. Simulated "

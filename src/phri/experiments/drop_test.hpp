@@ -96,7 +96,8 @@ struct DropTestOptions {
   /// The vendor position servo's encoder with elastic joints. Motor side: a servo closed through an
   /// elastic transmission on the link side is non-collocated (prone to ring); drives with both
   /// encoders close the position loop on the motor (Kinova does not document which).
-  SimRobotConfig::Elasticity::Encoder servo_encoder = SimRobotConfig::Elasticity::Encoder::kMotor;
+  /// Empty: the plant file's (plant.elasticity.position_loop_encoder).
+  std::optional<SimRobotConfig::Elasticity::Encoder> servo_encoder;
   std::optional<std::vector<double>> joint_stiffness_Nm_per_rad;  ///< empty: the plant file's
 
   // ---- plant variations for the sensitivity table (empty: the plant file's values)
@@ -127,6 +128,8 @@ struct DropRun : RunValidity {
 
 struct DropTestResult {
   std::vector<DropRun> runs;  ///< torque drops first, then position, each in index order
+  /// The encoder the vendor servo closed on (the option's, or the plant file's).
+  SimRobotConfig::Elasticity::Encoder servo_encoder = SimRobotConfig::Elasticity::Encoder::kMotor;
   double simulated_s = 0.0;
   double wall_s = 0.0;
   std::vector<std::string> files;

@@ -122,8 +122,11 @@ SimRobot::SimRobot(const SimRobotConfig& config)
       n_(config_.dof()),
       drive_(make_drive_loops(config_, {}, {})) {
   substeps_ = config_.substeps_per_cycle();
-  motor_encoder_ = config_.elasticity.enabled &&
-                   config_.elasticity.position_loop_encoder == SimRobotConfig::Elasticity::Encoder::kMotor;
+  using Encoder = SimRobotConfig::Elasticity::Encoder;
+  motor_encoder_ = config_.elasticity.enabled && config_.elasticity.position_loop_encoder != Encoder::kLink;
+  compensate_deflection_ =
+      config_.elasticity.enabled && config_.elasticity.position_loop_encoder == Encoder::kMotorCompensated;
+  deflection_alpha_ = config_.physics_step_s() / (config_.elasticity.deflection_filter_s + config_.physics_step_s());
   filter_decimation_ = static_cast<int>(std::lround(config_.physics_rate_Hz / config_.vendor.high_velocity_rate_Hz));
   ft_decimation_ = static_cast<int>(std::lround(config_.physics_rate_Hz / config_.ft_sensor.rate_Hz));
 
@@ -410,7 +413,7 @@ void SimRobot::allocate_buffers() {
   state_ = RobotState(n_);
   // Per-step buffers and truth, sized once here: read() and write() do not allocate.
   for (Eigen::VectorXd* v : {&q_meas_, &qd_meas_, &tau_meas_, &current_, &tau_motor_, &tau_viscous_, &tau_dry_, &tau_s_,
-                             &v_before_, &f_dry_, &damping_, &qdd_, &truth_.q_rad, &truth_.qd_rad_s,
+                             &deflection_torque_, &v_before_, &f_dry_, &damping_, &qdd_, &truth_.q_rad, &truth_.qd_rad_s,
                              &truth_.qdd_rad_s2, &truth_.current_A, &truth_.tau_motor_Nm, &truth_.tau_friction_Nm,
                              &truth_.tau_transmitted_Nm, &truth_.q_motor_rad, &q_before_}) {
     *v = Eigen::VectorXd::Zero(n_);
@@ -539,6 +542,8 @@ void SimRobot::start_drives_holding(const Eigen::VectorXd& hold) {
   qdd_.setZero();
 
   for (std::size_t k = 0; k < elastic_.size(); ++k) elastic_[k].reset(config_.initial_q_rad[k], hold[static_cast<int>(k)]);
+  tau_meas_ = tau_s_ + offsets_;
+  deflection_torque_ = tau_meas_;
   // The servo holds what its encoder reads now (a motor-side encoder reads the wound spring too).
   command_.mode = LowLevelMode::kPosition;
   for (int i = 0; i < n_; ++i) {
@@ -673,8 +678,12 @@ Eigen::VectorXd SimRobot::joint_inertia_diagonal() const {
   return m;
 }
 
+// With the deflection compensated, the drive's own torque reading, low-passed, over its stiffness.
 double SimRobot::servo_position(int i) const {
-  return motor_encoder_ ? elastic_[static_cast<std::size_t>(i)].position() : d_->qpos[qadr_[static_cast<std::size_t>(i)]];
+  const auto k = static_cast<std::size_t>(i);
+  if (!motor_encoder_) return d_->qpos[qadr_[k]];
+  const double rotor = elastic_[k].position();
+  return compensate_deflection_ ? rotor - deflection_torque_[i] / config_.elasticity.stiffness_Nm_per_rad[k] : rotor;
 }
 
 double SimRobot::servo_velocity(int i) const {
@@ -748,10 +757,13 @@ void SimRobot::substep(bool last_of_period) {
   const bool read_encoder = drive_reads_position_ || last_of_period;
   const double sv = config_.noise.velocity_std_rad_s;
   const double st = config_.noise.torque_sensor_std_Nm;
+  // A servo that compensates the deflection reads the torque sensor with its encoder.
+  const bool read_torque = drive_reads_torque_ || (compensate_deflection_ && drive_reads_position_);
   for (int i = 0; i < n_; ++i) {
-    if (read_encoder) q_meas_[i] = quantize(servo_position(i));
     qd_meas_[i] = servo_velocity(i) + (drive_reads_velocity_ ? joint_noise_.normal(sv) : 0.0);
-    tau_meas_[i] = tau_s_[i] + offsets_[i] + (drive_reads_torque_ ? joint_noise_.normal(st) : 0.0);
+    tau_meas_[i] = tau_s_[i] + offsets_[i] + (read_torque ? joint_noise_.normal(st) : 0.0);
+    if (compensate_deflection_) deflection_torque_[i] += deflection_alpha_ * (tau_meas_[i] - deflection_torque_[i]);
+    if (read_encoder) q_meas_[i] = quantize(servo_position(i));
   }
   drive_->tick(q_meas_, qd_meas_, tau_meas_, filter_phase_ == 0, current_);
 

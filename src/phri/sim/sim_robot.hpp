@@ -233,6 +233,8 @@ private:
   Eigen::VectorXd q_before_;                  // link angles at a physics step's start
   double quantum_ = 0.0;
   bool motor_encoder_ = false;  // the vendor servo's encoder is on the rotor (elastic joints, motor side)
+  bool compensate_deflection_ = false;  // ... less the deflection its torque sensor measures
+  double deflection_alpha_ = 1.0;       // that torque's low-pass step per physics step
 
   std::unique_ptr<DriveLoops> drive_;  // made at reset() (not in the cycle)
   std::vector<double> hold_kp_, hold_kd_;  // drive generic: the position hold's gains (set_generic_hold_gains)
@@ -245,7 +247,7 @@ private:
   bool drive_reads_position_ = false, drive_reads_velocity_ = false, drive_reads_torque_ = false;
 
   // per-step buffers
-  Eigen::VectorXd q_meas_, qd_meas_, tau_meas_, current_, tau_motor_, tau_viscous_, tau_dry_, tau_s_;
+  Eigen::VectorXd q_meas_, qd_meas_, tau_meas_, current_, tau_motor_, tau_viscous_, tau_dry_, tau_s_, deflection_torque_;
   Eigen::VectorXd v_before_, f_dry_, damping_, qdd_;
   Vector6d wrench_true_ = Vector6d::Zero();
   Vector6d wrench_meas_ = Vector6d::Zero();
