@@ -1,9 +1,11 @@
 """ctest `evaluate_quick`: runs `phri evaluate --quick` (argument vector, no shell) and checks the report:
-the five sections and their figures exist, report.html is self-contained (figures inline), and every
-number in the tables is finite.
+the five sections and their figures exist, report.html is self-contained (figures inline), every
+number in the tables is finite, and the protocol table states what ran: every row has a source, and the
+drop test's drops per mode equals the drops its runs file holds.
 
 Usage: check_report.py PHRI_EXECUTABLE OUTPUT_DIR
 """
+import csv
 import math
 import re
 import subprocess
@@ -39,10 +41,29 @@ def main(argv):
             for token in re.findall(r"[-+]?(?:\d+\.?\d*(?:e[-+]?\d+)?|nan|inf)", cell.strip().lower()):
                 if token in ("nan", "inf") or not math.isfinite(float(token)):
                     failures.append(f"non-finite number in table row: {line}")
+    failures += protocol_failures(out, md)
     for f in failures:
         print("FAIL:", f)
     print(f"report checked: {len(failures)} failures, {figures} inline figures")
     return 1 if failures else 0
+
+
+def protocol_failures(out, md):
+    with open(f"{out}/protocol.csv", newline="") as f:
+        rows = list(csv.DictReader(f))
+    failures = [f"protocol row without a source: {r}" for r in rows if not r["source"].strip()]
+    for name in ("friction identification", "torque tracking", "drop test", "dynamic tracking", "dual compliance"):
+        if not any(r["experiment"] == name for r in rows):
+            failures.append(f"protocol table has no row of {name!r}")
+    with open(f"{out}/drop_test/drop_test_runs.csv", newline="") as f:
+        runs = list(csv.DictReader(f))
+    drops = next((r["value"] for r in rows if r["experiment"] == "drop test" and r["parameter"] == "drops per mode"), None)
+    torque_runs = sum(1 for r in runs if r["mode"] == "torque")
+    if drops != str(torque_runs):
+        failures.append(f"protocol table says {drops} drops per mode, the runs file holds {torque_runs} torque drops")
+    if "The protocol of each evaluation as this run used it" not in md:
+        failures.append("report.md lacks the protocol table")
+    return failures
 
 
 if __name__ == "__main__":

@@ -18,8 +18,8 @@ import numpy as np
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from drop_test_figure import PAPER as DROP_PAPER  # noqa: E402
 from drop_test_figure import draw as draw_drop  # noqa: E402
-from drop_test_figure import drop_statistics, fmt, statistics_table  # noqa: E402
-from verdicts import MIN_VALID, claim_paragraph, outcome, parameter_range_sentence  # noqa: E402
+from drop_test_figure import drop_statistics, fmt, mann_whitney, statistics_table  # noqa: E402
+from verdicts import ALPHA, MIN_VALID, claim_paragraph, outcome, parameter_range_sentence  # noqa: E402
 from report_common import plt, read_rows, save_figure  # noqa: E402
 from parameter_sources import markdown_table, parameter_rows  # noqa: E402
 from friction_form_report import form_sentences, form_table, sweep_sentences, sweep_table  # noqa: E402
@@ -166,6 +166,43 @@ def tracking_summary(path):
     return read_rows(path) if os.path.exists(path) else []
 
 
+def tracking_runs_by_seed(out):
+    """The main torque-tracking runs and those on independent plants (torque_tracking_seeds/seed_*), as
+    {(scenario, loop): [rows]}, the main run's first."""
+    runs = {}
+    paths = [f"{out}/torque_tracking/torque_tracking_summary.csv"]
+    seeds = f"{out}/torque_tracking_seeds"
+    if os.path.isdir(seeds):
+        paths += [f"{seeds}/{d}/torque_tracking_summary.csv" for d in sorted(os.listdir(seeds))]
+    for path in paths:
+        for r in tracking_summary(path):
+            runs.setdefault((r["scenario"], r["loop"]), []).append(r)
+    return runs
+
+
+def tracking_test_sentence(custom_runs, hv_runs):
+    """The loops compared over independent plants (None with one run per loop): verdict and sentence."""
+    c = [float(r["rms_Nm"]) for r in custom_runs if run_valid(r)]
+    h = [float(r["rms_Nm"]) for r in hv_runs if run_valid(r)]
+    if len(custom_runs) < 2 and len(hv_runs) < 2:
+        return None
+    invalid = len(custom_runs) - len(c) + len(hv_runs) - len(h)
+    counts = (f"{len(c)} / {len(h)} valid runs on independent plants (custom / Kinova HV"
+              + (f"; {invalid} INVALID left out" if invalid else "") + ")")
+    if len(c) < MIN_VALID or len(h) < MIN_VALID:
+        return "NOT TESTED", f"{counts}: fewer than {MIN_VALID} per loop, no test"
+    _, p, _, _, effect = mann_whitney(c, h)
+    lower = sum(1 for x in c for y in h if x < y) / (len(c) * len(h))
+    text = (f"{counts}: RMS median custom {np.median(c):.4f} (range {min(c):.4f}-{max(c):.4f}) vs Kinova HV "
+            f"{np.median(h):.4f} ({min(h):.4f}-{max(h):.4f}) N.m, Mann-Whitney p = {p:.3g}, signed rank-biserial effect "
+            f"{effect:+.3f} (custom lower in {100 * lower:.0f} % of run pairs)")
+    if p < ALPHA and effect > 0:
+        return "REPRODUCED", text + f"; custom lower, p < {ALPHA}: the paper's direction"
+    if p < ALPHA and effect < 0:
+        return "NOT REPRODUCED", text + f"; custom higher, p < {ALPHA}: the opposite of the paper's direction"
+    return "NOT REPRODUCED", text + f"; no significant difference at p < {ALPHA}"
+
+
 def torque_tracking_section(rep, out):
     d = f"{out}/torque_tracking"
     rep.h(2, "2. Torque tracking (static and dynamic)")
@@ -193,7 +230,29 @@ def torque_tracking_section(rep, out):
     rep.table(md_table(["scenario, plant", "custom RMS [N.m]", "custom p95", "Kinova HV RMS", "Kinova HV p95",
                         "HV / custom", "valid"], rows))
     rep.p("Paper (Fig. torque-control-results, log scale, no numbers): custom below Kinova HV in both scenarios.")
+    by_seed = tracking_runs_by_seed(out)
+    seed_rows = []
+    for scen in ("static", "dynamic"):
+        for loop in ("custom", "kinova_torque_high_velocity"):
+            runs = by_seed.get((scen, loop), [])
+            if len(runs) > 1:
+                rms = [float(r["rms_Nm"]) for r in runs if run_valid(r)]
+                seed_rows.append([scen, LOOP_NAMES[loop], f"{len(rms)} of {len(runs)}",
+                                  f"{np.median(rms):.4f}" if rms else "n/a",
+                                  f"{min(rms):.4f}-{max(rms):.4f}" if rms else "n/a"])
+    if seed_rows:
+        rep.p("The same runs on independent plants (noise seed s, link-inertial and drive-gain seed 1000 + s; the "
+              "table above is seed 1):")
+        rep.table(md_table(["scenario", "loop", "valid runs", "median RMS [N.m]", "range [N.m]"], seed_rows))
     for name, c, hv, ratio in verdict_rows:
+        tested = None if "(sensitivity)" in name else tracking_test_sentence(by_seed.get((c["scenario"], "custom"), []),
+                                                                             by_seed.get((c["scenario"], hv["loop"]), []))
+        if tested is not None:
+            verdict, text = tested
+            rep.p(f"Claim 'the custom loop tracks torque better than Kinova's high-velocity loop' ({name}): {verdict}: "
+                  f"{text}. Seed 1 alone: HV / custom = {ratio:.2f}. The paper gives no numbers to compare the "
+                  "magnitude with.")
+            continue
         if ratio > 1.0 + GAP:
             verdict, direction = "REPRODUCED in direction", "custom lower than Kinova HV: the paper's direction"
         elif ratio < 1.0 - GAP:
@@ -259,8 +318,8 @@ def drop_section(rep, out, sensitivity):
           "end-effector task (K 400), null-space compliance, the paper code's external torque (momentum observer "
           "K_O = 10 plus the high-pass of J^T F/T, complementary filter). Position mode: as the paper's mc_rtc, the QP "
           "runs on its own state integrated open loop and the vendor position servo tracks it. Plant: elastic joints "
-          "(harmonic-drive springs between rotor and link, torque sensors measuring them; the servo closes on the "
-          "motor encoder).")
+          "(harmonic-drive springs between rotor and link, torque sensors measuring them). The values of this run, "
+          "the vendor servo's encoder among them: the protocol and parameter tables above.")
     rows = read_rows(f"{d}/drop_test_runs.csv")
     st = drop_statistics(rows)
     bands = ", ".join(f"{b['band_mm']:g} mm" for b in st["bands"])
@@ -494,8 +553,10 @@ def validity_header(rep, out, sensitivity):
     text = (f"Validity: {sum(invalid.values())} of {total} drops INVALID (supervisor safe stop, QP fallback, or a "
             "low-level loop other than the one the row names) and excluded from the statistics")
     text += (": " + ", ".join(f"{n}: {k}" for n, k in invalid.items()) + "." if invalid else ".")
-    tracking = [(sub, r) for sub in ("torque_tracking", "torque_tracking_rigid", "dynamic_tracking")
-                for r in tracking_summary(f"{out}/{sub}/torque_tracking_summary.csv")]
+    subs = ["torque_tracking", "torque_tracking_rigid", "dynamic_tracking"]
+    if os.path.isdir(f"{out}/torque_tracking_seeds"):
+        subs += [f"torque_tracking_seeds/{d}" for d in sorted(os.listdir(f"{out}/torque_tracking_seeds"))]
+    tracking = [(sub, r) for sub in subs for r in tracking_summary(f"{out}/{sub}/torque_tracking_summary.csv")]
     if tracking:
         bad = [f"{sub} {r['scenario']} / {r['loop']} ({r['invalid_reason']})" for sub, r in tracking if not run_valid(r)]
         text += (f" Tracking runs: {len(bad)} of {len(tracking)} INVALID and excluded from the verdicts"
@@ -503,12 +564,22 @@ def validity_header(rep, out, sensitivity):
     rep.p(text)
 
 
-def parameters_section(rep, files):
-    """Every parameter of the plant and drive files with its value and source (parameter_sources.py)."""
+def parameters_section(rep, out, files):
+    """Every protocol parameter of the evaluations as they ran (protocol.csv, written by phri evaluate) and every
+    parameter of the plant and drive files (parameter_sources.py), each with its value and source."""
     rep.h(2, "Parameters and their sources")
-    rep.p("Read from the files' own comments: a bracketed tag names a source ([PAPER], [DEMO x] the paper's code, "
-          "[KORTEX], [BOTA], [OURS]), ESTIMATE is our choice argued in the comment, a setting is a switch, name or "
-          "seed; 'no source' is what it says. Protocol parameters of each experiment are stated in its section.")
+    rep.p("A bracketed tag names a source ([PAPER] the paper's text, [DEMO x] the paper's code, [KORTEX], [BOTA], "
+          "[OURS]), ESTIMATE is our choice argued where it is set, a setting is a switch, name or seed; 'no source' "
+          "is what it says.")
+    protocol = f"{out}/protocol.csv"
+    if os.path.exists(protocol):
+        rows = read_rows(protocol)
+        missing = sum(1 for r in rows if r["source"].startswith("no source"))
+        rep.p(f"The protocol of each evaluation as this run used it: {len(rows)} parameters, {missing} with no source.")
+        rep.table(md_table(["evaluation", "parameter", "value", "source"],
+                           [[r["experiment"], r["parameter"], r["value"], r["source"]] for r in rows]))
+    else:
+        rep.p("The protocol table is missing (protocol.csv not written): the protocols' parameters are unlisted.")
     for path in files:
         rows = parameter_rows(path)
         lines = markdown_table(os.path.relpath(path), rows).split("\n")
@@ -529,7 +600,7 @@ def main(argv):
           f"noise, 5 % link and drive-gain mismatch; {plant_header(out)}.")
     sensitivity = sensitivity_statistics(out)
     validity_header(rep, out, sensitivity)
-    parameters_section(rep, argv[4:])
+    parameters_section(rep, out, argv[4:])
     friction_section(rep, out)
     torque_tracking_section(rep, out)
     drop_section(rep, out, sensitivity)

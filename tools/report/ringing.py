@@ -11,29 +11,46 @@ import numpy as np
 MIN_HZ = 5.0         # slower content is the posture's and friction's drift, not a ringing (no source)
 MIN_PEAK_RATIO = 10  # a peak under 10x the noise floor is not called a ringing (no source)
 MATCH = 0.10         # a measured peak within 10 % of a computed mode is called that mode (no source)
+SEGMENT_S = 1.0      # the spectrum's segments: 1 Hz bins; an oscillation must last through most of them (no source)
 
 
-def dominant_frequency(signal, dt, min_hz=MIN_HZ):
+def dominant_frequency(signal, dt, min_hz=MIN_HZ, segment_s=SEGMENT_S):
     """(frequency [Hz], sine amplitude, peak / median of the spectrum) of the largest spectral peak
-    above min_hz, Hann window, mean removed."""
+    above min_hz. A ringing is an oscillation that lasts: the spectrum is the median, bin by bin, of
+    the power spectra of Hann-windowed segment_s segments (half overlapping, each mean removed), so that
+    a one-off event (a joint slipping once, a step) that fills one segment's spectrum does not count.
+    The amplitude sums the peak's main lobe (scalloping-free); the frequency interpolates the peak."""
     x = np.asarray(signal, dtype=float)
-    x = x - x.mean()
-    w = np.hanning(len(x))
-    spectrum = 2.0 * np.abs(np.fft.rfft(x * w)) / w.sum()
-    f = np.fft.rfftfreq(len(x), dt)
+    n = min(len(x), max(8, int(round(segment_s / dt))))
+    starts = range(0, len(x) - n + 1, max(1, n // 2))
+    w = np.hanning(n)
+    spectra = []
+    for s0 in starts:
+        seg = x[s0:s0 + n] - x[s0:s0 + n].mean()
+        spectra.append((2.0 * np.abs(np.fft.rfft(seg * w)) / w.sum()) ** 2 / 2.0)  # a sine: A^2 / 2 at its bin
+    power = np.median(np.array(spectra), axis=0)
+    f = np.fft.rfftfreq(n, dt)
     band = f >= min_hz
-    if not band.any():
+    # A peak is a local maximum inside the band (not the edge of slower content rising below it).
+    peak = band.copy()
+    peak[1:-1] &= (power[1:-1] >= power[:-2]) & (power[1:-1] >= power[2:]) & band[:-2]
+    peak[0] = peak[-1] = False
+    if not peak.any():
         return float("nan"), float("nan"), float("nan")
-    k = np.argmax(np.where(band, spectrum, -1.0))
-    # Parabolic interpolation of the peak on the log spectrum: finer than one bin.
+    k = int(np.argmax(np.where(peak, power, -1.0)))
+    # Parabolic interpolation of the peak on the log amplitude spectrum: finer than one bin.
     freq = f[k]
-    if 0 < k < len(spectrum) - 1 and min(spectrum[k - 1:k + 2]) > 0:
-        a, b, c = np.log(spectrum[k - 1:k + 2])
+    amp = np.sqrt(power)
+    if 0 < k < len(amp) - 1 and min(amp[k - 1:k + 2]) > 0:
+        a, b, c = np.log(amp[k - 1:k + 2])
         denom = a - 2 * b + c
         if denom != 0:
             freq = f[k] + 0.5 * (a - c) / denom * (f[1] - f[0])
-    floor = float(np.median(spectrum[band]))
-    return float(freq), float(spectrum[k]), float(spectrum[k] / floor) if floor > 0 else float("inf")
+    # A sine's power spread over the Hann main lobe sums to (A^2 / 2) x 1.5 (the window's noise bandwidth).
+    lobe = power[max(0, k - 2):k + 3].sum()
+    amplitude = float(np.sqrt(2.0 * lobe / 1.5))
+    floor = float(np.median(amp[band]))
+    return float(freq), amplitude, float(amp[k] / floor) if floor > 0 else float("inf")
 
 
 def measure_ringing(rows, transient_s=0.5):

@@ -5,9 +5,12 @@
 #include <phri/experiments/dual_compliance.hpp>
 #include <phri/experiments/experiment_files.hpp>
 #include <phri/experiments/friction_identification.hpp>
+#include <phri/experiments/parallel_runs.hpp>
+#include <phri/experiments/protocol_table.hpp>
 #include <phri/experiments/torque_tracking.hpp>
 
 #include <algorithm>
+#include <cstdint>
 #include <chrono>
 #include <cmath>
 #include <functional>
@@ -37,7 +40,7 @@ private:
   std::chrono::steady_clock::time_point start_;
 };
 
-void friction(const EvaluationOptions& o, std::ostream& out) {
+void friction(const EvaluationOptions& o, ProtocolTable& protocol, std::ostream& out) {
   const Section section(out, "friction identification");
   FrictionIdentificationOptions f;
   f.plant_config_path = in_root(o, f.plant_config_path);
@@ -45,6 +48,7 @@ void friction(const EvaluationOptions& o, std::ostream& out) {
   f.figure_script = in_root(o, f.figure_script);
   f.output_dir = output_path(o.output_dir, "friction_identification");
   if (o.quick) f.joints = {1, 5};  // one large and one small actuator
+  protocol.add_friction_identification("friction identification", f);
   run_friction_identification_command(f, out);
   // Issue 39: the same protocol on a plant whose friction differs in form from the model (Stribeck
   // curve + position ripple), kept to a few seconds: one small joint, its v_s sweep with 6 levels per
@@ -57,6 +61,7 @@ void friction(const EvaluationOptions& o, std::ostream& out) {
   g.stribeck_ripple.sweep_speed_levels = 6;
   g.output_dir = output_path(o.output_dir, "friction_form");
   g.figure_script.clear();
+  protocol.add_friction_identification("friction of another form", g);
   const FrictionIdentificationResult r = identify_friction(g, nullptr);
   out << model_form_markdown(r) << "\n" << sweep_markdown(r.sweep);
 }
@@ -70,7 +75,7 @@ TorqueTrackingOptions tracking_files(const EvaluationOptions& o, const char* fol
   return t;
 }
 
-void torque_tracking(const EvaluationOptions& o, std::ostream& out) {
+void torque_tracking(const EvaluationOptions& o, ProtocolTable& protocol, std::ostream& out) {
   const Section section(out, "torque tracking (static and dynamic), elastic joints");
   TorqueTrackingOptions t = tracking_files(o, "torque_tracking");
   use_evaluation_plant(t);
@@ -78,8 +83,26 @@ void torque_tracking(const EvaluationOptions& o, std::ostream& out) {
     t.static_duration_s = 2.0;
     t.dynamic_duration_s = 4.0;
   }
+  protocol.add_torque_tracking("torque tracking", t);
   run_torque_tracking_command(t, out);
   if (o.quick) return;
+  // The same runs on independent plants, as the drop test's drops: noise seed s, link-inertial and
+  // drive-gain seed 1000 + s. One run per loop cannot tell a loop's tracking from one plant's stick-slip.
+  const int extra = std::max(0, o.tracking_runs - 1);
+  out << "-- " << extra << " more runs per loop and scenario on independent plants (torque_tracking_seeds/)" << std::endl;
+  protocol.add("torque tracking", "runs per loop and scenario",
+               std::to_string(extra + 1) + ": seed 1 (the table above) and seeds 2-" + std::to_string(extra + 1) +
+                   " with mismatch seed 1000 + seed",
+               "no source (enough for a rank test; the paper shows one run)");
+  run_in_parallel(extra, o.jobs, [&](int i) {
+    const int seed = i + 2;
+    TorqueTrackingOptions s = tracking_files(o, ("torque_tracking_seeds/seed_" + std::to_string(seed)).c_str());
+    use_evaluation_plant(s);
+    s.seed = static_cast<std::uint64_t>(seed);
+    s.mismatch_seed = static_cast<std::uint64_t>(1000 + seed);
+    s.figure_script.clear();
+    run_torque_tracking(s, nullptr);
+  });
   // A sensitivity row, labelled so: the same runs on rigid joints (~2 s), to show what the
   // elasticity changes.
   out << "-- sensitivity: rigid joints" << std::endl;
@@ -90,12 +113,13 @@ void torque_tracking(const EvaluationOptions& o, std::ostream& out) {
 }
 
 // The dynamic scenario with the four low-level loops of the paper's Fig. dynamic-comparison.
-void dynamic_tracking(const EvaluationOptions& o, std::ostream& out) {
+void dynamic_tracking(const EvaluationOptions& o, ProtocolTable& protocol, std::ostream& out) {
   const Section section(out, "dynamic tracking (position, custom, Kinova torque, Kinova high-velocity), elastic joints");
   TorqueTrackingOptions t = dynamic_tracking_options();
   for (std::string* path : {&t.plant_config_path, &t.urdf_path, &t.actuators_path, &t.collision_path}) *path = in_root(o, *path);
   t.output_dir = output_path(o.output_dir, "dynamic_tracking");
   if (o.quick) t.dynamic_duration_s = 4.0;
+  protocol.add_torque_tracking("dynamic tracking", t);
   run_torque_tracking_command(t, out);
 }
 
@@ -114,9 +138,11 @@ DropTestOptions drop_files(const EvaluationOptions& o, const std::string& folder
   return d;
 }
 
-void drop_test(const EvaluationOptions& o, std::ostream& out) {
+void drop_test(const EvaluationOptions& o, ProtocolTable& protocol, std::ostream& out) {
   const Section section(out, "drop test (torque vs position)");
-  run_drop_test_command(drop_files(o, "drop_test"), out);
+  const DropTestOptions d = drop_files(o, "drop_test");
+  protocol.add_drop_test("drop test", d);
+  run_drop_test_command(d, out);
 }
 
 // A CSV field in quotes (settings and sources hold commas).
@@ -198,6 +224,12 @@ std::vector<Variant> plant_variants() {
                }});
   v.push_back({"rigid_joints", "joint stiffness", "rigid joints", "the limit of infinite stiffness (no source)",
                [](DropTestOptions& d) { d.elastic = false; }});
+  // The vendor servo's structure is not documented (reference section 2); the main row's servo closes
+  // on the rotor's encoder (configs/plant_gen3.yaml says why).
+  v.push_back({"servo_deflection_compensated", "vendor servo encoder",
+               "vendor servo on the rotor encoder less the static deflection (low-passed tau_s / K)",
+               "not documented by Kinova (reference section 2)",
+               [](DropTestOptions& d) { d.servo_encoder = SimRobotConfig::Elasticity::Encoder::kMotorCompensated; }});
   v.push_back({"servo_on_link_encoder", "vendor servo encoder", "vendor servo on the link encoder",
                "not documented by Kinova (reference section 2)",
                [](DropTestOptions& d) { d.servo_encoder = SimRobotConfig::Elasticity::Encoder::kLink; }});
@@ -212,12 +244,17 @@ std::vector<Variant> plant_variants() {
 
 // The drop test with one setting changed at a time: which physical effect decides the comparison.
 // sensitivity/variants.csv names each row's parameter, setting and source for the report.
-void sensitivity(const EvaluationOptions& o, std::ostream& out) {
+void sensitivity(const EvaluationOptions& o, ProtocolTable& protocol, std::ostream& out) {
   const Section section(out, "drop-test sensitivity");
   std::vector<Variant> variants = estimator_and_protocol_variants();
   for (Variant& v : plant_variants()) variants.push_back(std::move(v));
   std::ostringstream index;
   index << "name,parameter,setting,source\n";
+  protocol.add("drop-test sensitivity", "drops per mode and row", std::to_string(o.sensitivity_drops),
+               "no source (fewer than the main table's, to keep phri evaluate within 2 minutes)");
+  protocol.add("drop-test sensitivity", "release", "at most 3 s after the start", "no source (2 s of torque control settle the arm)");
+  protocol.add("drop-test sensitivity", "rows", std::to_string(variants.size()) + ", one setting changed in each",
+               "each row's setting and source: the sensitivity table");
   for (const Variant& v : variants) {
     DropTestOptions d = drop_files(o, "sensitivity/" + v.name);
     d.drops = o.sensitivity_drops;
@@ -232,11 +269,12 @@ void sensitivity(const EvaluationOptions& o, std::ostream& out) {
   write_output_files(output_path(o.output_dir, "sensitivity"), {{"variants.csv", index.str()}});
 }
 
-void dual_compliance(const EvaluationOptions& o, std::ostream& out) {
+void dual_compliance(const EvaluationOptions& o, ProtocolTable& protocol, std::ostream& out) {
   const Section section(out, "dual compliance");
   DualComplianceOptions d;
   for (std::string* path : {&d.plant_config_path, &d.urdf_path, &d.actuators_path, &d.collision_path}) *path = in_root(o, *path);
   d.output_dir = output_path(o.output_dir, "dual_compliance");
+  protocol.add_dual_compliance("dual compliance", d);
   run_dual_compliance_command(d, out);
 }
 
@@ -263,12 +301,14 @@ int run_evaluation_command(const EvaluationOptions& o, std::ostream& out) {
   ensure_output_directory(o.output_dir);
   out << "phri evaluate: " << (o.quick ? "quick protocol" : "the paper's protocol") << ", " << o.jobs << " jobs, into "
       << o.output_dir << std::endl;
-  friction(o, out);
-  torque_tracking(o, out);
-  drop_test(o, out);
-  if (!o.quick) sensitivity(o, out);
-  dynamic_tracking(o, out);
-  dual_compliance(o, out);
+  ProtocolTable protocol;
+  friction(o, protocol, out);
+  torque_tracking(o, protocol, out);
+  drop_test(o, protocol, out);
+  if (!o.quick) sensitivity(o, protocol, out);
+  dynamic_tracking(o, protocol, out);
+  dual_compliance(o, protocol, out);
+  write_output_files(o.output_dir, {{"protocol.csv", protocol.csv()}});
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   out << "== report" << std::endl;
   // The report lists every parameter of the files the evaluations read, with its source.

@@ -28,6 +28,9 @@ struct EvaluationOptions {
   int jobs = 2;
   int drops = 30;          ///< per mode (quick: 4)
   int sensitivity_drops = 6;  ///< per mode and variant
+  /// Torque tracking's runs per loop and scenario, on independent plants (not with quick): the main
+  /// run and tracking_runs - 1 more, so that the report can test the loops' difference.
+  int tracking_runs = 6;
   /// Files, relative to the working directory (the CLI resolves them against the source tree).
   std::string root = ".";
   std::string report_script = "tools/report/evaluation_report.py";
