@@ -214,6 +214,16 @@ std::vector<Variant> plant_variants() {
                "gen3_compliant_controllers' tuned K_j (reference section 1.3)", [](DropTestOptions& d) {
                  d.joint_stiffness_Nm_per_rad = std::vector<double>{4000, 4000, 4000, 4000, 3500, 3500, 3500};
                }});
+  // Under the main row's servo the hand-over to the first position command steps each drive by
+  // kp tau / K (112 N.m at 4000 N.m/rad): every drop safe-stops at once. The same springs with the
+  // servo that compensates the deflection, so that the range's soft end is measured at all.
+  v.push_back({"soft_joints_4000_3500_servo_compensated", "joint stiffness",
+               "joint stiffness 4000 / 3500 N.m/rad, vendor servo compensating the static deflection",
+               "gen3_compliant_controllers' tuned K_j (reference section 1.3); the servo: configs/plant_gen3.yaml",
+               [](DropTestOptions& d) {
+                 d.joint_stiffness_Nm_per_rad = std::vector<double>{4000, 4000, 4000, 4000, 3500, 3500, 3500};
+                 d.servo_encoder = SimRobotConfig::Elasticity::Encoder::kMotorCompensated;
+               }});
   v.push_back({"joints_9000", "joint stiffness", "joint stiffness 9000 N.m/rad on every joint",
                "the upper end of gen3_compliant_controllers' K_j range (reference section 1.3)", [](DropTestOptions& d) {
                  d.joint_stiffness_Nm_per_rad = std::vector<double>(7, 9000.0);
