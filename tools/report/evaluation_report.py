@@ -23,7 +23,7 @@ from verdicts import ALPHA, MIN_VALID, claim_paragraph, outcome, parameter_range
 from report_common import plt, read_rows, save_figure  # noqa: E402
 from parameter_sources import markdown_table, parameter_rows  # noqa: E402
 from friction_form_report import form_sentences, form_table, sweep_sentences, sweep_table  # noqa: E402
-from ringing import MIN_HZ, measure_ringing, ringing_sentence  # noqa: E402
+from ringing import MATCH, MIN_HZ, dominant_frequency, measure_ringing, ringing_sentence  # noqa: E402
 
 # The paper's friction model, eq. friction-model: tau_f = Fc sign(qd) + Fv qd.
 PAPER_FRICTION = {"large": (2.15, 2.00), "small": (1.60, 1.36)}
@@ -308,7 +308,62 @@ DROP_CLAIMS = [("peak_mm", "peak error after the catch is lower in torque mode",
                ("residual_mm", "the residual error is lower in torque mode", "mm")]
 
 
-def drop_section(rep, out, sensitivity):
+def rig_modes(plant_file):
+    """The drop rig's computed modes from the plant file (None without it): the weight's pendulum on its
+    cable, sqrt(g / L) / 2 pi with L the cable plus the sphere's radius (its tension, which pulls the tool
+    down, varies at twice that), and its bounce on the cable's spring, sqrt(k / m) / 2 pi."""
+    if not plant_file or not os.path.exists(plant_file):
+        return None
+    values = {k: v for k, v, _ in parameter_rows(plant_file)}
+    try:
+        length = float(values["plant.drop_test.cable_length_m"]) + float(values["plant.drop_test.radius_m"])
+        k, m = float(values["plant.drop_test.cable_stiffness_N_per_m"]), float(values["plant.drop_test.mass_kg"])
+    except (KeyError, ValueError):
+        return None
+    return {"pendulum": math.sqrt(9.81 / length) / (2 * math.pi), "length_m": length,
+            "bounce": math.sqrt(k / m) / (2 * math.pi)}
+
+
+def late_oscillation_sentence(d, modes, band_mm, after_s=1.0):
+    """What keeps each mode's error from settling: the dominant oscillation of every drop's error from
+    after_s after the catch to the window's end (median spectrum of 2 s segments, 0.3-20 Hz), its median
+    over drops, against the rig's computed modes."""
+    rows = read_rows(f"{d}/drop_test_traces.csv")
+    t = np.array([float(r["t_s"]) for r in rows])
+    dt = float(np.median(np.diff(t)))
+    parts = []
+    for mode in ("torque", "position"):
+        found = []
+        for col in (c for c in rows[0] if c.startswith(mode + "_")):
+            e = np.array([float(r[col]) if r[col] else np.nan for r in rows])
+            x = e[(t >= after_s) & np.isfinite(e)]
+            if x.size * dt < 4.0:
+                continue
+            hz, amp, ratio = dominant_frequency(x, dt, min_hz=0.3, segment_s=2.0)
+            if math.isfinite(hz) and hz <= 20.0:
+                found.append((hz, amp))
+        if not found:
+            continue
+        hz, amp = float(np.median([f for f, _ in found])), float(np.median([a for _, a in found]))
+        text = (f"{mode} mode {hz:.2f} Hz, amplitude {amp:.3f} mm (medians over {len(found)} drops; "
+                + ("above" if amp > band_mm else "within") + f" the {band_mm:g} mm band)")
+        if modes:
+            candidates = (("the weight's pendulum", modes["pendulum"]),
+                          ("the cable tension of that swing (twice the pendulum's)", 2.0 * modes["pendulum"]),
+                          ("its bounce on the cable", modes["bounce"]))
+            near = min(candidates, key=lambda m: abs(m[1] - hz))
+            ratio = hz / near[1]
+            text += (f": {near[0]} computed at {near[1]:.2f} Hz (measured / computed {ratio:.2f}, "
+                     + ("the same motion" if abs(ratio - 1.0) <= MATCH else "not that motion") + ")")
+        parts.append(text)
+    if not parts:
+        return ""
+    rig = (f" The rig's computed modes: pendulum sqrt(g / L) / 2 pi = {modes['pendulum']:.2f} Hz (L = "
+           f"{modes['length_m']:.2f} m, cable and sphere), bounce sqrt(k / m) / 2 pi = {modes['bounce']:.2f} Hz.") if modes else ""
+    return (f"The error's dominant oscillation from {after_s:g} s after the catch: " + "; ".join(parts) + "." + rig)
+
+
+def drop_section(rep, out, sensitivity, plant_file=None):
     d = f"{out}/drop_test"
     rep.h(2, "3. Drop test: torque vs position mode")
     rep.p("Protocol (paper, 'Stiffness in static configurations'; issue 15): the arm half extended forward holds the "
@@ -360,6 +415,9 @@ def drop_section(rep, out, sensitivity):
         rep.p("Measured from the traces (means over drops, mm): error at the catch torque "
               f"{tr['torque']['at_catch']:.3f}, position {tr['position']['at_catch']:.3f}; standard deviation over the "
               f"last second torque {tr['torque']['tail_sd']:.3f}, position {tr['position']['tail_sd']:.3f}.")
+        late = late_oscillation_sentence(d, rig_modes(plant_file), st["bands"][0]["band_mm"])
+        if late:
+            rep.p(late)
         if not os.path.exists(f"{d}/drop_test.png"):
             draw_drop(d, f"{d}/drop_test.png")
         rep.figure(f"{d}/drop_test.png", "Drop test: e_z of every drop after the catch (paper Fig. static-torque-position)")
@@ -603,7 +661,7 @@ def main(argv):
     parameters_section(rep, out, argv[4:])
     friction_section(rep, out)
     torque_tracking_section(rep, out)
-    drop_section(rep, out, sensitivity)
+    drop_section(rep, out, sensitivity, argv[4] if len(argv) > 4 else None)
     sensitivity_section(rep, sensitivity)
     dynamic_section(rep, out)
     dual_section(rep, out)
