@@ -245,6 +245,30 @@ TEST(VendorLoops, BreakawayFeedForwardOnlyForAStuckJointAskedToMove) {
   EXPECT_NEAR(command.tau_Nm[3], 0.0, 1e-6);
 }
 
+// Entering a Kinova torque loop while a drive carries its full current, with the breakaway
+// feed-forward on top: tau_d + entry offset + breakaway would exceed what the drive can give, a
+// set-point the robot refuses (SimRobot::validate, Kortex); the command is held at the range.
+TEST(VendorLoops, TorqueSetPointStaysWithinTheDrivesRangeAtAFullCurrentEntry) {
+  const phri::ActuatorTable table = phri::ActuatorTable::from_yaml_file(kActuators);
+  phri::LowLevelController low(table, phri::CustomTorqueSettings{}, phri::LowLevelMode::kKinovaTorqueHighVelocity);
+  phri::RobotState state(7);
+  state.q_rad.setZero();
+  state.qd_rad_s.setZero();
+  state.tau_sensor_Nm.setZero();
+  state.current.valid = true;
+  state.current_A = Eigen::VectorXd::Zero(7);
+  state.current_A[6] = table[6].current_limit_A;  // joint 7 at its full current
+  Eigen::VectorXd tau_d = Eigen::VectorXd::Zero(7), qdd = Eigen::VectorXd::Zero(7);
+  qdd[6] = 5.0;  // stuck and asked to move: the breakaway share is added
+  phri::RobotCommand command(7);
+  low.update(state, tau_d, qdd, command);
+  const double range = table[6].max_motor_torque_Nm();
+  const double unsaturated = range + phri::LowLevelController::kVendorBreakawayShare * table[6].friction.static_Nm;
+  ASSERT_GT(unsaturated, range);
+  EXPECT_DOUBLE_EQ(command.tau_Nm[6], range);
+  for (int i = 0; i < 7; ++i) EXPECT_LE(std::abs(command.tau_Nm[i]), table[i].max_motor_torque_Nm()) << "joint " << i + 1;
+}
+
 // A 7-joint arm at rest at zero, no torque, no current reading.
 phri::RobotState resting_state() {
   phri::RobotState state(7);

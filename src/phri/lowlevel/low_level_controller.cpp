@@ -2,6 +2,7 @@
 
 #include <phri/lowlevel/friction_compensation.hpp>
 
+#include <algorithm>
 #include <cmath>
 
 namespace phri {
@@ -33,6 +34,16 @@ LowLevelController::LowLevelController(const ActuatorTable& actuators, const Cus
     torque_per_amp_[i] = actuators[i].torque_per_amp();
     current_limit_[i] = actuators[i].current_limit_A;
     friction_.push_back(actuators[i].friction);
+  }
+}
+
+// The entry offset and the feed-forward terms ride on a tau_d the QP keeps within its limits; their
+// sum is held within what the drive can give (its current limit x K_T G_r), since a set-point beyond
+// it is refused (the robot faults) rather than saturated.
+void LowLevelController::saturate_to_drive_range(Eigen::VectorXd& tau) const {
+  for (int i = 0; i < tau.size(); ++i) {
+    const double range = current_limit_[i] * torque_per_amp_[i];
+    tau[i] = std::clamp(tau[i], -range, range);
   }
 }
 
@@ -109,6 +120,7 @@ void LowLevelController::update(const RobotState& state, const Eigen::VectorXd& 
       }
       update_friction_assist(state.qd_rad_s, qdd_desired);
       command.tau_Nm = tau_desired + torque_offset_ + breakaway_;
+      saturate_to_drive_range(command.tau_Nm);
       torque_offset_ *= offset_decay_;
       break;
     case LowLevelMode::kTorque:
@@ -118,6 +130,7 @@ void LowLevelController::update(const RobotState& state, const Eigen::VectorXd& 
       if (entering) torque_offset_ = entry_torque(state) - tau_desired;  // bumpless, as above
       plain_torque_feedforward(state.qd_rad_s, qdd_desired);
       command.tau_Nm = tau_desired + torque_offset_ + feedforward_;
+      saturate_to_drive_range(command.tau_Nm);
       torque_offset_ *= offset_decay_;
       break;
     case LowLevelMode::kCurrent:

@@ -85,6 +85,7 @@ public:
 private:
   void update_friction_assist(const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd_desired);
   void plain_torque_feedforward(const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd_desired);
+  void saturate_to_drive_range(Eigen::VectorXd& tau) const;
   // The torque the motors produce now, as the Kinova loops' entry reads it: measured current x
   // K_T G_r (nominal), else tau_s.
   const Eigen::VectorXd& entry_torque(const RobotState& state);
