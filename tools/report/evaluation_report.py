@@ -288,8 +288,9 @@ def ringing_subsection(rep, d):
                        [[m["joint"], f"{float(m['stiffness_Nm_per_rad']):.0f}", f"{float(m['rotor_inertia_kgm2']):.3f}",
                          f"{float(m['link_inertia_kgm2']):.4f}", f"{float(m['locked_link_hz']):.1f}",
                          f"{float(m['mode_hz']):.1f}"] for m in static]))
-    rep.p(f"Measured from each run's log, per joint: the spectrum (Hann window) of the measured torque error "
-          f"tau_d - tau_s after the transient, mean removed, above {MIN_HZ:g} Hz; cells: the dominant peak's frequency "
+    rep.p(f"Measured from each run's log, per joint: the spectrum of the measured torque error tau_d - tau_s after the "
+          f"transient, the bin-wise median over 1 s half-overlapping Hann segments (a ringing lasts; a one-off slip "
+          f"does not count), above {MIN_HZ:g} Hz; cells: the dominant peak's frequency "
           "[Hz] / amplitude [N.m] / peak over the spectrum's median (the noise floor: the plant's 0.05 N.m sensor noise "
           "is white); beside it the joint's computed two-mass mode at that run's posture [Hz].")
     rows = []
