@@ -4,12 +4,16 @@
 #include <phri/core/error.hpp>
 #include <phri/model/algorithms.hpp>
 #include <phri/model/model.hpp>
+#include <phri/model/small_cholesky.hpp>
 
 #include "allocation_counter.hpp"
 #include "config_error.hpp"
 #include "random_chain.hpp"
 
 #include <gtest/gtest.h>
+
+#include <Eigen/Cholesky>
+#include <Eigen/QR>
 
 #include <fstream>
 #include <functional>
@@ -310,6 +314,62 @@ TEST(ModelCrba, MassMatrixIsTheSumOverBodiesOfJacobianInertiaJacobianToRounding)
   }
   EXPECT_GT(prismatic, 0);  // the general joints are covered, not only the Gen3's
   EXPECT_GT(revolute_off_z, 0);
+}
+
+// SmallCholesky (the mass matrix's factor) against Eigen's LLT, the reference: the same factor and
+// solutions to rounding for every size from 1 to 30 (conditioning up to 1e6), only the lower
+// triangle read, a matrix's columns solved as the vectors are, and Eigen's refusals (indefinite,
+// singular) plus a NaN, which Eigen's pivot test (x <= 0) lets through.
+TEST(SmallCholesky, AgreesWithEigensLltToRoundingAndRefusesWhatItRefuses) {
+  std::mt19937 rng(44);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  for (int n = 1; n <= 30; ++n) {
+    for (const double condition : {1.0, 1e3, 1e6}) {
+      // A = Q diag(1 .. 1/condition) Q^T with a random orthogonal Q.
+      const Eigen::MatrixXd random = Eigen::MatrixXd::NullaryExpr(n, n, [&] { return unit(rng); });
+      const Eigen::MatrixXd q = Eigen::HouseholderQR<Eigen::MatrixXd>(random).householderQ();
+      Eigen::VectorXd spectrum(n);
+      for (int i = 0; i < n; ++i) spectrum[i] = std::pow(condition, -double(i) / std::max(n - 1, 1));
+      Eigen::MatrixXd a = q * spectrum.asDiagonal() * q.transpose();
+      a = 0.5 * (a + a.transpose()).eval();
+      const Eigen::LLT<Eigen::MatrixXd> reference(a);
+      ASSERT_EQ(reference.info(), Eigen::Success);
+
+      Eigen::MatrixXd upper_garbage = a;
+      upper_garbage.triangularView<Eigen::StrictlyUpper>().setConstant(std::nan(""));
+      phri::SmallCholesky factor(n);
+      ASSERT_TRUE(factor.compute(upper_garbage)) << n;
+      const Eigen::MatrixXd l = factor.factor().triangularView<Eigen::Lower>();
+      const Eigen::MatrixXd l_reference = reference.matrixL();
+      EXPECT_LT((l - l_reference).cwiseAbs().maxCoeff(), 1e-14 * n * condition) << n << " cond " << condition;
+
+      const Eigen::MatrixXd b = Eigen::MatrixXd::NullaryExpr(n, 3, [&] { return unit(rng); });
+      Eigen::MatrixXd x = b;
+      factor.solve_in_place(x);
+      const Eigen::MatrixXd x_reference = reference.solve(b);
+      EXPECT_LT((x - x_reference).norm() / x_reference.norm(), 1e-15 * n * condition) << n << " cond " << condition;
+      EXPECT_LT((a * x - b).norm() / x.norm(), 1e-14 * n) << n << " cond " << condition;  // backward error, ||A|| = 1
+      for (int c = 0; c < 3; ++c) {
+        Eigen::VectorXd column = b.col(c);
+        factor.solve_in_place(column);
+        EXPECT_EQ(column, x.col(c));  // a matrix is solved column by column, bit for bit
+      }
+    }
+  }
+  // The refusals, and a refusal is remembered until the next factor.
+  phri::SmallCholesky factor(3);
+  Eigen::Matrix3d indefinite = Eigen::Vector3d(1.0, -1e-9, 2.0).asDiagonal();
+  Eigen::Matrix3d singular = Eigen::Matrix3d::Ones();
+  Eigen::Matrix3d not_a_number = Eigen::Matrix3d::Identity();
+  not_a_number(2, 1) = std::nan("");
+  for (const Eigen::Matrix3d& bad : {indefinite, singular}) {
+    EXPECT_FALSE(factor.compute(bad));
+    EXPECT_FALSE(factor.ok());
+    EXPECT_NE(Eigen::LLT<Eigen::MatrixXd>(bad).info(), Eigen::Success);
+  }
+  EXPECT_FALSE(factor.compute(not_a_number));
+  EXPECT_TRUE(factor.compute(Eigen::Matrix3d::Identity()));
+  EXPECT_TRUE(factor.ok());
 }
 
 // ------------------------------------------------------------------- Kinova's own FK figures

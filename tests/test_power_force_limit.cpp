@@ -18,6 +18,8 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Cholesky>
+
 #include <fstream>
 #include <iterator>
 #include <random>
@@ -74,7 +76,8 @@ TEST(PowerForceLimit, ReflectedMassOfATwoLinkArmIsItsClosedForm) {
     Eigen::MatrixXd inertia = data.mass_matrix;
     inertia.diagonal().array() += rotor;
     EXPECT_LT((inertia - m).norm(), 1e-9);
-    const Eigen::LLT<Eigen::MatrixXd> llt(inertia);
+    phri::SmallCholesky llt(inertia.rows());
+    ASSERT_TRUE(llt.compute(inertia));
     Eigen::VectorXd scratch(2), solved(2);
     for (const double angle : {0.0, 0.8, 2.0}) {
       const Eigen::Vector2d u2(std::cos(angle), std::sin(angle));
@@ -102,7 +105,8 @@ TEST(PowerForceLimit, ReflectedMassIsTheLeastKineticEnergyOfAUnitSpeedAlongU) {
   Eigen::VectorXd rotor = Eigen::VectorXd::Constant(7, 0.3);
   Eigen::MatrixXd inertia = data.mass_matrix;
   inertia.diagonal() += rotor;
-  const Eigen::LLT<Eigen::MatrixXd> llt(inertia);
+  phri::SmallCholesky llt(inertia.rows());
+  ASSERT_TRUE(llt.compute(inertia));
   const Eigen::Vector3d u = Eigen::Vector3d(0.3, -0.5, 0.8).normalized();
   Eigen::VectorXd scratch(7), solved(7);
   const double m_u = phri::reflected_mass(j, llt, u, scratch, solved);
@@ -120,7 +124,7 @@ TEST(PowerForceLimit, ReflectedMassIsTheLeastKineticEnergyOfAUnitSpeedAlongU) {
     qd /= along;
     least = std::min(least, 0.5 * qd.dot(inertia * qd));
   }
-  const Eigen::VectorXd best = llt.solve(j.transpose() * u) * m_u;  // (M + I_r)^-1 J^T u m_u
+  const Eigen::VectorXd best = inertia.llt().solve(j.transpose() * u) * m_u;  // (M + I_r)^-1 J^T u m_u
   const double h = 1e-6;
   EXPECT_NEAR(u.dot(point_at(q + h * best) - point_at(q - h * best)) / (2 * h), 1.0, 1e-6);
   EXPECT_NEAR(0.5 * best.dot(inertia * best), 0.5 * m_u, 1e-9 * m_u);
@@ -389,7 +393,8 @@ TEST(PowerForceLimitMonitor, EachLinkHasItsFasterEndPointsFiguresAndItsOwnRegion
   monitor.update(model, data);
   Eigen::MatrixXd inertia = data.mass_matrix;
   inertia.diagonal() += rotor;
-  const Eigen::LLT<Eigen::MatrixXd> llt(inertia);
+  phri::SmallCholesky llt(inertia.rows());
+  ASSERT_TRUE(llt.compute(inertia));
   auto world = [&](const Eigen::VectorXd& at, int body, const Eigen::Vector3d& local) {
     phri::Data d(model);
     phri::forward_kinematics(model, d, at);

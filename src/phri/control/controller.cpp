@@ -709,10 +709,9 @@ void Controller::guard_torque(Eigen::VectorXd& tau) {
   if (speeding) {
     guard_inertia_ = data_.mass_matrix;
     guard_inertia_.diagonal() += reflected_inertia_;
-    guard_llt_.compute(guard_inertia_);
-    if (guard_llt_.info() == Eigen::Success) {
+    if (guard_llt_.compute(guard_inertia_)) {
       guard_mobility_.setIdentity();
-      guard_llt_.solveInPlace(guard_mobility_);
+      guard_llt_.solve_in_place(guard_mobility_);
       scale = guard_coupling_scale(guard_mobility_, guard_damping_, guard_excess_, settings_.period_s, kGuardMaxStep);
     }
   }

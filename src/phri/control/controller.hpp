@@ -32,6 +32,7 @@
 #include <phri/lowlevel/low_level_controller.hpp>
 #include <phri/model/collision_model.hpp>
 #include <phri/model/model.hpp>
+#include <phri/model/small_cholesky.hpp>
 #include <phri/robot/actuator_table.hpp>
 #include <phri/robot/robot_command.hpp>
 #include <phri/robot/robot_state.hpp>
@@ -228,7 +229,7 @@ private:
   // The guards' working memory (guard_torque): excess speed, damping, collision torque, M + I_r and its inverse
   Eigen::VectorXd guard_excess_, guard_damping_, collision_guard_;
   Eigen::MatrixXd guard_inertia_, guard_mobility_;
-  Eigen::LLT<Eigen::MatrixXd> guard_llt_;
+  SmallCholesky guard_llt_;
 };
 
 }  // namespace phri

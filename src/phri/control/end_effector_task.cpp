@@ -267,14 +267,8 @@ void EndEffectorTask::weigh_rows() {
 void EndEffectorTask::add_objective(ObjectiveTerms& objective) const {
   const double w = weight();
   const Eigen::MatrixXd& a = rows();
-  if (weighted_) {
-    // w || (S^1/2 W S^1/2)^1/2 (A qdd - b) ||^2 (singular_direction_weight.hpp).
-    objective.hessian.noalias() += w * a.transpose() * weighted_rows_;
-    objective.gradient.noalias() -= w * weighted_rows_.transpose() * reference_;
-  } else {
-    objective.hessian.noalias() += w * a.transpose() * a;
-    objective.gradient.noalias() -= w * a.transpose() * reference_;
-  }
+  // w || (S^1/2 W S^1/2)^1/2 (A qdd - b) ||^2 (singular_direction_weight.hpp).
+  objective.add_least_squares(w, a, weighted_ ? weighted_rows_ : a, reference_);
 }
 
 }  // namespace phri

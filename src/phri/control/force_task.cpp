@@ -75,7 +75,7 @@ private:
   // Lambda_n = n^T (J M^-1 J^T)^-1 n, the task-space inertia along n with the other axes held [kg].
   double inertia_along(const Data& data, const Eigen::Vector3d& n) {
     mobility_ = jacobian_.transpose();
-    data.mass_matrix_llt.solveInPlace(mobility_);  // M^-1 J^T
+    data.mass_matrix_llt.solve_in_place(mobility_);  // M^-1 J^T
     jjt_.noalias() = jacobian_ * mobility_;
     jjt_.diagonal().array() += 1e-9;
     llt_.compute(jjt_);

@@ -52,8 +52,7 @@ public:
   }
 
   void add_objective(ObjectiveTerms& objective) const override {
-    objective.hessian.noalias() += weight_ * rows_.transpose() * weighted_rows_;
-    objective.gradient.noalias() -= weight_ * weighted_rows_.transpose() * reference_;
+    objective.add_least_squares(weight_, rows_, weighted_rows_, reference_);
   }
 
 private:

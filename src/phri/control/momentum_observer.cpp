@@ -58,7 +58,7 @@ const Eigen::VectorXd& MomentumObserver::update(const Data& data, const Eigen::V
   // The kick the arm would get if every push were gone and the controller still cancelled r:
   // -M^-1 r. Only where it drives a fast joint along its motion does the release path act.
   release_kick_ = -residual_;
-  data.mass_matrix_llt.solveInPlace(release_kick_);
+  data.mass_matrix_llt.solve_in_place(release_kick_);
   bool kick_along_motion = false;
   for (Eigen::Index j = 0; j < residual_.size(); ++j) {
     kick_along_motion = kick_along_motion || (std::abs(release_velocity_[j]) > release_speed_[j] &&

@@ -89,7 +89,8 @@ void PostureTask::update(const Eigen::VectorXd& q, const Eigen::VectorXd& qd, co
   gamma_.step(dt);
   for (int i = 0; i < nv_; ++i) {
     double e = target_q_[i] + offset_q_[i] - q[i];
-    if (continuous_[static_cast<std::size_t>(i)]) e = std::remainder(e, 2.0 * std::numbers::pi);
+    // remainder(e, 2 pi) is e itself for |e| <= pi (ties round to the even quotient, 0): skip the call.
+    if (continuous_[static_cast<std::size_t>(i)] && std::abs(e) > std::numbers::pi) e = std::remainder(e, 2.0 * std::numbers::pi);
     error_[i] = e;
   }
   update_integral(qd, dt);

@@ -33,16 +33,16 @@ double permissible_speed(const BodyRegion& region, double robot_kg) {
   return region.transient_force_N() / std::sqrt(reduced_mass(robot_kg, region.mass_kg) * region.stiffness_N_per_m);
 }
 
-double reflected_mass(const Eigen::Ref<const Eigen::MatrixXd>& linear_jacobian, const Eigen::LLT<Eigen::MatrixXd>& inertia,
+double reflected_mass(const Eigen::Ref<const Eigen::MatrixXd>& linear_jacobian, const SmallCholesky& inertia,
                       const Eigen::Vector3d& direction, Eigen::VectorXd& scratch, Eigen::VectorXd& solved) {
   scratch.noalias() = linear_jacobian.transpose() * direction;  // J^T u
   solved = scratch;
-  inertia.solveInPlace(solved);
+  inertia.solve_in_place(solved);
   const double along = scratch.dot(solved);
   return along > 0.0 ? 1.0 / along : std::numeric_limits<double>::infinity();
 }
 
-bool contact_point_figures(const Model& model, const Data& data, const Eigen::LLT<Eigen::MatrixXd>& inertia, int body,
+bool contact_point_figures(const Model& model, const Data& data, const SmallCholesky& inertia, int body,
                            const Eigen::Vector3d& local, const BodyRegion& region, double min_speed_m_s,
                            ContactPointState& s, Eigen::Vector3d& direction, Eigen::MatrixXd& jacobian,
                            Eigen::VectorXd& scratch, Eigen::VectorXd& solved) {

@@ -54,7 +54,7 @@ double reduced_mass(double robot_kg, double human_kg);
 double permissible_speed(const BodyRegion& region, double robot_kg);
 /// m_u = 1 / (u^T J_v W J_v^T u) with W = (M + I_r)^-1 given by its Cholesky factor; `scratch` and
 /// `solved` of size nv (no allocation).
-double reflected_mass(const Eigen::Ref<const Eigen::MatrixXd>& linear_jacobian, const Eigen::LLT<Eigen::MatrixXd>& inertia,
+double reflected_mass(const Eigen::Ref<const Eigen::MatrixXd>& linear_jacobian, const SmallCholesky& inertia,
                       const Eigen::Vector3d& direction, Eigen::VectorXd& scratch, Eigen::VectorXd& solved);
 
 struct PowerForceLimitSettings {
@@ -76,7 +76,7 @@ struct ContactPointState {
 /// The point's figures from its velocity and, when it moves (|v| >= min_speed), its reflected mass
 /// along the motion; `direction` is then v / |v| and `jacobian` its 3 x nv linear Jacobian. False
 /// (figures zero) when it does not move. `inertia`: the factor of M + I_r; no allocation.
-bool contact_point_figures(const Model& model, const Data& data, const Eigen::LLT<Eigen::MatrixXd>& inertia, int body,
+bool contact_point_figures(const Model& model, const Data& data, const SmallCholesky& inertia, int body,
                            const Eigen::Vector3d& local, const BodyRegion& region, double min_speed_m_s,
                            ContactPointState& state, Eigen::Vector3d& direction, Eigen::MatrixXd& jacobian,
                            Eigen::VectorXd& scratch, Eigen::VectorXd& solved);
@@ -109,7 +109,7 @@ private:
   std::vector<ContactPointState> states_;
   Eigen::VectorXd rotor_inertia_;
   Eigen::MatrixXd inertia_;        // M + I_r
-  Eigen::LLT<Eigen::MatrixXd> inertia_llt_;
+  SmallCholesky inertia_llt_;
   Eigen::MatrixXd jacobian_;       // 3 x nv
   Eigen::VectorXd scratch_, solved_;
 };
@@ -148,7 +148,7 @@ private:
   int worst_ = -1;
   Eigen::VectorXd rotor_inertia_;
   Eigen::MatrixXd inertia_;
-  Eigen::LLT<Eigen::MatrixXd> inertia_llt_;
+  SmallCholesky inertia_llt_;
   Eigen::MatrixXd jacobian_;
   Eigen::VectorXd scratch_, solved_;
 };

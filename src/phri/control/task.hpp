@@ -37,6 +37,23 @@ struct ObjectiveTerms {
   Eigen::MatrixXd& hessian;
   Eigen::VectorXd& hessian_diagonal;
   Eigen::VectorXd& gradient;
+
+  // w ||W^1/2 (A qdd - b)||^2 with W A given (weighted_rows; A itself when W = I): H += w A^T W A,
+  // g -= w (W A)^T b. H's lower triangle from column dots, mirrored, so H stays exactly symmetric;
+  // Eigen's product of two dynamic matrices takes its blocked GEMM path at a task's sizes (6 x 7).
+  void add_least_squares(double w, const Eigen::MatrixXd& rows, const Eigen::MatrixXd& weighted_rows,
+                         const Eigen::Ref<const Eigen::VectorXd>& reference) {
+    const Eigen::Index n = rows.cols();
+    for (Eigen::Index j = 0; j < n; ++j) {
+      const auto weighted = weighted_rows.col(j);
+      gradient[j] -= w * weighted.dot(reference);
+      for (Eigen::Index i = j; i < n; ++i) {
+        const double term = w * rows.col(i).dot(weighted);
+        hessian(i, j) += term;
+        if (i != j) hessian(j, i) += term;
+      }
+    }
+  }
 };
 
 /// What a task reads in one cycle (all after the model terms of (q, qd)).

@@ -194,7 +194,7 @@ WholeBodyQpStatus WholeBodyQp::update(const Model& model, const Data& data, cons
   }
   // qdd_ext = M^-1 tau_ext: what the push alone would do to the arm (through the dead band).
   soft_deadband(tau_ext, deadband_, qdd_external_);
-  data.mass_matrix_llt.solveInPlace(qdd_external_);
+  data.mass_matrix_llt.solve_in_place(qdd_external_);
 
   const TaskContext task_context{model, data, q, qd, tau_ext, qdd_external_, ee_wrench_world, dt};
   for (const auto& task : tasks_) task->update(task_context);

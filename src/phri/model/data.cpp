@@ -16,9 +16,6 @@ Data::Data(const Model& model)
       tau(Eigen::VectorXd::Zero(model.nv())),
       nonlinear_effects(Eigen::VectorXd::Zero(model.nv())),
       gravity_torque(Eigen::VectorXd::Zero(model.nv())),
-      coriolis_transpose_qd(Eigen::VectorXd::Zero(model.nv())) {
-  // Factor the identity once so that the LLT object owns a correctly sized buffer.
-  mass_matrix_llt.compute(Eigen::MatrixXd::Identity(model.nv(), model.nv()));
-}
+      coriolis_transpose_qd(Eigen::VectorXd::Zero(model.nv())) {}
 
 }  // namespace phri

@@ -4,7 +4,7 @@
 #include <phri/model/model.hpp>
 #include <phri/model/spatial.hpp>
 
-#include <Eigen/Cholesky>
+#include <phri/model/small_cholesky.hpp>
 
 #include <vector>
 
@@ -25,7 +25,7 @@ struct Data {
   std::vector<WorldInertia> composite_inertias;  ///< bodies i..n-1 together (CRBA)
   Matrix6Xd body_forces;      ///< RNEA: net spatial force transmitted through joint i
   Eigen::MatrixXd mass_matrix;                 ///< M(q), armature included (crba)
-  Eigen::LLT<Eigen::MatrixXd> mass_matrix_llt; ///< compute_mass_matrix_cholesky
+  SmallCholesky mass_matrix_llt;  ///< compute_mass_matrix_cholesky
   Eigen::VectorXd tau;                ///< rnea output
   Eigen::VectorXd nonlinear_effects;  ///< h(q, qd) = C(q, qd) qd + g(q)
   Eigen::VectorXd gravity_torque;     ///< g(q)

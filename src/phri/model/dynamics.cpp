@@ -153,12 +153,11 @@ const Eigen::MatrixXd& crba(const Model& model, Data& data, const Eigen::VectorX
 }
 
 bool compute_mass_matrix_cholesky(Data& data) {
-  data.mass_matrix_llt.compute(data.mass_matrix);
-  return data.mass_matrix_llt.info() == Eigen::Success;
+  return data.mass_matrix_llt.compute(data.mass_matrix);
 }
 
 void mass_matrix_solve_in_place(const Data& data, Eigen::Ref<Eigen::VectorXd> x) {
-  data.mass_matrix_llt.solveInPlace(x);
+  data.mass_matrix_llt.solve_in_place(x);
 }
 
 const Eigen::VectorXd& rnea(const Model& model, Data& data, const Eigen::VectorXd& q,
