@@ -19,7 +19,16 @@ void place_body(const Model& model, Data& data, int i, double qi) {
     body.translation() += axis_world * qi;
     data.motion_subspace.col(i) << axis_world, Eigen::Vector3d::Zero();
   } else {
-    body.linear() = body.linear() * Eigen::AngleAxisd(qi, joint.axis).toRotationMatrix();
+    if (joint.axis == Eigen::Vector3d::UnitZ()) {
+      // R Rz(q): only the first two columns turn (most arms' URDFs put every joint on z).
+      const double c = std::cos(qi), s = std::sin(qi);
+      auto r = body.linear();
+      const Eigen::Vector3d x = r.col(0), y = r.col(1);
+      r.col(0) = c * x + s * y;
+      r.col(1) = c * y - s * x;
+    } else {
+      body.linear() = body.linear() * Eigen::AngleAxisd(qi, joint.axis).toRotationMatrix();
+    }
     // A rotation about the axis through the body origin p moves the world-origin point at p x a.
     data.motion_subspace.col(i) << body.translation().cross(axis_world), axis_world;
   }
