@@ -249,8 +249,10 @@ TEST_F(ModelFiniteDifferences, CoriolisTransposeTimesVelocityIsTheKineticEnergyG
       }
       // Armature does not depend on q, so the gradient is the same with or without it.
       phri::compute_all_terms(model, data, q, qd);
+      const Eigen::VectorXd from_all_terms = data.coriolis_transpose_qd;  // its fused backward pass
       const Eigen::VectorXd ctqd = phri::coriolis_transpose_times_velocity(model, data);
       EXPECT_LT((ctqd - gradient).norm(), 1e-6 * (1.0 + gradient.norm())) << name;
+      EXPECT_EQ(from_all_terms, ctqd) << name;  // the same operations in the same order
     }
   }
 }

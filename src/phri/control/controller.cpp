@@ -333,8 +333,7 @@ bool Controller::apply(const ControllerTargets& targets) {
 // Model terms, momentum observer, F/T wrench at the end effector.
 void Controller::estimate(const RobotState& state, double dt) {
   ft_torque_current_ = false;
-  compute_all_terms(model_, data_, q_, qd_);
-  coriolis_transpose_times_velocity(model_, data_);
+  compute_all_terms(model_, data_, q_, qd_);  // C^T qd for the observer included
   observer_.update(data_, qd_, state.tau_sensor_Nm, dt);
   estimate_wrench(state);
   if (settings_.position_mode_open_loop && low_level_.integrating_position()) {

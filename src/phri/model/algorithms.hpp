@@ -73,8 +73,9 @@ const Eigen::VectorXd& compute_gravity(const Model& model, Data& data, const Eig
 const Eigen::VectorXd& coriolis_transpose_times_velocity(const Model& model, Data& data);
 
 /// One pass for the controller: placements of bodies and frames, velocities, drift accelerations
-/// (so frame_jdot_qdot works), M(q) and its Cholesky factor, h(q, qd), g(q). Returns false if M is
-/// not positive definite (which a valid model never gives).
+/// (so frame_jdot_qdot works), M(q) and its Cholesky factor, h(q, qd), g(q) and C(q, qd)^T qd (as
+/// coriolis_transpose_times_velocity gives it). Returns false if M is not positive definite (which a
+/// valid model never gives).
 bool compute_all_terms(const Model& model, Data& data, const Eigen::VectorXd& q,
                        const Eigen::VectorXd& qd);
 

@@ -189,21 +189,36 @@ const Eigen::VectorXd& compute_gravity(const Model& model, Data& data, const Eig
   return data.gravity_torque;
 }
 
+namespace {
+
+// Body i's step of the backward pass of C^T qd: the subtree's momentum gains I_i v_i, and
+// dT/dq_i = (v_{i-1} x S_i) . H_i.
+void coriolis_transpose_step(const Data& data, int i, Vector6d& momentum, Eigen::VectorXd& out) {
+  momentum += data.body_inertias[static_cast<std::size_t>(i)].apply(data.body_velocities.col(i));
+  out[i] = i == 0 ? 0.0  // the base does not move
+                  : motion_cross(data.body_velocities.col(i - 1), data.motion_subspace.col(i)).dot(momentum);
+}
+
+// g(q) and C^T qd in one backward pass over the same inertias (each as its own pass computes it).
+void gravity_and_coriolis_transpose_backward(const Model& model, Data& data) {
+  Vector6d base_acceleration;
+  base_acceleration << -model.gravity(), Eigen::Vector3d::Zero();
+  Vector6d force = Vector6d::Zero(), momentum = Vector6d::Zero();
+  for (int i = model.nq() - 1; i >= 0; --i) {
+    force += data.body_inertias[static_cast<std::size_t>(i)].apply(base_acceleration);
+    data.gravity_torque[i] = data.motion_subspace.col(i).dot(force);
+    coriolis_transpose_step(data, i, momentum, data.coriolis_transpose_qd);
+  }
+}
+
+}  // namespace
+
 const Eigen::VectorXd& coriolis_transpose_times_velocity(const Model& model, Data& data) {
   // T = sum_j 1/2 v_j' I_j v_j. Joint i turns every body j >= i; in body coordinates the inertia is
   // constant and the body velocity changes by -(S_i x v_{i-1}), so dT/dq_i = (v_{i-1} x S_i) . H_i
   // with H_i = sum_{j >= i} I_j v_j the momentum of the subtree (a running sum on a chain).
   Vector6d momentum = Vector6d::Zero();
-  for (int i = model.nq() - 1; i >= 0; --i) {
-    const WorldInertia& inertia = data.body_inertias[static_cast<std::size_t>(i)];
-    momentum += inertia.apply(data.body_velocities.col(i));
-    if (i == 0) {
-      data.coriolis_transpose_qd[i] = 0.0;  // the base does not move
-    } else {
-      data.coriolis_transpose_qd[i] =
-          motion_cross(data.body_velocities.col(i - 1), data.motion_subspace.col(i)).dot(momentum);
-    }
-  }
+  for (int i = model.nq() - 1; i >= 0; --i) coriolis_transpose_step(data, i, momentum, data.coriolis_transpose_qd);
   return data.coriolis_transpose_qd;
 }
 
@@ -211,7 +226,7 @@ bool compute_all_terms(const Model& model, Data& data, const Eigen::VectorXd& q,
                        const Eigen::VectorXd& qd) {
   nonlinear_effects(model, data, q, qd);  // placements, velocities, drift accelerations, inertias
   update_frame_placements(model, data);
-  gravity_backward(model, data);
+  gravity_and_coriolis_transpose_backward(model, data);
   composite_rigid_body(model, data);
   return compute_mass_matrix_cholesky(data);
 }
