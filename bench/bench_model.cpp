@@ -4,8 +4,11 @@
 #include <phri/model/algorithms.hpp>
 #include <phri/model/collision_model.hpp>
 #include <phri/model/model.hpp>
+#include <phri/model/small_cholesky.hpp>
 
 #include <benchmark/benchmark.h>
+
+#include <Eigen/Cholesky>
 
 #include <random>
 
@@ -68,6 +71,58 @@ void ModelCrba(benchmark::State& state) {
   }
 }
 BENCHMARK(ModelCrba);
+
+// The mass matrix's factor and one solve, phri::SmallCholesky (what Data holds) against Eigen's
+// LLT<MatrixXd> on the same M; Arg: the Gen3's M (7), or a 30 x 30 SPD matrix (dynamic-size path).
+Eigen::MatrixXd cholesky_input(int n) {
+  if (n == 7) return Gen3().data.mass_matrix;
+  std::mt19937 rng(30);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const Eigen::MatrixXd a = Eigen::MatrixXd::NullaryExpr(n, n, [&] { return u(rng); });
+  return a * a.transpose() + n * Eigen::MatrixXd::Identity(n, n);
+}
+void SmallCholeskyFactor(benchmark::State& state) {
+  const Eigen::MatrixXd m = cholesky_input(static_cast<int>(state.range(0)));
+  phri::SmallCholesky factor(m.rows());
+  for (auto _ : state) benchmark::DoNotOptimize(factor.compute(m));
+}
+BENCHMARK(SmallCholeskyFactor)->Arg(7)->Arg(30);
+void EigenLltCholeskyFactor(benchmark::State& state) {
+  const Eigen::MatrixXd m = cholesky_input(static_cast<int>(state.range(0)));
+  Eigen::LLT<Eigen::MatrixXd> factor(m.rows());
+  for (auto _ : state) {
+    factor.compute(m);
+    benchmark::DoNotOptimize(factor.matrixLLT().data());
+  }
+}
+BENCHMARK(EigenLltCholeskyFactor)->Arg(7)->Arg(30);
+void SmallCholeskySolve(benchmark::State& state) {
+  const Eigen::MatrixXd m = cholesky_input(static_cast<int>(state.range(0)));
+  phri::SmallCholesky factor(m.rows());
+  factor.compute(m);
+  const Eigen::VectorXd b = Eigen::VectorXd::LinSpaced(m.rows(), -1.0, 1.0);
+  Eigen::VectorXd x = b;
+  for (auto _ : state) {
+    x = b;
+    factor.solve_in_place(x);
+    benchmark::DoNotOptimize(x.data());
+    benchmark::ClobberMemory();
+  }
+}
+BENCHMARK(SmallCholeskySolve)->Arg(7)->Arg(30);
+void EigenLltCholeskySolve(benchmark::State& state) {
+  const Eigen::MatrixXd m = cholesky_input(static_cast<int>(state.range(0)));
+  const Eigen::LLT<Eigen::MatrixXd> factor(m);
+  const Eigen::VectorXd b = Eigen::VectorXd::LinSpaced(m.rows(), -1.0, 1.0);
+  Eigen::VectorXd x = b;
+  for (auto _ : state) {
+    x = b;
+    factor.solveInPlace(x);
+    benchmark::DoNotOptimize(x.data());
+    benchmark::ClobberMemory();
+  }
+}
+BENCHMARK(EigenLltCholeskySolve)->Arg(7)->Arg(30);
 
 void ModelRnea(benchmark::State& state) {
   Gen3 g;

@@ -372,6 +372,11 @@ TEST(SmallCholesky, AgreesWithEigensLltToRoundingAndRefusesWhatItRefuses) {
   EXPECT_FALSE(factor.compute(not_a_number));
   EXPECT_TRUE(factor.compute(Eigen::Matrix3d::Identity()));
   EXPECT_TRUE(factor.ok());
+  // Another size is the caller's error, named, never a read past the factor.
+  EXPECT_THROW(factor.compute(Eigen::Matrix2d::Identity()), phri::ArgumentError);
+  EXPECT_THROW(factor.compute(Eigen::MatrixXd::Identity(3, 4)), phri::ArgumentError);
+  Eigen::VectorXd too_long = Eigen::VectorXd::Ones(4);
+  EXPECT_THROW(factor.solve_in_place(too_long), phri::ArgumentError);
 }
 
 // ------------------------------------------------------------------- Kinova's own FK figures

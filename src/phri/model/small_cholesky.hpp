@@ -2,11 +2,13 @@
 // phri::SmallCholesky: L L^T = A for the small dense SPD matrices of the cycle (the mass matrix,
 // 6 to ~30 joints). Eigen's LLT<MatrixXd> routes these sizes through its blocked triangular
 // kernels; plain loops whose length the compiler knows, with the pivots' inverses stored, cost less
-// (n = 7, x86-64-v3: solve 81 vs 149 ns, factor 120 vs 127 ns on this project's machine). The size
+// at 7 joints (phri_bench --benchmark_filter=Cholesky: SmallCholesky* against EigenLlt*). The size
 // is fixed at construction, so the kernels for 6 and 7 joints are chosen once then; other sizes run
 // the same code with the length read at run time. Same factor as Eigen's LLT (lower triangle of A
 // read), to rounding; a pivot that is not > 0 is refused, a NaN included (Eigen's x <= 0 test lets
 // it through). compute and the in-place solves do not allocate.
+#include <phri/core/error.hpp>
+
 #include <Eigen/Core>
 
 #include <cmath>
@@ -33,17 +35,20 @@ class SmallCholesky {
   // L, lower triangle; the strict upper part holds no meaning.
   const Eigen::MatrixXd& factor() const { return l_; }
 
-  // Factors the lower triangle of `a` (n x n, n == size()). Returns ok().
+  // Factors the lower triangle of `a` (n x n, n == size(); another size is an ArgumentError). Returns ok().
   bool compute(const Eigen::Ref<const Eigen::MatrixXd>& a) {
+    check_size("SmallCholesky::compute", "rows", a.rows(), l_.rows());
+    check_size("SmallCholesky::compute", "cols", a.cols(), l_.rows());
     ok_ = factor_(l_.rows(), a.data(), a.outerStride(), l_.data(), inverse_diagonal_.data());
     return ok_;
   }
 
-  // x <- A^-1 x for a vector, or column by column for a matrix (rows == size()).
+  // x <- A^-1 x for a vector, or column by column for a matrix (rows == size(), else ArgumentError).
   template <typename Derived>
   void solve_in_place(Eigen::MatrixBase<Derived>& x) const {
     static_assert(Derived::InnerStrideAtCompileTime == 1 && (!Derived::IsRowMajor || Derived::ColsAtCompileTime == 1),
                   "SmallCholesky solves contiguous columns");
+    check_size("SmallCholesky::solve_in_place", "rows", x.rows(), l_.rows());
     for (Index c = 0; c < x.cols(); ++c) solve_(l_.rows(), l_.data(), inverse_diagonal_.data(), &x.coeffRef(0, c));
   }
   template <typename Derived>
