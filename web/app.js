@@ -17,7 +17,15 @@ const PUSH_RENEW_MS = 150;    // a held push is re-sent (the server ends a push 
 // The page hands it the latest request on every change and tells it when the push starts and ends.
 const pushRenewer = new Worker(URL.createObjectURL(new Blob([`
   let timer = null, request = null;
-  const send = () => request && fetch(request.url, request.init).catch(() => {});
+  // Each renewal's send and reply times (the worker's clock) go back to the page: a gap in the push
+  // is then either a renewal that came late (a starved machine; the server's hold ran out, as it must)
+  // or a defect.
+  const send = () => {
+    if (!request) return;
+    const sent = performance.now();
+    fetch(request.url, request.init).then(() => postMessage([sent, performance.now()]),
+                                          () => postMessage([sent, null]));
+  };
   onmessage = ({ data }) => {
     if (data.request) request = data.request;
     if (data.start && timer === null) timer = setInterval(send, data.period);
@@ -26,7 +34,11 @@ const pushRenewer = new Worker(URL.createObjectURL(new Blob([`
 
 const $ = (id) => document.getElementById(id);
 // Hooks for the browser test and for curious users (window.phri in the console).
-const phri = (window.phri = { frames: 0, plotUpdates: 0, last: null, model: null, pushes: 0, replies: [] });
+const phri = (window.phri = { frames: 0, plotUpdates: 0, last: null, model: null, pushes: 0, replies: [], renewals: [] });
+pushRenewer.onmessage = ({ data }) => {  // [sent ms, replied ms or null], the last 2000
+  phri.renewals.push(data);
+  if (phri.renewals.length > 2000) phri.renewals.shift();
+};
 
 async function post(action, body = {}) {
   const res = await fetch('/api/' + action, {

@@ -9,7 +9,8 @@
 //   4. moving the stiffness slider applies the new gain (streamed and logged stiffness_scale);
 //   5. the power-and-force-limiting bars show one number per monitored link;
 //   6. a push held still for 5 s while the page is slowed 4x (CPU throttling: long tasks of hundreds
-//      of ms) stays on the arm without a gap in the log (live_push_n); long tasks and plot rate printed.
+//      of ms) stays on the arm without a gap in the log (live_push_n) beyond what late renewals explain
+//      (each renewal's send and reply times come back from the worker); long tasks and plot rate printed.
 // Screenshots go to --out (dashboard_*.png). Exit 77 (ctest: skipped) when chromium is absent.
 //
 //   node web/test/dashboard_browser.test.mjs --phri build/release/phri --config configs/dashboard.yaml --out DIR
@@ -166,6 +167,7 @@ try {
   //    (renewed from a worker, whatever the page's main thread is doing); long tasks and plot rate printed.
   await page.evaluate(() => {
     window.phri.longTasks = [];
+    window.phri.renewals = [];
     new PerformanceObserver((list) => window.phri.longTasks.push(...list.getEntries().map((e) => e.duration)))
       .observe({ type: 'longtask' });
   });
@@ -204,10 +206,23 @@ try {
   }
   gap = Math.max(gap, run);
   const tasks = await page.evaluate(() => window.phri.longTasks);
+  // The server receives renewal i between its send s_i and its reply r_i, so two renewals arrive at
+  // most r_{i+1} - s_i apart. The hold (0.5 s of robot time, which runs no faster than the wall
+  // clock) ends the push only if that exceeds 500 ms, and then for at most the excess: a gap beyond
+  // 50 ms plus the renewals' own lateness is the dashboard's fault, not the machine's.
+  const renewals = await page.evaluate(() => window.phri.renewals);
+  let late = 0, failed = 0;
+  for (let i = 0; i + 1 < renewals.length; ++i) {
+    if (renewals[i + 1][1] === null) { ++failed; continue; }
+    late = Math.max(late, renewals[i + 1][1] - renewals[i][0] - 500);
+  }
+  const allowed = 50 + Math.max(0, late);
   console.log(`held push on a 4x-throttled page: ${heldS.toFixed(1)} s held, ${tasks.length} long tasks ` +
-              `(${tasks.reduce((a, b) => a + b, 0).toFixed(0)} ms), plots redrawn at ${((plotsAfter - plotsBefore) / heldS).toFixed(1)} Hz`);
-  check(rows >= 3000 && gap <= 50,
-        `the held push is in the log over ${(rows / 1000).toFixed(2)} s of robot time, longest gap ${gap} ms (<= 50)`);
+              `(${tasks.reduce((a, b) => a + b, 0).toFixed(0)} ms), plots redrawn at ${((plotsAfter - plotsBefore) / heldS).toFixed(1)} Hz, ` +
+              `${renewals.length} renewals (${failed} failed), the latest ${Math.max(0, late).toFixed(0)} ms beyond the 500 ms hold`);
+  check(rows >= 3000 && renewals.length >= 10 && failed === 0 && gap <= allowed,
+        `the held push is in the log over ${(rows / 1000).toFixed(2)} s of robot time, longest gap ${gap} ms ` +
+        `(<= 50${late > 0 ? ` + ${late.toFixed(0)} ms the renewals came late: a starved machine` : ''})`);
 
   // 4. The stiffness slider: drag its thumb to about 60 % of the range.
   const slider = await page.$('#gain-stiffness_scale');
