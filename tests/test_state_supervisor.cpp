@@ -529,18 +529,30 @@ TEST(StateSupervisorEdges, SignalsMarkedInvalidOrNotFinite) {
   }
 }
 
-TEST(StateSupervisorEdges, WrongSizes) {
+// A joint vector of the wrong size is no kinematics; a torque or current vector of the wrong size
+// is refused as well, but the joints beside it still feed the brake (fresh, this sample's q).
+TEST(StateSupervisorEdges, WrongSizesSpoilOnlyTheirOwnPartOfTheSample) {
   phri::StateSupervisor supervisor(one_joint(), phri::SupervisorSettings{});
   ASSERT_TRUE(supervisor.check(sample(1)));
   phri::RobotState two(2);
   two.joints = two.torque = sample(2).joints;
   two.joints.valid = two.torque.valid = true;
   EXPECT_EQ(verdict(supervisor, two), SafetyFault::kSize);
+  EXPECT_FALSE(supervisor.kinematics_fresh());
+  EXPECT_DOUBLE_EQ(supervisor.kinematic_q()[0], sample(1).q_rad[0]);
   phri::RobotState current = sample(3);
   current.current.valid = true;
   current.current_A = Eigen::VectorXd::Zero(3);
   EXPECT_EQ(verdict(supervisor, current), SafetyFault::kSize);
-  EXPECT_EQ(verdict(supervisor, sample(4)), SafetyFault::kNone);
+  EXPECT_TRUE(supervisor.kinematics_fresh());
+  EXPECT_DOUBLE_EQ(supervisor.kinematic_q()[0], sample(3).q_rad[0]);
+  phri::RobotState torque = sample(4);
+  torque.tau_sensor_Nm = Eigen::VectorXd::Zero(0);
+  EXPECT_EQ(verdict(supervisor, torque), SafetyFault::kSize);
+  EXPECT_TRUE(supervisor.kinematics_fresh());
+  EXPECT_DOUBLE_EQ(supervisor.kinematic_q()[0], sample(4).q_rad[0]);
+  EXPECT_EQ(verdict(supervisor, sample(4)), SafetyFault::kStale) << "its sequence was taken";
+  EXPECT_EQ(verdict(supervisor, sample(5)), SafetyFault::kNone);
 }
 
 TEST(StateSupervisorEdges, TheRobotsOwnFaultAndStopRequest) {

@@ -197,10 +197,7 @@ SafetyFault StateSupervisor::check_drive_ranges(const RobotState& s, int& joint)
 SafetyFault StateSupervisor::classify(const RobotState& s, int& joint) {
   joint = -1;
   kinematics_passed_ = header_passed_ = false;
-  if (s.q_rad.size() != n_ || s.qd_rad_s.size() != n_ || s.tau_sensor_Nm.size() != n_ ||
-      (s.current.valid && s.current_A.size() != n_)) {
-    return SafetyFault::kSize;
-  }
+  if (s.q_rad.size() != n_ || s.qd_rad_s.size() != n_) return SafetyFault::kSize;
   if (s.fault) return SafetyFault::kRobotFault;
   if (!s.joints.valid) return SafetyFault::kInvalid;
   for (const Eigen::VectorXd* v : {&s.q_rad, &s.qd_rad_s}) {
@@ -216,6 +213,9 @@ SafetyFault StateSupervisor::classify(const RobotState& s, int& joint) {
   const SafetyFault kinematic = check_kinematics(s, joint);
   if (kinematic != SafetyFault::kNone) return kinematic;
   kinematics_passed_ = true;
+  // A torque or current vector of the wrong size spoils only its own part: the joints still feed
+  // the brake (a stop on stale joints coasts a prediction the servo then yanks the arm to).
+  if (s.tau_sensor_Nm.size() != n_ || (s.current.valid && s.current_A.size() != n_)) return SafetyFault::kSize;
   if (!s.torque.valid) return SafetyFault::kInvalid;
   if ((joint = first_not_finite(s.tau_sensor_Nm)) >= 0) return SafetyFault::kNotFinite;
   if (s.current.valid && (joint = first_not_finite(s.current_A)) >= 0) return SafetyFault::kNotFinite;
