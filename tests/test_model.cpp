@@ -3,6 +3,7 @@
 // forward-kinematics check from Kinova's numbers, URDF validation errors, zero heap allocation.
 #include <phri/core/error.hpp>
 #include <phri/model/algorithms.hpp>
+#include <phri/model/batch_sincos.hpp>
 #include <phri/model/model.hpp>
 #include <phri/model/small_cholesky.hpp>
 
@@ -15,8 +16,11 @@
 #include <Eigen/Cholesky>
 #include <Eigen/QR>
 
+#include <algorithm>
+#include <cmath>
 #include <fstream>
 #include <functional>
+#include <iterator>
 #include <random>
 #include <sstream>
 
@@ -322,6 +326,61 @@ TEST(ModelCrba, MassMatrixIsTheSumOverBodiesOfJacobianInertiaJacobianToRounding)
 // solutions to rounding for every size from 1 to 30 (conditioning up to 1e6), only the lower
 // triangle read, a matrix's columns solved as the vectors are, and Eigen's refusals (indefinite,
 // singular) plus a NaN, which Eigen's pivot test (x <= 0) lets through.
+// The kinematics' sines and cosines against libm's: within 1 ulp (plus 1e-16 absolute where the
+// value passes through zero) for joint angles, 2 ulp up to the reduction's bound, libm's own beyond
+// it and for non-finite angles; any batch length up to its width, and the same for an angle
+// whatever its place in the batch.
+TEST(BatchSinCos, WithinAnUlpOfLibmAndLibmsOwnBeyondTheReduction) {
+  namespace bs = phri::batch_sincos;
+  auto ulp = [](double v) { return std::nextafter(std::abs(v), INFINITY) - std::abs(v); };
+  std::mt19937_64 rng(11);
+  struct Range {
+    double half_width, ulps;
+  };
+  for (const Range range : {Range{1.0, 1.0}, Range{2.0 * M_PI, 1.0}, Range{100.0, 1.0}, Range{bs::kReducibleRad, 2.0}}) {
+    SCOPED_TRACE(range.half_width);
+    std::uniform_real_distribution<double> angle(-range.half_width, range.half_width);
+    double worst = 0.0;
+    for (int trial = 0; trial < 20000; ++trial) {
+      double x[bs::kWidth], s[bs::kWidth], c[bs::kWidth];
+      const int n = 1 + trial % bs::kWidth;
+      for (int i = 0; i < n; ++i) x[i] = angle(rng);
+      bs::compute(x, n, s, c);
+      for (int i = 0; i < n; ++i) {
+        const double es = std::abs(s[i] - std::sin(x[i])), ec = std::abs(c[i] - std::cos(x[i]));
+        ASSERT_LE(es, range.ulps * ulp(std::sin(x[i])) + 1e-16) << x[i];
+        ASSERT_LE(ec, range.ulps * ulp(std::cos(x[i])) + 1e-16) << x[i];
+        worst = std::max({worst, es / ulp(std::sin(x[i])), ec / ulp(std::cos(x[i]))});
+      }
+    }
+    EXPECT_LE(worst, range.ulps);
+  }
+  const double specials[] = {0.0, M_PI / 4, -M_PI / 4, M_PI / 2, -M_PI / 2, M_PI, 3 * M_PI / 2, 1e-300,
+                             bs::kReducibleRad, std::nextafter(bs::kReducibleRad, INFINITY), 1e10, -1e300,
+                             INFINITY, -INFINITY, NAN, 5.0};
+  for (int start = 0; start + bs::kWidth <= static_cast<int>(std::size(specials)); start += 4) {
+    double s[bs::kWidth], c[bs::kWidth];
+    bs::compute(specials + start, bs::kWidth, s, c);
+    for (int i = 0; i < bs::kWidth; ++i) {
+      const double x = specials[start + i];
+      SCOPED_TRACE(x);
+      if (!std::isfinite(x)) {
+        EXPECT_TRUE(std::isnan(s[i]) && std::isnan(c[i]));
+      } else if (std::abs(x) > bs::kReducibleRad) {
+        EXPECT_EQ(s[i], std::sin(x));
+        EXPECT_EQ(c[i], std::cos(x));
+      } else {
+        EXPECT_LE(std::abs(s[i] - std::sin(x)), ulp(std::sin(x)) + 1e-16);
+        EXPECT_LE(std::abs(c[i] - std::cos(x)), ulp(std::cos(x)) + 1e-16);
+      }
+      double alone_s, alone_c;
+      bs::compute(&x, 1, &alone_s, &alone_c);
+      EXPECT_TRUE(alone_s == s[i] || (std::isnan(alone_s) && std::isnan(s[i])));
+      EXPECT_TRUE(alone_c == c[i] || (std::isnan(alone_c) && std::isnan(c[i])));
+    }
+  }
+}
+
 TEST(SmallCholesky, AgreesWithEigensLltToRoundingAndRefusesWhatItRefuses) {
   std::mt19937 rng(44);
   std::uniform_real_distribution<double> unit(-1.0, 1.0);

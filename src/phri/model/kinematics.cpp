@@ -4,12 +4,16 @@
 #include <phri/model/algorithms.hpp>
 
 #include <phri/core/error.hpp>
+#include <phri/model/batch_sincos.hpp>
+
+#include <algorithm>
 
 namespace phri {
 namespace {
 
-// Placement of body i in the world and its motion subspace, for the joint position qi.
-void place_body(const Model& model, Data& data, int i, double qi) {
+// Placement of body i in the world and its motion subspace, for the joint position qi whose cosine
+// and sine are cos_qi and sin_qi.
+void place_body(const Model& model, Data& data, int i, double qi, double cos_qi, double sin_qi) {
   const Joint& joint = model.joint(i);
   const Eigen::Isometry3d& parent = i == 0 ? model.base_placement() : data.body_placements[static_cast<std::size_t>(i - 1)];
   Eigen::Isometry3d& body = data.body_placements[static_cast<std::size_t>(i)];
@@ -21,13 +25,24 @@ void place_body(const Model& model, Data& data, int i, double qi) {
   } else {
     if (joint.axis == Eigen::Vector3d::UnitZ()) {
       // R Rz(q): only the first two columns turn (most arms' URDFs put every joint on z).
-      const double c = std::cos(qi), s = std::sin(qi);
+      const double c = cos_qi, s = sin_qi;
       auto r = body.linear();
       const Eigen::Vector3d x = r.col(0), y = r.col(1);
       r.col(0) = c * x + s * y;
       r.col(1) = c * y - s * x;
     } else {
-      body.linear() = body.linear() * Eigen::AngleAxisd(qi, joint.axis).toRotationMatrix();
+      // Rodrigues: Rot(a, q) = c Id + s [a]x + (1 - c) a a^T.
+      const Eigen::Vector3d& a = joint.axis;
+      const double c = cos_qi, s = sin_qi;
+      Eigen::Matrix3d turn = (1.0 - c) * a * a.transpose();
+      turn.diagonal().array() += c;
+      turn(0, 1) -= s * a.z();
+      turn(1, 0) += s * a.z();
+      turn(0, 2) += s * a.y();
+      turn(2, 0) -= s * a.y();
+      turn(1, 2) -= s * a.x();
+      turn(2, 1) += s * a.x();
+      body.linear() = body.linear() * turn;
     }
     // A rotation about the axis through the body origin p moves the world-origin point at p x a.
     data.motion_subspace.col(i) << body.translation().cross(axis_world), axis_world;
@@ -38,23 +53,38 @@ const Eigen::Isometry3d& frame_parent_placement(const Model& model, const Data& 
   return body < 0 ? model.base_placement() : data.body_placements[static_cast<std::size_t>(body)];
 }
 
+// Every body placed from the base out, the joints' sines and cosines taken batch_sincos::kWidth at a
+// time; each(i) runs right after body i is placed.
+template <class Each>
+void place_bodies(const Model& model, Data& data, const Eigen::VectorXd& q, const Each& each) {
+  constexpr int kWidth = batch_sincos::kWidth;
+  double sin_q[kWidth], cos_q[kWidth];
+  for (int start = 0; start < model.nq(); start += kWidth) {
+    const int count = std::min(kWidth, model.nq() - start);
+    batch_sincos::compute(q.data() + start, count, sin_q, cos_q);
+    for (int k = 0; k < count; ++k) {
+      place_body(model, data, start + k, q[start + k], cos_q[k], sin_q[k]);
+      each(start + k);
+    }
+  }
+}
+
 }  // namespace
 
 void forward_kinematics(const Model& model, Data& data, const Eigen::VectorXd& q) {
   check_size("forward_kinematics", "q", q.size(), model.nq());
-  for (int i = 0; i < model.nq(); ++i) place_body(model, data, i, q[i]);
+  place_bodies(model, data, q, [](int) {});
 }
 
 void forward_kinematics(const Model& model, Data& data, const Eigen::VectorXd& q,
                         const Eigen::VectorXd& qd) {
   check_size("forward_kinematics", "q", q.size(), model.nq());
   check_size("forward_kinematics", "qd", qd.size(), model.nv());
-  for (int i = 0; i < model.nq(); ++i) {
-    place_body(model, data, i, q[i]);
+  place_bodies(model, data, q, [&](int i) {
     auto v = data.body_velocities.col(i);
     v = data.motion_subspace.col(i) * qd[i];
     if (i > 0) v += data.body_velocities.col(i - 1);
-  }
+  });
 }
 
 void forward_kinematics(const Model& model, Data& data, const Eigen::VectorXd& q,
