@@ -3,7 +3,7 @@
 // forward-kinematics check from Kinova's numbers, URDF validation errors, zero heap allocation.
 #include <phri/core/error.hpp>
 #include <phri/model/algorithms.hpp>
-#include <phri/model/batch_sincos.hpp>
+#include <phri/core/batch_math.hpp>
 #include <phri/model/model.hpp>
 #include <phri/model/small_cholesky.hpp>
 
@@ -330,8 +330,8 @@ TEST(ModelCrba, MassMatrixIsTheSumOverBodiesOfJacobianInertiaJacobianToRounding)
 // value passes through zero) for joint angles, 2 ulp up to the reduction's bound, libm's own beyond
 // it and for non-finite angles; any batch length up to its width, and the same for an angle
 // whatever its place in the batch.
-TEST(BatchSinCos, WithinAnUlpOfLibmAndLibmsOwnBeyondTheReduction) {
-  namespace bs = phri::batch_sincos;
+TEST(BatchMath, SinCosWithinAnUlpOfLibmAndLibmsOwnBeyondTheReduction) {
+  namespace bs = phri::batch_math;
   auto ulp = [](double v) { return std::nextafter(std::abs(v), INFINITY) - std::abs(v); };
   std::mt19937_64 rng(11);
   struct Range {
@@ -345,7 +345,7 @@ TEST(BatchSinCos, WithinAnUlpOfLibmAndLibmsOwnBeyondTheReduction) {
       double x[bs::kWidth], s[bs::kWidth], c[bs::kWidth];
       const int n = 1 + trial % bs::kWidth;
       for (int i = 0; i < n; ++i) x[i] = angle(rng);
-      bs::compute(x, n, s, c);
+      bs::sincos(x, n, s, c);
       for (int i = 0; i < n; ++i) {
         const double es = std::abs(s[i] - std::sin(x[i])), ec = std::abs(c[i] - std::cos(x[i]));
         ASSERT_LE(es, range.ulps * ulp(std::sin(x[i])) + 1e-16) << x[i];
@@ -360,7 +360,7 @@ TEST(BatchSinCos, WithinAnUlpOfLibmAndLibmsOwnBeyondTheReduction) {
                              INFINITY, -INFINITY, NAN, 5.0};
   for (int start = 0; start + bs::kWidth <= static_cast<int>(std::size(specials)); start += 4) {
     double s[bs::kWidth], c[bs::kWidth];
-    bs::compute(specials + start, bs::kWidth, s, c);
+    bs::sincos(specials + start, bs::kWidth, s, c);
     for (int i = 0; i < bs::kWidth; ++i) {
       const double x = specials[start + i];
       SCOPED_TRACE(x);
@@ -374,7 +374,7 @@ TEST(BatchSinCos, WithinAnUlpOfLibmAndLibmsOwnBeyondTheReduction) {
         EXPECT_LE(std::abs(c[i] - std::cos(x)), ulp(std::cos(x)) + 1e-16);
       }
       double alone_s, alone_c;
-      bs::compute(&x, 1, &alone_s, &alone_c);
+      bs::sincos(&x, 1, &alone_s, &alone_c);
       EXPECT_TRUE(alone_s == s[i] || (std::isnan(alone_s) && std::isnan(s[i])));
       EXPECT_TRUE(alone_c == c[i] || (std::isnan(alone_c) && std::isnan(c[i])));
     }

@@ -5,7 +5,10 @@
 // the two distributions we need are written out here: xoshiro256** seeded through splitmix64, a
 // uniform double on [0, 1) from the top 53 bits, and normals by the Box-Muller transform.
 // Same seed and stream => bit-identical sequence on every platform with IEEE doubles and a
-// correctly rounded libm (log, sqrt, sin, cos). No allocation, no global state.
+// correctly rounded libm (log, sqrt; sine and cosine are batch_math's). No allocation, no global state.
+#include <phri/core/batch_math.hpp>
+
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <numbers>
@@ -43,22 +46,43 @@ public:
   double uniform(double lo, double hi) { return lo + (hi - lo) * uniform(); }
   /// Standard normal N(0, 1) (Box-Muller; the second value of each pair is kept for the next call).
   double normal() {
-    if (has_spare_) {
-      has_spare_ = false;
-      return spare_;
-    }
-    // u1 in (0, 1] so that log(u1) is finite.
-    const double u1 = 1.0 - uniform();
-    const double u2 = uniform();
-    const double radius = std::sqrt(-2.0 * std::log(u1));
-    const double angle = 2.0 * std::numbers::pi * u2;
-    spare_ = radius * std::sin(angle);
-    has_spare_ = true;
-    return radius * std::cos(angle);
+    double x;
+    fill_normal(&x, 1);
+    return x;
   }
   /// N(0, std^2); returns exactly 0 without drawing when std == 0, so a disabled noise source
   /// consumes nothing from the sequence.
   double normal(double std) { return std == 0.0 ? 0.0 : std * normal(); }
+  /// `count` standard normals, the same sequence as `count` calls of normal(), their angles' sines
+  /// and cosines taken up to batch_math::kWidth at a time (a simulator step draws one or two per joint).
+  void fill_normal(double* out, int count) {
+    int k = 0;
+    if (has_spare_ && count > 0) {
+      out[k++] = spare_;
+      has_spare_ = false;
+    }
+    constexpr int kWidth = batch_math::kWidth;
+    double radius[kWidth], angle[kWidth], sine[kWidth], cosine[kWidth];
+    while (k < count) {
+      const int pairs = std::min(kWidth, (count - k + 1) / 2);
+      for (int j = 0; j < pairs; ++j) {
+        const double u1 = 1.0 - uniform();  // in (0, 1], so that log(u1) is finite
+        const double u2 = uniform();
+        radius[j] = std::sqrt(-2.0 * std::log(u1));
+        angle[j] = 2.0 * std::numbers::pi * u2;
+      }
+      batch_math::sincos(angle, pairs, sine, cosine);
+      for (int j = 0; j < pairs; ++j) {
+        out[k++] = radius[j] * cosine[j];
+        if (k < count) {
+          out[k++] = radius[j] * sine[j];
+        } else {
+          spare_ = radius[j] * sine[j];
+          has_spare_ = true;
+        }
+      }
+    }
+  }
 
 private:
   static std::uint64_t rotl(std::uint64_t x, int k) { return (x << k) | (x >> (64 - k)); }

@@ -4,7 +4,7 @@
 #include <phri/model/algorithms.hpp>
 
 #include <phri/core/error.hpp>
-#include <phri/model/batch_sincos.hpp>
+#include <phri/core/batch_math.hpp>
 
 #include <algorithm>
 
@@ -53,15 +53,15 @@ const Eigen::Isometry3d& frame_parent_placement(const Model& model, const Data& 
   return body < 0 ? model.base_placement() : data.body_placements[static_cast<std::size_t>(body)];
 }
 
-// Every body placed from the base out, the joints' sines and cosines taken batch_sincos::kWidth at a
+// Every body placed from the base out, the joints' sines and cosines taken batch_math::kWidth at a
 // time; each(i) runs right after body i is placed.
 template <class Each>
 void place_bodies(const Model& model, Data& data, const Eigen::VectorXd& q, const Each& each) {
-  constexpr int kWidth = batch_sincos::kWidth;
+  constexpr int kWidth = batch_math::kWidth;
   double sin_q[kWidth], cos_q[kWidth];
   for (int start = 0; start < model.nq(); start += kWidth) {
     const int count = std::min(kWidth, model.nq() - start);
-    batch_sincos::compute(q.data() + start, count, sin_q, cos_q);
+    batch_math::sincos(q.data() + start, count, sin_q, cos_q);
     for (int k = 0; k < count; ++k) {
       place_body(model, data, start + k, q[start + k], cos_q[k], sin_q[k]);
       each(start + k);

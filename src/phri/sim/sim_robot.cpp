@@ -418,6 +418,7 @@ void SimRobot::allocate_buffers() {
                              &truth_.tau_transmitted_Nm, &truth_.q_motor_rad, &q_before_}) {
     *v = Eigen::VectorXd::Zero(n_);
   }
+  noise_draws_.assign(static_cast<std::size_t>(std::max(3 * n_, 6)), 0.0);
 }
 
 void SimRobot::reset() {
@@ -577,9 +578,13 @@ void SimRobot::sample_ft_sensor(const double* force, const double* torque) {
     wrench_true_[3 + k] = kWrenchSign * torque[k];
   }
   const auto& ft = config_.ft_sensor;
+  // The draws in the order of one normal(std) per axis, force then torque (none for a zero std).
+  const bool noisy_force = ft.force_std_N != 0.0, noisy_torque = ft.torque_std_Nm != 0.0;
+  double* draw = noise_draws_.data();
+  ft_noise_.fill_normal(draw, 3 * (int{noisy_force} + int{noisy_torque}));
   for (int k = 0; k < 3; ++k) {
-    wrench_meas_[k] = wrench_true_[k] + ft.force_bias_N[k] + ft_noise_.normal(ft.force_std_N);
-    wrench_meas_[3 + k] = wrench_true_[3 + k] + ft.torque_bias_Nm[k] + ft_noise_.normal(ft.torque_std_Nm);
+    wrench_meas_[k] = wrench_true_[k] + ft.force_bias_N[k] + (noisy_force ? ft.force_std_N * *draw++ : 0.0);
+    wrench_meas_[3 + k] = wrench_true_[3 + k] + ft.torque_bias_Nm[k] + (noisy_torque ? ft.torque_std_Nm * *draw++ : 0.0);
   }
 }
 
@@ -759,9 +764,13 @@ void SimRobot::substep(bool last_of_period) {
   const double st = config_.noise.torque_sensor_std_Nm;
   // A servo that compensates the deflection reads the torque sensor with its encoder.
   const bool read_torque = drive_reads_torque_ || (compensate_deflection_ && drive_reads_position_);
+  // The draws in the order of one normal(std) per reading, joint by joint (none for a zero std).
+  const bool noisy_velocity = drive_reads_velocity_ && sv != 0.0, noisy_torque = read_torque && st != 0.0;
+  const double* draw = noise_draws_.data();
+  joint_noise_.fill_normal(noise_draws_.data(), n_ * (int{noisy_velocity} + int{noisy_torque}));
   for (int i = 0; i < n_; ++i) {
-    qd_meas_[i] = servo_velocity(i) + (drive_reads_velocity_ ? joint_noise_.normal(sv) : 0.0);
-    tau_meas_[i] = tau_s_[i] + offsets_[i] + (read_torque ? joint_noise_.normal(st) : 0.0);
+    qd_meas_[i] = servo_velocity(i) + (noisy_velocity ? sv * *draw++ : 0.0);
+    tau_meas_[i] = tau_s_[i] + offsets_[i] + (noisy_torque ? st * *draw++ : 0.0);
     if (compensate_deflection_) deflection_torque_[i] += deflection_alpha_ * (tau_meas_[i] - deflection_torque_[i]);
     if (read_encoder) q_meas_[i] = quantize(servo_position(i));
   }
@@ -908,14 +917,19 @@ void SimRobot::sample_state() {
   bool joints_ok = true;
   bool torque_ok = true;
   bool current_ok = true;
+  // The draws in the order of one normal(std) per reading, joint by joint (none for a zero std).
+  const bool noisy_velocity = z.velocity_std_rad_s != 0.0, noisy_torque = z.torque_sensor_std_Nm != 0.0,
+             noisy_current = z.current_std_A != 0.0;
+  const double* draw = noise_draws_.data();
+  joint_noise_.fill_normal(noise_draws_.data(), n_ * (int{noisy_velocity} + int{noisy_torque} + int{noisy_current}));
   for (int i = 0; i < n_; ++i) {
     const auto k = static_cast<std::size_t>(i);
     const double q = d_->qpos[qadr_[k]];
     const double qd = d_->qvel[dadr_[k]];
     state_.q_rad[i] = quantize(q);
-    state_.qd_rad_s[i] = qd + joint_noise_.normal(z.velocity_std_rad_s);
-    state_.tau_sensor_Nm[i] = tau_s_[i] + offsets_[i] + joint_noise_.normal(z.torque_sensor_std_Nm);
-    state_.current_A[i] = current_[i] + joint_noise_.normal(z.current_std_A);
+    state_.qd_rad_s[i] = qd + (noisy_velocity ? z.velocity_std_rad_s * *draw++ : 0.0);
+    state_.tau_sensor_Nm[i] = tau_s_[i] + offsets_[i] + (noisy_torque ? z.torque_sensor_std_Nm * *draw++ : 0.0);
+    state_.current_A[i] = current_[i] + (noisy_current ? z.current_std_A * *draw++ : 0.0);
     joints_ok = joints_ok && std::isfinite(state_.q_rad[i]) && std::isfinite(state_.qd_rad_s[i]);
     torque_ok = torque_ok && std::isfinite(state_.tau_sensor_Nm[i]);
     current_ok = current_ok && std::isfinite(state_.current_A[i]);

@@ -255,6 +255,7 @@ private:
   double wrench_stamp_ = 0.0;
 
   RandomGenerator joint_noise_, ft_noise_;
+  std::vector<double> noise_draws_;  // up to 3 standard normals per joint, drawn at once (fill_normal)
   RandomPushGenerator pushes_;
   std::vector<RandomPushGenerator::LinkSurface> push_links_;
 

@@ -1,25 +1,27 @@
 #pragma once
-// sin and cos of a batch of joint angles at once, for the forward kinematics: libm's sincos is one
-// call of ~20 ns per joint, most of a 7-joint CRBA; this loop has no calls and no branches, so the
-// compiler runs it four angles to an AVX2 register.
+// Sine and cosine of a batch of arguments at once, for the hot loops: the forward kinematics' joint
+// angles and the simulator's Gaussian noise (Box-Muller's angles). libm's sincos is one call of
+// ~15-20 ns per angle; this loop has no calls and no branches, so the compiler runs it four angles to
+// an AVX2 register. Within an ulp or two of libm (test: BatchMath.*); angles outside the reduced
+// range go to libm. (A batch log was tried for Box-Muller's radius: slower than libm's, whose log is
+// a few ns.)
 //
-// x = k pi/2 + r with |r| <= pi/4 (Cody-Waite: pi/2 in three parts, the first two of 33 bits, so
-// k P1 and k P2 are exact for |k| < 2^20), then Taylor polynomials of r to degree 15 (sin) and 16
-// (cos): the first omitted terms, r^17/17! and r^18/18!, are below 5e-17 at pi/4. Within an ulp or
-// two of libm (test: BatchSinCos.*). Angles beyond kReducibleRad, and non-finite ones, go to
-// std::sin / std::cos.
+// x = k pi/2 + r with |r| <= pi/4 (Cody-Waite: pi/2 in three parts, the first two of 33
+// bits, so k P1 and k P2 are exact for |k| < 2^20), then Taylor polynomials of r to degree 15 (sin)
+// and 16 (cos): the first omitted terms, r^17/17! and r^18/18!, are below 5e-17 at pi/4.
 #include <cmath>
 #include <cstdint>
 #include <cstring>
 
-namespace phri::batch_sincos {
+namespace phri::batch_math {
 
-constexpr double kReducibleRad = 1.0e5;  // |k| < 2^17: the reduction above is exact
+constexpr double kReducibleRad = 1.0e5;  ///< sincos: |k| < 2^17, the reduction is exact
 
-// The angles' sine and cosine, n of them (n <= kWidth), in s and c.
+/// The most arguments one call takes.
 constexpr int kWidth = 8;
 
-inline void compute(const double* x, int n, double* s, double* c) {
+/// s[i] = sin(x[i]) and c[i] = cos(x[i]) for i < n <= kWidth.
+inline void sincos(const double* x, int n, double* s, double* c) {
   constexpr double kTwoOverPi = 0x1.45f306dc9c883p-1;
   constexpr double kP1 = 0x1.921fb544p+0;       // pi/2, its first 33 bits
   constexpr double kP2 = 0x1.0b4611a6p-34;      // the next 33
@@ -64,4 +66,4 @@ inline void compute(const double* x, int n, double* s, double* c) {
   }
 }
 
-}  // namespace phri::batch_sincos
+}  // namespace phri::batch_math
