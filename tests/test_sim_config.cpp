@@ -369,7 +369,6 @@ TEST(RandomGenerator, ReproducibleStreamsAndMoments) {
 TEST(RandomGenerator, BatchedNormalsAreTheSequenceOfSingleOnes) {
   phri::RandomGenerator batched(9, 3), single(9, 3), uniforms(9, 3);
   std::vector<double> out(40);
-  std::vector<double> reference;
   for (int count : {0, 1, 2, 3, 16, 17, 40, 5, 1, 31}) {
     batched.fill_normal(out.data(), count);
     for (int k = 0; k < count; ++k) ASSERT_EQ(out[static_cast<std::size_t>(k)], single.normal()) << count << " " << k;

@@ -580,8 +580,8 @@ void SimRobot::sample_ft_sensor(const double* force, const double* torque) {
   const auto& ft = config_.ft_sensor;
   // The draws in the order of one normal(std) per axis, force then torque (none for a zero std).
   const bool noisy_force = ft.force_std_N != 0.0, noisy_torque = ft.torque_std_Nm != 0.0;
-  double* draw = noise_draws_.data();
-  ft_noise_.fill_normal(draw, 3 * (int{noisy_force} + int{noisy_torque}));
+  const double* draw = noise_draws_.data();
+  ft_noise_.fill_normal(noise_draws_.data(), 3 * (int{noisy_force} + int{noisy_torque}));
   for (int k = 0; k < 3; ++k) {
     wrench_meas_[k] = wrench_true_[k] + ft.force_bias_N[k] + (noisy_force ? ft.force_std_N * *draw++ : 0.0);
     wrench_meas_[3 + k] = wrench_true_[3 + k] + ft.torque_bias_Nm[k] + (noisy_torque ? ft.torque_std_Nm * *draw++ : 0.0);
