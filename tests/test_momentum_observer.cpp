@@ -161,4 +161,30 @@ TEST(MomentumObserver, ReleasePathDropsAPushThatEndsOnlyWhenItsKickDrivesAFastJo
   }
 }
 
+// After missed periods (dt = 10 ms here) the release path's step would be gain x dt = 5 times the
+// error, an overshoot of 5x the push: it takes at most a deadbeat step (r_fast = tau_ext at once),
+// and its state stays consistent with its gain, so the next 1 ms steps hold tau_ext. The K_O
+// observer (gain x dt = 0.5) keeps its own recursion, r = 0.5 tau_ext. Constant momentum:
+// tau_s = g - C^T qd - tau_ext.
+TEST(MomentumObserver, TheFastEstimateTakesAtMostADeadbeatStepAfterAGap) {
+  const phri::Model model = phri::Model::from_urdf_file(kGen3 + "gen3.urdf");
+  phri::Data data(model);
+  const Eigen::VectorXd q = Eigen::VectorXd::Constant(7, 0.3);
+  Eigen::VectorXd qd = Eigen::VectorXd::Zero(7);
+  qd[2] = 0.4;
+  phri::compute_all_terms(model, data, q, qd);
+  phri::coriolis_transpose_times_velocity(model, data);
+  phri::MomentumObserver observer(model, 50.0);
+  observer.set_release_path(500.0, 5.0, Eigen::VectorXd::Constant(7, 1.0));
+  observer.reset(data, qd);
+  const Eigen::VectorXd external = Eigen::VectorXd::LinSpaced(7, -4.0, 3.0);
+  const Eigen::VectorXd pushed = data.gravity_torque - data.coriolis_transpose_qd - external;
+  observer.update(data, qd, pushed, 0.010);
+  EXPECT_LT((observer.fast_external_torque() - external).cwiseAbs().maxCoeff(), 1e-9);
+  EXPECT_LT((observer.external_torque() - 0.5 * external).cwiseAbs().maxCoeff(), 1e-9);
+  for (int k = 0; k < 3; ++k) observer.update(data, qd, pushed, 0.001);
+  EXPECT_LT((observer.fast_external_torque() - external).cwiseAbs().maxCoeff(), 1e-9);
+  EXPECT_LT((observer.external_torque() - (1.0 - 0.5 * std::pow(0.95, 3)) * external).cwiseAbs().maxCoeff(), 1e-9);
+}
+
 }  // namespace

@@ -280,6 +280,29 @@ TEST(StateSupervisorEdges, VelocityAgainstTheRateOfThePosition) {
   }
 }
 
+// Over a gap (a control-thread stall of 19 periods) a joint may stop, or turn back, and sit on the
+// very count it left from: q identical, the mean of its two end speeds (0.09 and 0 rad/s) over 20 ms
+// covering more than two quanta. That is no stuck reading; only a joint moving the same way at
+// both ends has surely moved, by at least its slower end's speed.
+TEST(StateSupervisorEdges, AJointBackOnTheSameCountAfterAGapIsNotStuck) {
+  struct Case {
+    double qd_before, qd_after;
+    bool stuck;
+  };
+  for (const Case c : {Case{0.09, 0.0, false}, Case{0.09, -0.05, false}, Case{0.09, 0.02, true}, Case{-0.09, -0.02, true},
+                       Case{0.09, 0.009, false}}) {
+    SCOPED_TRACE(::testing::Message() << c.qd_before << " -> " << c.qd_after);
+    phri::StateSupervisor supervisor(one_joint(), phri::SupervisorSettings{});
+    phri::RobotState first = at_rest(1);
+    first.qd_rad_s[0] = c.qd_before;
+    ASSERT_TRUE(supervisor.check(first));
+    phri::RobotState after_gap = at_rest(21);  // 20 periods later, the same q
+    after_gap.qd_rad_s[0] = c.qd_after;
+    // Two quanta (2e-4 rad) over the 20 ms: 0.01 rad/s at the slower end.
+    EXPECT_EQ(verdict(supervisor, after_gap), c.stuck ? SafetyFault::kFrozenValues : SafetyFault::kNone);
+  }
+}
+
 TEST(StateSupervisorEdges, APositionStuckWhileTheVelocitySaysItMoved) {
   // q bit-identical to the last sample's while the mean q̇ over the period covers more than two
   // encoder quanta (2e-4 rad in 1 ms: 0.2 rad/s).

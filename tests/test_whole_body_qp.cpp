@@ -4,6 +4,7 @@
 // exactly), the dampers' bounds, torque limits, the fallback, and zero allocation per cycle.
 #include <phri/control/compliance_controller.hpp>
 #include <phri/control/momentum_observer.hpp>
+#include <phri/control/uncancelled_push.hpp>
 #include <phri/control/whole_body_qp.hpp>
 #include <phri/core/error.hpp>
 #include <phri/model/algorithms.hpp>
@@ -15,6 +16,8 @@
 #include <gtest/gtest.h>
 #include <unsupported/Eigen/MatrixFunctions>
 
+#include <algorithm>
+#include <limits>
 #include <random>
 
 namespace {
@@ -144,6 +147,110 @@ TEST_F(WholeBodyQpTest, JointDamperAndTorqueLimitsBound) {
   qp.update(model_, data_, q_, qd_, Eigen::VectorXd::Zero(7), 1e-3);
   EXPECT_TRUE((qp.desired_torque().cwiseAbs().array() <= qp.torque_limit().array() + 1e-6).all())
       << qp.desired_torque().transpose();
+}
+
+// A push the command does not cancel yet, a_u (UncancelledPush): every bound on qdd moves inward by
+// it, ub - max(a_u, 0) and lb - min(a_u, 0), so that qdd_d + a_u stays within the paper's bounds;
+// the rows and the other direction are untouched. With the posture pressing joint 2 into its
+// damper (the case above), the command gives up exactly the push's share.
+TEST_F(WholeBodyQpTest, AnUncancelledPushMovesTheBoundsInwardByItsAcceleration) {
+  phri::WholeBodyQp plain(model_, nullptr, gen3_settings()), pushed(model_, nullptr, gen3_settings());
+  Eigen::VectorXd q = q_, qd = Eigen::VectorXd::Zero(7);
+  q[1] = 2.24 - 0.05;
+  qd[1] = 0.8;
+  phri::compute_all_terms(model_, data_, q, qd);
+  Eigen::VectorXd posture = q;
+  posture[1] = 3.0;
+  for (phri::WholeBodyQp* qp : {&plain, &pushed}) {
+    set_tasks(*qp, 0.0, 0.0);
+    qp->posture().reset_gains(200.0, 10.0, 1.0, 0.0);
+    qp->posture().set_target(posture);
+  }
+  const Eigen::VectorXd tau_ext = Eigen::VectorXd::Zero(7);
+  Eigen::VectorXd uncancelled(7);
+  uncancelled << 0.0, 3.0, -0.4, 0.0, 0.7, -0.2, 0.0;
+  ASSERT_EQ(plain.update(model_, data_, q, qd, tau_ext, 1e-3), phri::WholeBodyQpStatus::kOk);
+  ASSERT_EQ(pushed.update(model_, data_, q, qd, tau_ext, 1e-3, nullptr, &uncancelled), phri::WholeBodyQpStatus::kOk);
+  ASSERT_EQ(pushed.solve_count(), 1u) << "feasible with the shift: nothing relaxed";
+  const phri::QpProblem &a = plain.qp_problem(), &b = pushed.qp_problem();
+  for (int i = 0; i < 7; ++i) {
+    EXPECT_EQ(b.ub[i], a.ub[i] - std::max(uncancelled[i], 0.0)) << i;
+    EXPECT_EQ(b.lb[i], a.lb[i] - std::min(uncancelled[i], 0.0)) << i;
+  }
+  EXPECT_EQ(a.A, b.A);
+  EXPECT_EQ(a.l, b.l);
+  EXPECT_EQ(a.u, b.u);
+  // Active on joint 2: the command plus the push lands on the damper's bound.
+  EXPECT_NEAR(plain.desired_acceleration()[1], a.ub[1], 1e-6);
+  EXPECT_NEAR(pushed.desired_acceleration()[1] + uncancelled[1], a.ub[1], 1e-6);
+  // A push the torque limits cannot answer within the bounds: the shift is dropped (last), not the QP.
+  Eigen::VectorXd beyond = Eigen::VectorXd::Zero(7);
+  beyond[1] = 1e4;
+  ASSERT_EQ(pushed.update(model_, data_, q, qd, tau_ext, 1e-3, nullptr, &beyond), phri::WholeBodyQpStatus::kOk);
+  EXPECT_EQ(pushed.solve_count(), 3u);
+  EXPECT_EQ(pushed.qp_problem().ub, a.ub);
+  EXPECT_NEAR(pushed.desired_acceleration()[1], plain.desired_acceleration()[1], 1e-9);
+  // Not finite: ignored (the bounds of tau_ext alone); the wrong size: invalid input.
+  Eigen::VectorXd bad = uncancelled;
+  bad[3] = std::numeric_limits<double>::quiet_NaN();
+  ASSERT_EQ(pushed.update(model_, data_, q, qd, tau_ext, 1e-3, nullptr, &bad), phri::WholeBodyQpStatus::kOk);
+  EXPECT_EQ(pushed.qp_problem().ub, a.ub);
+  EXPECT_EQ(pushed.qp_problem().lb, a.lb);
+  const Eigen::VectorXd short_vector = Eigen::VectorXd::Zero(6);
+  EXPECT_EQ(pushed.update(model_, data_, q, qd, tau_ext, 1e-3, nullptr, &short_vector), phri::WholeBodyQpStatus::kInvalidInput);
+}
+
+// UncancelledPush against closed forms: a_u = (M + B)^-1 (tau_fast - tau_ext) from the torque side
+// (reference: Eigen's LDLT of M + diag(B)) and (qd - qd_prev) / dt - qdd_commanded from the motion;
+// per joint the smaller where they agree in sign, else 0. A torque-sensor spike the motion does not
+// show is no push; without a previous QP command there is no motion evidence.
+TEST(UncancelledPush, IsTheSmallerOfTheTorqueAndMotionEstimatesWhereTheyAgree) {
+  const phri::Model model = phri::Model::from_urdf_file(kGen3 + "gen3.urdf");
+  phri::Data data(model);
+  Eigen::VectorXd q(7), qd0(7);
+  q << 0.2, 0.58, 3.0, -1.84, 0.3, 0.85, 1.57;
+  qd0 << 0.1, -0.2, 0.3, 0.1, -0.2, 0.1, 0.3;
+  phri::compute_all_terms(model, data, q, qd0);
+  const Eigen::VectorXd rotor = Eigen::VectorXd::LinSpaced(7, 0.4, 0.1);
+  Eigen::MatrixXd inertia = data.mass_matrix;
+  inertia.diagonal() += rotor;
+  const Eigen::VectorXd tau_ext = Eigen::VectorXd::LinSpaced(7, -3.0, 2.0);
+  Eigen::VectorXd push(7);
+  push << 4.0, -6.0, 1.5, 3.0, -2.0, 0.5, 1.0;
+  const Eigen::VectorXd tau_fast = tau_ext + push;
+  const Eigen::VectorXd truth = inertia.ldlt().solve(push);
+  Eigen::VectorXd commanded(7);
+  commanded << 1.0, -2.0, 0.5, 3.0, -1.0, 0.0, 2.0;
+  const double dt = 1e-3;
+
+  phri::UncancelledPush estimate(rotor);
+  // No previous sample: nothing.
+  EXPECT_EQ(estimate.update(data, tau_ext, tau_fast, qd0, &commanded, dt), Eigen::VectorXd::Zero(7));
+  struct Case {
+    const char* what;
+    double motion_share;  // the motion shows this share of the torque side's acceleration
+  };
+  for (const Case c : {Case{"the motion shows the whole push", 1.0}, Case{"the motion shows half of it", 0.5},
+                       Case{"the motion shows more", 1.5}, Case{"the motion goes the other way", -1.0},
+                       Case{"no motion beyond the command (a sensor spike)", 0.0}}) {
+    SCOPED_TRACE(c.what);
+    phri::UncancelledPush e(rotor);
+    e.update(data, tau_ext, tau_fast, qd0, &commanded, dt);
+    const Eigen::VectorXd qd1 = qd0 + dt * (commanded + c.motion_share * truth);
+    phri::test::AllocationCounter count;
+    const Eigen::VectorXd& a = e.update(data, tau_ext, tau_fast, qd1, &commanded, dt);
+    EXPECT_EQ(count.allocations(), 0u);
+    EXPECT_LT((e.from_torque() - truth).cwiseAbs().maxCoeff(), 1e-9 * truth.cwiseAbs().maxCoeff());
+    const double share = c.motion_share <= 0.0 ? 0.0 : std::min(c.motion_share, 1.0);
+    EXPECT_LT((a - share * truth).cwiseAbs().maxCoeff(), 1e-6 * truth.cwiseAbs().maxCoeff()) << a.transpose();
+  }
+  // The previous cycle sent no QP command, or the estimate was forgotten: no motion evidence.
+  phri::UncancelledPush e(rotor);
+  e.update(data, tau_ext, tau_fast, qd0, &commanded, dt);
+  EXPECT_EQ(e.update(data, tau_ext, tau_fast, qd0 + dt * truth, nullptr, dt), Eigen::VectorXd::Zero(7));
+  e.forget();
+  EXPECT_EQ(e.update(data, tau_ext, tau_fast, qd0 + 2 * dt * truth, &commanded, dt), Eigen::VectorXd::Zero(7));
+  EXPECT_GT(e.update(data, tau_ext, tau_fast, qd0 + 2 * dt * truth + dt * (commanded + truth), &commanded, dt).norm(), 0.0);
 }
 
 TEST_F(WholeBodyQpTest, InvalidInputHoldsTheLastCommandAndInfeasibleBrakes) {

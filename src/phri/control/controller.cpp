@@ -221,6 +221,8 @@ Controller::Controller(LoadedRobot robot, const ControllerSettings& settings)
       ee_jacobian_(Eigen::MatrixXd::Zero(6, model_.nv())),
       ft_torque_(Eigen::VectorXd::Zero(model_.nv())),
       tau_ext_(Eigen::VectorXd::Zero(model_.nv())),
+      tau_ext_fast_(Eigen::VectorXd::Zero(model_.nv())),
+      uncancelled_(Eigen::VectorXd::Zero(model_.nv())),
       trigger_filter_(settings.wrench_trigger_filter_s, settings.period_s),
       estimate_torque_(Eigen::VectorXd::Zero(model_.nv())),
       ft_fusion_(model_.nv(), settings.observer_gain, settings.period_s),
@@ -253,6 +255,7 @@ Controller::Controller(LoadedRobot robot, const ControllerSettings& settings)
     reflected_inertia_[i] = actuators_[i].reflected_inertia_kgm2;
     static_friction_[i] = std::max(actuators_[i].friction.static_Nm, actuators_[i].friction.coulomb_Nm);
   }
+  uncancelled_ = UncancelledPush(reflected_inertia_);
   add_declared_tasks(settings.tasks);
   add_declared_constraints(settings.constraints);
 }
@@ -668,13 +671,13 @@ void Controller::brake_reference() {
 // into the stop (the observer then reads the stop's answer as a push, and so on). It is dropped
 // there. Not in the whole damper band d_i, where it could hide a hand pushing the joint out at speed
 // (replayed: SafetyFuzz.FormerFailuresReplayedPass, seed 8642).
-void Controller::bound_external_torque() {
+void Controller::bound_external_torque(Eigen::VectorXd& tau) const {
   for (int i = 0; i < model_.nv(); ++i) {
     const double bound = settings_.safety.external_torque_bound_factor * torque_limit_[i];
-    double t = std::clamp(tau_ext_[i], -bound, bound);
+    double t = std::clamp(tau[i], -bound, bound);
     if (q_[i] > qp_.safe_upper()[i]) t = std::max(t, 0.0);
     if (q_[i] < qp_.safe_lower()[i]) t = std::min(t, 0.0);
-    tau_ext_[i] = std::isfinite(t) ? t : 0.0;
+    tau[i] = std::isfinite(t) ? t : 0.0;
   }
 }
 
@@ -805,6 +808,9 @@ void Controller::shape_tasks() {
 
 CycleStatus Controller::step(const RobotState& state, const ControllerTargets& targets, RobotCommand& command) {
   ++steps_;
+  // Whether the previous cycle sent the QP's command (the motion since then answers it).
+  const bool commanded_last = qp_commanded_;
+  qp_commanded_ = false;
   if (std::isfinite(state.joints.stamp_s)) stop_stamp_s_ = state.joints.stamp_s;
   stop_sequence_ = state.joints.sequence;
   const bool targets_accepted = apply(targets);
@@ -830,7 +836,7 @@ CycleStatus Controller::step(const RobotState& state, const ControllerTargets& t
       qd_ = state.qd_rad_s;
       estimate(state, dt);
       select_external_torque();
-      bound_external_torque();
+      bound_external_torque(tau_ext_);
     }
     safe_stop(good, command);
     return status_;
@@ -850,13 +856,29 @@ CycleStatus Controller::step(const RobotState& state, const ControllerTargets& t
   // ---- QP and inverse dynamics. Under the robot's position loop the external torque is not fed
   // back: the stiff servo rejects it and the observer would only see servo effort.
   select_external_torque();
-  bound_external_torque();
-  if (low_level_.requested() == LowLevelMode::kPosition) tau_ext_.setZero();
+  bound_external_torque(tau_ext_);
+  const bool torque_loop = low_level_.requested() != LowLevelMode::kPosition;
+  if (!torque_loop) tau_ext_.setZero();
+  // The push the command does not cancel yet, from the observer's fast estimate and the motion:
+  // the safety bounds hold for it too.
+  const bool fast_estimate = torque_loop && settings_.observer_release_gain > 0.0;
+  if (fast_estimate) {
+    tau_ext_fast_ = observer_.fast_external_torque();
+    bound_external_torque(tau_ext_fast_);
+    // After missed periods the arm ran on a held command, and the fast observer's step (gain x dt)
+    // overshoots: no motion evidence across a gap.
+    const bool one_period = dt <= 1.5 * settings_.period_s;
+    uncancelled_.update(data_, tau_ext_, tau_ext_fast_, qd_, commanded_last && one_period ? &qp_.desired_acceleration() : nullptr,
+                        dt);
+  } else {
+    uncancelled_.forget();
+  }
   shape_tasks();
   // The F/T wrench for the tasks that read it (a force task), when it is plausible and in use.
   const bool wrench_usable = wrench_supervisor_.fresh() && wrench_.calibrated();
   const WholeBodyQpStatus qp_status =
-      qp_.update(model_, data_, q_, qd_, tau_ext_, settings_.period_s, wrench_usable ? &wrench_.wrench_world() : nullptr);
+      qp_.update(model_, data_, q_, qd_, tau_ext_, settings_.period_s, wrench_usable ? &wrench_.wrench_world() : nullptr,
+                 fast_estimate ? &uncancelled_.acceleration() : nullptr);
   check_qp(qp_status, state.time_s);
   if (supervisor_.safe_stop()) {
     safe_stop(true, command);
@@ -869,6 +891,7 @@ CycleStatus Controller::step(const RobotState& state, const ControllerTargets& t
   low_level_.update(state, guarded_tau_, qp_.desired_acceleration(), command);
   supervisor_.note_command(command);
   have_command_ = true;
+  qp_commanded_ = true;
   status_ = qp_status != WholeBodyQpStatus::kOk ? CycleStatus::kQpFallback
             : targets_accepted                 ? CycleStatus::kOk
                                                : CycleStatus::kTargetsRejected;

@@ -25,6 +25,7 @@
 #include <phri/control/controller_targets.hpp>
 #include <phri/control/compliance_controller.hpp>
 #include <phri/control/return_leash.hpp>
+#include <phri/control/uncancelled_push.hpp>
 #include <phri/control/momentum_observer.hpp>
 #include <phri/control/whole_body_qp.hpp>
 #include <phri/control/wrench_estimator.hpp>
@@ -161,7 +162,7 @@ private:
   void estimate_wrench(const RobotState& state);
   void estimate_wrench_from_observer();
   void select_external_torque();
-  void bound_external_torque();
+  void bound_external_torque(Eigen::VectorXd& tau) const;
   void update_modes_and_targets();
   void shape_tasks();
   void guard_torque(Eigen::VectorXd& tau);
@@ -195,6 +196,9 @@ private:
   long rejected_targets_ = 0;
   Eigen::MatrixXd ee_jacobian_;              // 6 x nv, for J^T F
   Eigen::VectorXd ft_torque_, tau_ext_;
+  Eigen::VectorXd tau_ext_fast_;             // the observer's fast estimate, bounded as tau_ext_
+  UncancelledPush uncancelled_;
+  bool qp_commanded_ = false;                // the last cycle sent the QP's command
   bool ft_torque_current_ = false;           // ft_torque_ is J^T F on this cycle's model terms
   Eigen::Matrix<double, 6, 2> wrench_history_ = Eigen::Matrix<double, 6, 2>::Zero();  // the two previous samples
   Vector6d wrench_median_ = Vector6d::Zero();

@@ -52,7 +52,11 @@ const Eigen::VectorXd& MomentumObserver::update(const Data& data, const Eigen::V
   residual_ = gains_.cwiseProduct(momentum_ - initial_momentum_ - integral_);
   if (release_gain_ <= 0.0) return residual_;
   release_integral_ += dt * (tau_sensor + data.coriolis_transpose_qd - data.gravity_torque + release_residual_);
-  release_residual_ = release_gain_ * (momentum_ - initial_momentum_ - release_integral_);
+  // After missed periods gain x dt may exceed 1, and the step would overshoot (x -9 at 20 ms): at
+  // most a deadbeat step, the state kept consistent with the gain for the next one.
+  const double step_gain = std::min(release_gain_, 1.0 / dt);
+  release_residual_ = step_gain * (momentum_ - initial_momentum_ - release_integral_);
+  if (step_gain < release_gain_) release_integral_ = momentum_ - initial_momentum_ - release_residual_ / release_gain_;
   // The joint's speed over the last ~10 ms: an elastic joint's ringing (fast, tiny) is no motion.
   release_velocity_ += (dt / (kReleaseVelocityFilter_s + dt)) * (qd - release_velocity_);
   // The kick the arm would get if every push were gone and the controller still cancelled r:

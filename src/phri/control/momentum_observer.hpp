@@ -44,6 +44,9 @@ public:
   const Eigen::VectorXd& update(const Data& data, const Eigen::VectorXd& qd, const Eigen::VectorXd& tau_sensor,
                                 double dt);
   const Eigen::VectorXd& external_torque() const { return residual_; }
+  /// The release path's own estimate of the same tau_ext (gain release_gain: ~10x faster and
+  /// noisier than r); zero while the release path is off.
+  const Eigen::VectorXd& fast_external_torque() const { return release_residual_; }
 
 private:
   Eigen::VectorXd gains_;

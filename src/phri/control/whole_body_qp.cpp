@@ -171,9 +171,20 @@ void WholeBodyQp::fill_constraints(const ConstraintContext& context) {
     constraint->fill_rows(context, problem_.A.middleRows(row, n), problem_.l.segment(row, n), problem_.u.segment(row, n));
     row += n;
   }
+  if (qdd_uncancelled_) bound_uncancelled_push();
   for (int i = 0; i < nv_; ++i) {
     // Both limits bind (e.g. beyond one): split the difference.
     if (problem_.lb[i] > problem_.ub[i]) problem_.lb[i] = problem_.ub[i] = 0.5 * (problem_.lb[i] + problem_.ub[i]);
+  }
+}
+
+// The bounds on qdd hold the real acceleration (constraint.hpp): the command's qdd_d plus a_u, the
+// push the command does not cancel yet. Each bound only moves inward: ub - max(a_u, 0), lb - min(a_u, 0).
+void WholeBodyQp::bound_uncancelled_push() {
+  for (int i = 0; i < nv_; ++i) {
+    const double a = (*qdd_uncancelled_)[i];
+    if (a > 0.0) problem_.ub[i] -= a;
+    if (a < 0.0) problem_.lb[i] -= a;
   }
 }
 
@@ -181,13 +192,19 @@ bool WholeBodyQp::relax_a_constraint() {
   for (const auto& constraint : constraints_) {
     if (constraint->relax()) return true;
   }
+  // Last: the uncancelled push's share of the bounds (the paper's bounds stay).
+  if (qdd_uncancelled_) {
+    qdd_uncancelled_ = nullptr;
+    return true;
+  }
   return false;
 }
 
 WholeBodyQpStatus WholeBodyQp::update(const Model& model, const Data& data, const Eigen::VectorXd& q,
                                      const Eigen::VectorXd& qd, const Eigen::VectorXd& tau_ext, double dt,
-                                     const Vector6d* ee_wrench_world) {
-  if (!q.allFinite() || !qd.allFinite() || !tau_ext.allFinite() || !data.mass_matrix.allFinite()) {
+                                     const Vector6d* ee_wrench_world, const Eigen::VectorXd* uncancelled_acceleration) {
+  if (!q.allFinite() || !qd.allFinite() || !tau_ext.allFinite() || !data.mass_matrix.allFinite() ||
+      (uncancelled_acceleration && uncancelled_acceleration->size() != nv_)) {
     tau_desired_ = last_good_tau_;
     status_ = WholeBodyQpStatus::kInvalidInput;
     return status_;
@@ -195,6 +212,8 @@ WholeBodyQpStatus WholeBodyQp::update(const Model& model, const Data& data, cons
   // qdd_ext = M^-1 tau_ext: what the push alone would do to the arm (through the dead band).
   soft_deadband(tau_ext, deadband_, qdd_external_);
   data.mass_matrix_llt.solve_in_place(qdd_external_);
+  // Not finite: ignored (tau_ext, checked above, still bounds the arm).
+  qdd_uncancelled_ = uncancelled_acceleration && uncancelled_acceleration->allFinite() ? uncancelled_acceleration : nullptr;
 
   const TaskContext task_context{model, data, q, qd, tau_ext, qdd_external_, ee_wrench_world, dt};
   for (const auto& task : tasks_) task->update(task_context);

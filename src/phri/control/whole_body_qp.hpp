@@ -131,9 +131,12 @@ public:
 
   /// One control cycle. `data`: after compute_all_terms(q, qd) on the controller's (link-side)
   /// model; tau_ext: estimated external torque; ee_wrench_world: the F/T wrench at the end effector
-  /// (TaskContext), or null. Returns the status; results below.
+  /// (TaskContext), or null; uncancelled_acceleration: what the push does to the arm beyond what
+  /// the command cancels (UncancelledPush), or null: the bounds on qdd hold for it too. Returns the
+  /// status; results below.
   WholeBodyQpStatus update(const Model& model, const Data& data, const Eigen::VectorXd& q, const Eigen::VectorXd& qd,
-                          const Eigen::VectorXd& tau_ext, double dt, const Vector6d* ee_wrench_world = nullptr);
+                          const Eigen::VectorXd& tau_ext, double dt, const Vector6d* ee_wrench_world = nullptr,
+                          const Eigen::VectorXd* uncancelled_acceleration = nullptr);
 
   const Eigen::VectorXd& desired_acceleration() const { return qdd_desired_; }
   /// The soft dead band of tau_ext in the compliant terms, per joint [N.m].
@@ -172,6 +175,7 @@ private:
               const Limits& limits);
   void assemble_objective();
   void fill_constraints(const ConstraintContext& context);
+  void bound_uncancelled_push();
   bool relax_a_constraint();
   void resize_problem();
   void fallback_brake(const Data& data, const Eigen::VectorXd& qd, const Eigen::VectorXd& tau_ext);
@@ -191,6 +195,7 @@ private:
   QpSolver solver_;
   Eigen::VectorXd deadband_;
   Eigen::VectorXd qdd_external_, qdd_desired_, tau_desired_, last_good_tau_;
+  const Eigen::VectorXd* qdd_uncancelled_ = nullptr;  // this update's; null: none, or dropped as infeasible
   Eigen::VectorXd hold_torque_, inertia_diagonal_;  // the constraints' context
   Eigen::VectorXd hessian_diagonal_;                // the tasks' diagonal Hessian terms (ObjectiveTerms)
   WholeBodyQpStatus status_ = WholeBodyQpStatus::kOk;

@@ -172,8 +172,10 @@ SafetyFault StateSupervisor::check_kinematics(const RobotState& s, int& joint) c
       }
       // A position that did not change by a single bit while q̇ says the joint moved more than two
       // encoder quanta: the reading is stuck (within the tolerance above, it would pass for
-      // frozen_s while the arm moves on).
-      if (q == q_ref[i] && std::abs(mean_qd) * dt > 2.0 * c.encoder_quantum_rad) return SafetyFault::kFrozenValues;
+      // frozen_s while the arm moves on). Moved: the same way at both ends, at least the slower
+      // end's speed; a joint that stopped or turned back within a gap may be back on the same count.
+      const double surely_moved = s.qd_rad_s[i] * qd_ref[i] > 0.0 ? std::min(std::abs(s.qd_rad_s[i]), std::abs(qd_ref[i])) : 0.0;
+      if (q == q_ref[i] && surely_moved * dt > 2.0 * c.encoder_quantum_rad) return SafetyFault::kFrozenValues;
     }
   }
   joint = -1;

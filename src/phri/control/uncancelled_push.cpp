@@ -1,0 +1,46 @@
+#include <phri/control/uncancelled_push.hpp>
+
+#include <algorithm>
+
+namespace phri {
+
+UncancelledPush::UncancelledPush(const Eigen::VectorXd& rotor_inertia)
+    : rotor_inertia_(rotor_inertia),
+      inertia_(Eigen::MatrixXd::Zero(rotor_inertia.size(), rotor_inertia.size())),
+      inertia_llt_(rotor_inertia.size()),
+      previous_qd_(Eigen::VectorXd::Zero(rotor_inertia.size())),
+      from_torque_(Eigen::VectorXd::Zero(rotor_inertia.size())),
+      from_motion_(Eigen::VectorXd::Zero(rotor_inertia.size())),
+      acceleration_(Eigen::VectorXd::Zero(rotor_inertia.size())) {}
+
+void UncancelledPush::forget() {
+  have_previous_ = false;
+  acceleration_.setZero();
+}
+
+const Eigen::VectorXd& UncancelledPush::update(const Data& data, const Eigen::VectorXd& tau_ext,
+                                               const Eigen::VectorXd& tau_fast, const Eigen::VectorXd& qd,
+                                               const Eigen::VectorXd* qdd_commanded, double dt) {
+  const bool have_motion = have_previous_ && qdd_commanded && dt > 0.0;
+  have_previous_ = true;
+  acceleration_.setZero();
+  if (!have_motion) {
+    previous_qd_ = qd;
+    return acceleration_;
+  }
+  from_motion_ = (qd - previous_qd_) / dt - *qdd_commanded;
+  previous_qd_ = qd;
+  from_torque_ = tau_fast - tau_ext;
+  inertia_ = data.mass_matrix;
+  inertia_.diagonal() += rotor_inertia_;
+  if (!inertia_llt_.compute(inertia_)) return acceleration_;
+  inertia_llt_.solve_in_place(from_torque_);
+  for (Eigen::Index i = 0; i < acceleration_.size(); ++i) {
+    const double t = from_torque_[i], m = from_motion_[i];
+    if (t > 0.0 && m > 0.0) acceleration_[i] = std::min(t, m);
+    if (t < 0.0 && m < 0.0) acceleration_[i] = std::max(t, m);
+  }
+  return acceleration_;
+}
+
+}  // namespace phri

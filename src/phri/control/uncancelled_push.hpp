@@ -1,0 +1,53 @@
+#pragma once
+// The part of a push the command does not cancel yet (ours, not the paper's).
+//
+// tau_d = M qdd_d + h - tau_ext cancels the observer's tau_ext, which follows a push at K_O (20 ms
+// at 50/s). Meanwhile the arm gets a_u = (M + B)^-1 (tau_true - tau_ext) on top of qdd_d, B being
+// the rotors behind rigid gears. The QP's bounds hold the command, not the arm: a light wrist goes
+// from rest past its speed limit in 5 ms that way (a UR5e's wrist under a 173 N step: 3.96 rad/s
+// for a 3.14 rad/s limit, with 28 N.m available and 5.5 used).
+//
+// Two estimates of a_u, each fooled by a different fault:
+// - the observer's fast path (MomentumObserver::fast_external_torque, ~500/s): tau_true ~ tau_fast;
+//   a spike or offset on a torque sensor reads as a push;
+// - the arm's motion over the last period: (qd - qd_prev) / dt - qdd_d(prev); velocity noise and
+//   the torque loop's tracking error read as one.
+// acceleration() takes, per joint, the smaller of the two where they agree in sign, and 0 where they
+// do not: a push both the torque sensors and the motion show. WholeBodyQp's bounds hold for it.
+// Without motion evidence (the first cycle, after a cycle with no QP command) it is 0.
+#include <phri/model/data.hpp>
+#include <phri/model/small_cholesky.hpp>
+
+#include <Eigen/Core>
+
+namespace phri {
+
+class UncancelledPush {
+public:
+  /// rotor_inertia: B, the reflected rotor inertia per joint (zero where unknown).
+  explicit UncancelledPush(const Eigen::VectorXd& rotor_inertia);
+
+  /// One cycle. data: after compute_all_terms(q, qd) (M); tau_ext: the estimate the command cancels;
+  /// tau_fast: the observer's fast estimate; qd: this sample's velocity; qdd_commanded: the
+  /// acceleration the last cycle's command asked for, or null when it sent none from the QP; dt: the
+  /// time since that sample.
+  const Eigen::VectorXd& update(const Data& data, const Eigen::VectorXd& tau_ext, const Eigen::VectorXd& tau_fast,
+                                const Eigen::VectorXd& qd, const Eigen::VectorXd* qdd_commanded, double dt);
+  /// No estimate this cycle (a mode without it): the next update has no motion evidence either.
+  void forget();
+
+  const Eigen::VectorXd& acceleration() const { return acceleration_; }
+  /// The two estimates of the last update: (M + B)^-1 (tau_fast - tau_ext), and the motion's.
+  const Eigen::VectorXd& from_torque() const { return from_torque_; }
+  const Eigen::VectorXd& from_motion() const { return from_motion_; }
+
+private:
+  Eigen::VectorXd rotor_inertia_;
+  Eigen::MatrixXd inertia_;  // M + B
+  SmallCholesky inertia_llt_;
+  Eigen::VectorXd previous_qd_;
+  bool have_previous_ = false;
+  Eigen::VectorXd from_torque_, from_motion_, acceleration_;
+};
+
+}  // namespace phri
