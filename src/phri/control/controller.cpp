@@ -446,6 +446,22 @@ void Controller::select_external_torque() {
   }
 }
 
+// The push the command does not cancel yet, from the observer's fast estimate and the motion (the
+// safety bounds hold for it too): in torque loops with the release path on. True when estimated.
+bool Controller::estimate_uncancelled_push(bool torque_loop, bool commanded_last, double dt) {
+  if (!torque_loop || !(settings_.observer_release_gain > 0.0)) {
+    uncancelled_.forget();
+    return false;
+  }
+  tau_ext_fast_ = observer_.fast_external_torque();
+  bound_external_torque(tau_ext_fast_);
+  // After missed periods the arm ran on a held command, and the fast observer's step (gain x dt)
+  // overshoots: no motion evidence across a gap.
+  const bool one_period = dt <= 1.5 * settings_.period_s;
+  uncancelled_.update(data_, tau_ext_, tau_ext_fast_, qd_, commanded_last && one_period ? &qp_.desired_acceleration() : nullptr, dt);
+  return true;
+}
+
 // Keeps the previous command while the supervisor holds the last good state (bounded: it turns
 // into a safe stop after max_degraded_s). Before any command: the robot's hold at the measured pose.
 void Controller::hold_previous(const RobotState& state, RobotCommand& command) {
@@ -859,20 +875,7 @@ CycleStatus Controller::step(const RobotState& state, const ControllerTargets& t
   bound_external_torque(tau_ext_);
   const bool torque_loop = low_level_.requested() != LowLevelMode::kPosition;
   if (!torque_loop) tau_ext_.setZero();
-  // The push the command does not cancel yet, from the observer's fast estimate and the motion:
-  // the safety bounds hold for it too.
-  const bool fast_estimate = torque_loop && settings_.observer_release_gain > 0.0;
-  if (fast_estimate) {
-    tau_ext_fast_ = observer_.fast_external_torque();
-    bound_external_torque(tau_ext_fast_);
-    // After missed periods the arm ran on a held command, and the fast observer's step (gain x dt)
-    // overshoots: no motion evidence across a gap.
-    const bool one_period = dt <= 1.5 * settings_.period_s;
-    uncancelled_.update(data_, tau_ext_, tau_ext_fast_, qd_, commanded_last && one_period ? &qp_.desired_acceleration() : nullptr,
-                        dt);
-  } else {
-    uncancelled_.forget();
-  }
+  const bool fast_estimate = estimate_uncancelled_push(torque_loop, commanded_last, dt);
   shape_tasks();
   // The F/T wrench for the tasks that read it (a force task), when it is plausible and in use.
   const bool wrench_usable = wrench_supervisor_.fresh() && wrench_.calibrated();

@@ -163,6 +163,7 @@ private:
   void estimate_wrench_from_observer();
   void select_external_torque();
   void bound_external_torque(Eigen::VectorXd& tau) const;
+  bool estimate_uncancelled_push(bool torque_loop, bool commanded_last, double dt);
   void update_modes_and_targets();
   void shape_tasks();
   void guard_torque(Eigen::VectorXd& tau);
