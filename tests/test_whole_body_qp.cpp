@@ -223,7 +223,7 @@ TEST(UncancelledPush, IsTheSmallerOfTheTorqueAndMotionEstimatesWhereTheyAgree) {
   commanded << 1.0, -2.0, 0.5, 3.0, -1.0, 0.0, 2.0;
   const double dt = 1e-3;
 
-  phri::UncancelledPush estimate(rotor);
+  phri::UncancelledPush estimate(rotor, Eigen::VectorXd(), dt);
   // No previous sample: nothing.
   EXPECT_EQ(estimate.update(data, tau_ext, tau_fast, qd0, &commanded, dt), Eigen::VectorXd::Zero(7));
   struct Case {
@@ -234,7 +234,7 @@ TEST(UncancelledPush, IsTheSmallerOfTheTorqueAndMotionEstimatesWhereTheyAgree) {
                        Case{"the motion shows more", 1.5}, Case{"the motion goes the other way", -1.0},
                        Case{"no motion beyond the command (a sensor spike)", 0.0}}) {
     SCOPED_TRACE(c.what);
-    phri::UncancelledPush e(rotor);
+    phri::UncancelledPush e(rotor, Eigen::VectorXd(), dt);
     e.update(data, tau_ext, tau_fast, qd0, &commanded, dt);
     const Eigen::VectorXd qd1 = qd0 + dt * (commanded + c.motion_share * truth);
     phri::test::AllocationCounter count;
@@ -245,12 +245,58 @@ TEST(UncancelledPush, IsTheSmallerOfTheTorqueAndMotionEstimatesWhereTheyAgree) {
     EXPECT_LT((a - share * truth).cwiseAbs().maxCoeff(), 1e-6 * truth.cwiseAbs().maxCoeff()) << a.transpose();
   }
   // The previous cycle sent no QP command, or the estimate was forgotten: no motion evidence.
-  phri::UncancelledPush e(rotor);
+  phri::UncancelledPush e(rotor, Eigen::VectorXd(), dt);
   e.update(data, tau_ext, tau_fast, qd0, &commanded, dt);
   EXPECT_EQ(e.update(data, tau_ext, tau_fast, qd0 + dt * truth, nullptr, dt), Eigen::VectorXd::Zero(7));
   e.forget();
   EXPECT_EQ(e.update(data, tau_ext, tau_fast, qd0 + 2 * dt * truth, &commanded, dt), Eigen::VectorXd::Zero(7));
   EXPECT_GT(e.update(data, tau_ext, tau_fast, qd0 + 2 * dt * truth + dt * (commanded + truth), &commanded, dt).norm(), 0.0);
+}
+
+// Through an elastic transmission a command reaches the link as the spring winds: the estimate is
+// scaled by the share f a held link sees of a torque step on average over the period. Reference:
+// the rotor B theta'' = 1 - K theta integrated in 100000 explicit steps (semi-implicit Euler), the
+// mean of K theta over [0, dt]. Rigid joints (no compliance) keep f = 1, as above.
+TEST(UncancelledPush, AnElasticTransmissionPassesOnlyWhatItsSpringDeliversWithinThePeriod) {
+  const double dt = 1e-3;
+  const Eigen::VectorXd rotor = (Eigen::VectorXd(4) << 0.03, 0.03, 0.0135, 0.5).finished();
+  const Eigen::VectorXd stiffness = (Eigen::VectorXd(4) << 13000.0, 1e9, 5500.0, 200.0).finished();
+  const Eigen::VectorXd compliance = stiffness.cwiseInverse();
+  const phri::UncancelledPush e(rotor, compliance, dt);
+  for (int i = 0; i < 4; ++i) {
+    constexpr int kSteps = 100000;
+    const double h = dt / kSteps;
+    double theta = 0.0, omega = 0.0, delivered = 0.0;
+    for (int k = 0; k < kSteps; ++k) {
+      omega += h * (1.0 - stiffness[i] * theta) / rotor[i];
+      theta += h * omega;
+      delivered += stiffness[i] * theta * h / dt;
+    }
+    EXPECT_NEAR(e.delivered_fraction()[i], delivered, 1e-4) << "joint " << i;
+  }
+  EXPECT_NEAR(e.delivered_fraction()[0], 0.07, 0.01);  // the Gen3's large joints: a tenth at most
+  EXPECT_GT(e.delivered_fraction()[1], 0.99);          // a stiff spring: nearly rigid
+  const phri::UncancelledPush rigid(rotor, Eigen::VectorXd(), dt);
+  EXPECT_EQ(rigid.delivered_fraction(), Eigen::VectorXd::Ones(4));
+
+  // The estimate itself: f times the rigid one, joint by joint.
+  const phri::Model model = phri::Model::from_urdf_file(kGen3 + "gen3.urdf");
+  phri::Data data(model);
+  Eigen::VectorXd q(7), qd0(7);
+  q << 0.2, 0.58, 3.0, -1.84, 0.3, 0.85, 1.57;
+  qd0.setZero();
+  phri::compute_all_terms(model, data, q, qd0);
+  const Eigen::VectorXd b = Eigen::VectorXd::Constant(7, 0.03);
+  const Eigen::VectorXd k = Eigen::VectorXd::LinSpaced(7, 1.0 / 13000.0, 1.0 / 2000.0);
+  const Eigen::VectorXd tau_ext = Eigen::VectorXd::Zero(7);
+  const Eigen::VectorXd tau_fast = Eigen::VectorXd::LinSpaced(7, 3.0, -2.0);
+  const Eigen::VectorXd commanded = Eigen::VectorXd::Zero(7);
+  phri::UncancelledPush elastic(b, k, dt), stiff(b, Eigen::VectorXd(), dt);
+  for (phri::UncancelledPush* p : {&elastic, &stiff}) p->update(data, tau_ext, tau_fast, qd0, &commanded, dt);
+  const Eigen::VectorXd qd1 = qd0 + dt * 10.0 * tau_fast;  // the motion shows more than the torque side
+  const Eigen::VectorXd expected = elastic.delivered_fraction().cwiseProduct(stiff.update(data, tau_ext, tau_fast, qd1, &commanded, dt));
+  EXPECT_LT((elastic.update(data, tau_ext, tau_fast, qd1, &commanded, dt) - expected).cwiseAbs().maxCoeff(), 1e-12);
+  EXPECT_GT(expected.norm(), 0.0);
 }
 
 TEST_F(WholeBodyQpTest, InvalidInputHoldsTheLastCommandAndInfeasibleBrakes) {

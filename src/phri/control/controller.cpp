@@ -222,7 +222,7 @@ Controller::Controller(LoadedRobot robot, const ControllerSettings& settings)
       ft_torque_(Eigen::VectorXd::Zero(model_.nv())),
       tau_ext_(Eigen::VectorXd::Zero(model_.nv())),
       tau_ext_fast_(Eigen::VectorXd::Zero(model_.nv())),
-      uncancelled_(Eigen::VectorXd::Zero(model_.nv())),
+      uncancelled_(Eigen::VectorXd::Zero(model_.nv()), Eigen::VectorXd(), settings.period_s),
       trigger_filter_(settings.wrench_trigger_filter_s, settings.period_s),
       estimate_torque_(Eigen::VectorXd::Zero(model_.nv())),
       ft_fusion_(model_.nv(), settings.observer_gain, settings.period_s),
@@ -255,7 +255,7 @@ Controller::Controller(LoadedRobot robot, const ControllerSettings& settings)
     reflected_inertia_[i] = actuators_[i].reflected_inertia_kgm2;
     static_friction_[i] = std::max(actuators_[i].friction.static_Nm, actuators_[i].friction.coulomb_Nm);
   }
-  uncancelled_ = UncancelledPush(reflected_inertia_);
+  uncancelled_ = UncancelledPush(reflected_inertia_, supervisor_.ranges().transmission_compliance, settings.period_s);
   add_declared_tasks(settings.tasks);
   add_declared_constraints(settings.constraints);
 }

@@ -1,11 +1,30 @@
 #include <phri/control/uncancelled_push.hpp>
 
 #include <algorithm>
+#include <cmath>
 
 namespace phri {
 
-UncancelledPush::UncancelledPush(const Eigen::VectorXd& rotor_inertia)
+namespace {
+
+// f = 1 - sin(x) / x, x = sqrt(K / B) dt: the period's mean of 1 - cos(w t), the share of a torque
+// step the spring passes to a held link (header). Rigid (no compliance) or no rotor: 1.
+Eigen::VectorXd delivered_fractions(const Eigen::VectorXd& rotor_inertia, const Eigen::VectorXd& compliance, double dt) {
+  Eigen::VectorXd f = Eigen::VectorXd::Ones(rotor_inertia.size());
+  if (compliance.size() != rotor_inertia.size()) return f;
+  for (Eigen::Index i = 0; i < f.size(); ++i) {
+    if (!(compliance[i] > 0.0) || !(rotor_inertia[i] > 0.0) || !(dt > 0.0)) continue;
+    const double x = std::sqrt(1.0 / (compliance[i] * rotor_inertia[i])) * dt;
+    f[i] = x < 1e-4 ? x * x / 6.0 : std::min(1.0, 1.0 - std::sin(x) / x);
+  }
+  return f;
+}
+
+}  // namespace
+
+UncancelledPush::UncancelledPush(const Eigen::VectorXd& rotor_inertia, const Eigen::VectorXd& compliance, double period_s)
     : rotor_inertia_(rotor_inertia),
+      delivered_(delivered_fractions(rotor_inertia, compliance, period_s)),
       inertia_(Eigen::MatrixXd::Zero(rotor_inertia.size(), rotor_inertia.size())),
       inertia_llt_(rotor_inertia.size()),
       previous_qd_(Eigen::VectorXd::Zero(rotor_inertia.size())),
@@ -37,8 +56,8 @@ const Eigen::VectorXd& UncancelledPush::update(const Data& data, const Eigen::Ve
   inertia_llt_.solve_in_place(from_torque_);
   for (Eigen::Index i = 0; i < acceleration_.size(); ++i) {
     const double t = from_torque_[i], m = from_motion_[i];
-    if (t > 0.0 && m > 0.0) acceleration_[i] = std::min(t, m);
-    if (t < 0.0 && m < 0.0) acceleration_[i] = std::max(t, m);
+    if (t > 0.0 && m > 0.0) acceleration_[i] = delivered_[i] * std::min(t, m);
+    if (t < 0.0 && m < 0.0) acceleration_[i] = delivered_[i] * std::max(t, m);
   }
   return acceleration_;
 }

@@ -15,6 +15,15 @@
 // acceleration() takes, per joint, the smaller of the two where they agree in sign, and 0 where they
 // do not: a push both the torque sensors and the motion show. WholeBodyQp's bounds hold for it.
 // Without motion evidence (the first cycle, after a cycle with no QP command) it is 0.
+//
+// Both the motion estimate and the bound's counter-acceleration assume a command reaches the link
+// within the period, as through rigid gears. Through an elastic transmission (stiffness K behind a
+// rotor B) a torque step reaches the link as K (theta - q), and the link sees on average
+// f = 1 - sin(x) / x of it over the period, x = sqrt(K / B) dt (rotor against a held link): on the
+// Gen3's declared springs f ~ 0.07. So a_u is scaled by f: where the command cannot counter the push
+// within the period, the bounds do not ask it to, and the command the drive has not delivered yet is
+// not read back as a push (replayed: the drop test with the observer alone at K_O 10, whose wrist
+// rang between -4 and +4 rad/s on the full shift).
 #include <phri/model/data.hpp>
 #include <phri/model/small_cholesky.hpp>
 
@@ -24,8 +33,9 @@ namespace phri {
 
 class UncancelledPush {
 public:
-  /// rotor_inertia: B, the reflected rotor inertia per joint (zero where unknown).
-  explicit UncancelledPush(const Eigen::VectorXd& rotor_inertia);
+  /// rotor_inertia: B, the reflected rotor inertia per joint (zero where unknown); compliance: 1 / K
+  /// of each transmission (empty, or 0 where rigid); period_s: the control period.
+  UncancelledPush(const Eigen::VectorXd& rotor_inertia, const Eigen::VectorXd& compliance, double period_s);
 
   /// One cycle. data: after compute_all_terms(q, qd) (M); tau_ext: the estimate the command cancels;
   /// tau_fast: the observer's fast estimate; qd: this sample's velocity; qdd_commanded: the
@@ -40,9 +50,11 @@ public:
   /// The two estimates of the last update: (M + B)^-1 (tau_fast - tau_ext), and the motion's.
   const Eigen::VectorXd& from_torque() const { return from_torque_; }
   const Eigen::VectorXd& from_motion() const { return from_motion_; }
+  /// Per joint, the share f of a command the link sees within one period (1: rigid).
+  const Eigen::VectorXd& delivered_fraction() const { return delivered_; }
 
 private:
-  Eigen::VectorXd rotor_inertia_;
+  Eigen::VectorXd rotor_inertia_, delivered_;
   Eigen::MatrixXd inertia_;  // M + B
   SmallCholesky inertia_llt_;
   Eigen::VectorXd previous_qd_;
