@@ -215,8 +215,8 @@ std::vector<Variant> plant_variants() {
                  d.joint_stiffness_Nm_per_rad = std::vector<double>{4000, 4000, 4000, 4000, 3500, 3500, 3500};
                }});
   // Under the main row's servo the hand-over to the first position command steps each drive by
-  // kp tau / K (112 N.m at 4000 N.m/rad): every drop safe-stops at once. The same springs with the
-  // servo that compensates the deflection, so that the range's soft end is measured at all.
+  // kp tau / K (112 N.m at 4000 N.m/rad, a sample's spike the supervisor's median of three absorbs).
+  // The same springs with the servo that compensates the deflection: the soft end without that step.
   v.push_back({"soft_joints_4000_3500_servo_compensated", "joint stiffness",
                "joint stiffness 4000 / 3500 N.m/rad, vendor servo compensating the static deflection",
                "gen3_compliant_controllers' tuned K_j (reference section 1.3); the servo: configs/plant_gen3.yaml",

@@ -80,12 +80,15 @@ void StateSupervisor::ResidualTrack::resize(int n) {
   filtered = acceleration_size = raw[0] = raw[1] = Eigen::VectorXd::Zero(n);
 }
 
-double StateSupervisor::ResidualTrack::update(int i, double residual, double acceleration, double alpha, bool median) {
-  // Median of the last three raw residuals: an impact (a hard stop, a step push) aliases into one
-  // or two samples of ~100 N.m between a 1 kHz q̈ and the sensor's instant; a fault persists.
-  const double m = median ? median_of_three(residual, raw[0][i], raw[1][i]) : residual;
+double StateSupervisor::ResidualTrack::update(int i, double residual, double acceleration, double alpha, bool started) {
+  // Median of the last three raw residuals: an impact (a hard stop, a step push, the drive's first
+  // command) aliases into one or two samples of ~100 N.m between a 1 kHz q̈ and the sensor's
+  // instant; a fault persists. The filter starts at the third sample, when the median and τ̈_s (the
+  // elastic hypothesis) are both known.
+  const double m = median_of_three(residual, raw[0][i], raw[1][i]);
   raw[1][i] = raw[0][i];
   raw[0][i] = residual;
+  if (!started) return filtered[i];
   filtered[i] += alpha * (m - filtered[i]);
   acceleration_size[i] += alpha * (std::abs(acceleration) - acceleration_size[i]);
   return filtered[i];

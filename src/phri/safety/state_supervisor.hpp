@@ -298,8 +298,8 @@ private:
     Eigen::VectorXd acceleration_size;  // low-passed |a_r| [rad/s^2]
     Eigen::VectorXd raw[2];             // the last two unfiltered residuals
     void resize(int n);
-    /// Feeds joint i's raw residual; returns the filtered one.
-    double update(int i, double residual, double acceleration, double alpha, bool median);
+    /// Feeds joint i's raw residual; returns the filtered one (unchanged until started: three samples).
+    double update(int i, double residual, double acceleration, double alpha, bool started);
   };
   // [0]: rigid (a_r = q̈); [1]: the catalogue's compliance (a_r = q̈ + τ̈_s / K).
   ResidualTrack residual_track_[2];
