@@ -198,6 +198,36 @@ TEST(RobotBundle, TheCustomLoopFilterComesFromTheBundle) {
   EXPECT_THROW(phri::CustomTorqueController(drives, identity), phri::ConfigError);
 }
 
+// Kinova's H(z) is a Kinova datum: a generic drive's custom loop has no filter term unless its
+// bundle states an H(z) (robots/ur5e states none: a 2 N.m torque error gives 0 from the filter and
+// only the integrator's first step; stated, H = 1 gives lambda e).
+TEST(RobotBundle, AGenericDriveGetsNoKinovaFilterUnlessItsBundleStatesOne) {
+  const std::string ur5e = kRoot + "/robots/ur5e";
+  const phri::RobotBundle bundle = phri::RobotBundle::from_folder(ur5e);
+  ASSERT_EQ(bundle.drive, phri::DriveKind::kGeneric);
+  const phri::ActuatorTable drives = phri::ActuatorTable::from_yaml_file(bundle.actuators_path);
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(6), error = Eigen::VectorXd::Constant(6, 2.0);
+  auto first_update = [&](const phri::RobotBundle& b) {
+    phri::ControllerSettings settings;
+    b.apply_to(settings);
+    phri::CustomTorqueController loop(drives, settings.custom_torque);
+    loop.reset(zero, zero, zero, zero, zero);
+    loop.update(error, zero, zero, zero);
+    return std::pair{Eigen::VectorXd(loop.filter_term()), settings.custom_torque};
+  };
+  const auto [unstated, custom] = first_update(bundle);
+  EXPECT_EQ(unstated, Eigen::VectorXd::Zero(6));
+  EXPECT_NE(first_update(phri::RobotBundle::from_folder(kGen3)).first[0], 0.0);  // the Gen3 keeps Kinova's
+
+  const std::string folder = phri::test::temp_path("phri_test_robot_bundle", "ur5e_with_filter");
+  std::filesystem::remove_all(folder);
+  std::filesystem::copy(ur5e, folder, std::filesystem::copy_options::recursive);
+  std::ofstream(folder + "/robot.yaml", std::ios::app) << "\ncustom_loop_filter: {numerator: [1.0], denominator: [1.0]}\n";
+  const Eigen::VectorXd stated = first_update(phri::RobotBundle::from_folder(folder)).first;
+  EXPECT_NEAR(stated[5], custom.transfer_gain * 2.0, 1e-12);
+  std::filesystem::remove_all(folder);
+}
+
 // `collision: fitted` (robots/example_6dof): the controller gets capsules fitted from the URDF, no
 // pair on adjacent bodies, none within the damper's influence distance at the home posture.
 TEST(RobotBundle, FittedCollisionCapsulesReachTheController) {

@@ -298,6 +298,12 @@ void RobotBundle::apply_to(ControllerSettings& s) const {
   s.base_placement = base_placement;
   s.custom_torque.filter_numerator = custom_loop_numerator;
   s.custom_torque.filter_denominator = custom_loop_denominator;
+  if (drive != DriveKind::kKinova && custom_loop_numerator.empty()) {
+    // Kinova's H(z) was identified on Kinova's actuators: another drive gets no filter term unless
+    // its bundle states one (the loop is then the feed-forward and the leaky integrator).
+    s.custom_torque.filter_numerator = {0.0};
+    s.custom_torque.filter_denominator = {1.0};
+  }
   s.offered_loops = offered_loops(drive);
 }
 

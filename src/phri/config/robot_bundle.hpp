@@ -58,7 +58,8 @@ struct RobotBundle {
   /// `drive: {kind: generic, position_hold: {kp_Nm_per_rad, kd_Nms_per_rad}}`: the generic drive's
   /// position hold (sim/generic_drive.hpp; empty: its default rule on the arm's inertia).
   GenericHoldGains generic_hold;
-  /// The custom torque loop's H(z) (b, a in powers of z^-1); both empty: Kinova's (the library's).
+  /// The custom torque loop's H(z) (b, a in powers of z^-1); both empty: Kinova's (the library's) on a
+  /// kinova drive, none (H = 0) on another (apply_to).
   std::vector<double> custom_loop_numerator, custom_loop_denominator;
 
   /// `end_of_arm`: the F/T sensor and the tool (becoming the controller's payloads and the
