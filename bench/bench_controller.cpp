@@ -63,10 +63,12 @@ void time_cycles(benchmark::State& state, const std::function<void(phri::Control
   state.counters["supervisor_median_us"] = phri::percentile(supervisor_micros, 0.5);
   state.counters["supervisor_p99_us"] = phri::percentile(supervisor_micros, 0.99);
   // The cycles the singular-direction weight answered from its Weyl certificate, without a test,
-  // and those it decomposed J J^T on (the rest: a Cholesky test, or the weak direction tracked).
+  // and those it decomposed J J^T on (the rest: a Cholesky test, or the weak direction tracked);
+  // weight_second_certified: tracked cycles whose other eigenvalues the certificate answered.
   const phri::SingularDirectionWeight& weight = cycle.qp().end_effector().singular_weight();
   state.counters["weight_certified"] = static_cast<double>(weight.certified_skips()) / kCycles;
   state.counters["weight_decomposed"] = static_cast<double>(weight.decompositions()) / kCycles;
+  state.counters["weight_second_certified"] = static_cast<double>(weight.second_certified()) / kCycles;
   state.counters["implausible"] = static_cast<double>(cycle.supervisor().implausible_samples());
 }
 void ControllerCycle(benchmark::State& state) {

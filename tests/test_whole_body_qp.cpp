@@ -580,6 +580,45 @@ TEST(SingularDirectionWeightTest, TrackingTheWeakDirectionGivesTheDecompositions
   EXPECT_LT((tracked.weight() - fresh.weight()).norm(), 1e-12);
 }
 
+// While the weak direction is tracked, the other eigenvalues' check is carried by Weyl's certificate
+// (lambda_1 >= 4 sigma_0^2 tested once, then ||A - A_c||_F < 3 sigma_0^2): along a path on which
+// the second singular value comes down through the threshold and back, every answer and weight equals
+// a fresh decomposition's, the certificate answers on most steps while sigma_1 is far, and never
+// while sigma_1 is below sigma_0 (it carries lambda_1 > t, no more).
+TEST(SingularDirectionWeightTest, TrackingCarriesTheOtherEigenvaluesCheckOnlyWhileItHolds) {
+  std::mt19937 rng(5);
+  std::normal_distribution<double> normal;
+  const Eigen::MatrixXd v = Eigen::HouseholderQR<Eigen::MatrixXd>(
+                                Eigen::MatrixXd::NullaryExpr(7, 7, [&] { return normal(rng); })).householderQ();
+  const Eigen::MatrixXd u = Eigen::HouseholderQR<Eigen::MatrixXd>(
+                                Eigen::MatrixXd::NullaryExpr(6, 6, [&] { return normal(rng); })).householderQ();
+  const double sigma0 = 0.03;
+  phri::SingularDirectionWeight tracked(sigma0, 7);
+  double worst = 0.0;
+  long second_below_steps = 0, far_tracked_steps = 0;
+  for (double t = 0.0; t < 4.0; t += 1e-3) {
+    // sigma_1: 0.3 -> 0.02 -> 0.3 (below sigma_0 for a while: two weak directions), sigma_min ~0.01.
+    const double second = 0.16 + 0.14 * std::cos(0.5 * M_PI * t);
+    Eigen::MatrixXd s = Eigen::MatrixXd::Zero(6, 7);
+    s.diagonal() << 1.5, 1.1, 0.8, 0.4, second, 0.01 + 0.005 * std::sin(3.0 * t);
+    const Eigen::MatrixXd jacobian = u * s * v.transpose() + 0.02 * std::sin(2.0 * t) * u.col(1) * v.col(6).transpose();
+    phri::SingularDirectionWeight fresh(sigma0);
+    const long certified_before = tracked.second_certified();
+    ASSERT_EQ(tracked.update(jacobian), fresh.update(jacobian)) << "t " << t;
+    ASSERT_TRUE(fresh.active());
+    worst = std::max(worst, (tracked.weight() - fresh.weight()).norm());
+    const bool certified = tracked.second_certified() > certified_before;
+    if (second < sigma0) {
+      EXPECT_FALSE(certified) << "t " << t << " sigma_1 " << second;
+      ++second_below_steps;
+    }
+    far_tracked_steps += second > 0.1;
+  }
+  EXPECT_LT(worst, 1e-12);
+  EXPECT_GT(second_below_steps, 100);
+  EXPECT_GT(tracked.second_certified(), far_tracked_steps / 2) << "certified on most steps with sigma_1 far";
+}
+
 // Far from a singularity the weight answers from Weyl's certificate (sigma_i(J) >= sigma_i(J_c) -
 // ||J - J_c||_F) instead of testing: along a path that approaches the threshold, leaves and comes
 // back, its answers and weights equal a fresh weight's (which always tests) at every step, and most

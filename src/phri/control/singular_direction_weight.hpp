@@ -26,11 +26,12 @@
 // The test is cheap: every sigma_i >= sigma_0 exactly when J J^T - sigma_0^2 I has a Cholesky
 // factor (6 x 6). Near a singularity one direction is weak, cycle after cycle, and its direction
 // moves little in a millisecond: W = I - (1 - f_w) u_w u_w^T is then updated from the last u_w by
-// Rayleigh-quotient iteration (cubic convergence, two or three 6 x 6 solves) and accepted only when
-// checked exact: the residual |A u - mu u| at rounding level, mu below sigma_0^2, and every other
-// eigenvalue at or above it (A - sigma_0^2 I + c u u^T has a Cholesky factor). Otherwise (first
-// cycle near the singularity, two weak directions, a check failing) the eigen-decomposition decides,
-// as it always did.
+// Rayleigh-quotient iteration (cubic convergence; one or two 6 x 6 Cholesky solves in its
+// Jacobi-Davidson form) and accepted only when checked exact: the residual |A u - mu u| at rounding
+// level, mu below sigma_0^2, and every other eigenvalue at or above it (A - b I + c u u^T has a
+// Cholesky factor for b = sigma_0^2, or did for b = 4 sigma_0^2 on an A within Weyl's distance).
+// Otherwise (first cycle near the singularity, two weak directions, a check failing) the
+// eigen-decomposition decides, as it always did.
 //
 // Far from a singularity most cycles need no test at all. Weyl's inequality for singular values,
 // sigma_i(J) >= sigma_i(J_c) - ||J - J_c||_2 >= sigma_i(J_c) - ||J - J_c||_F, carries a certificate
@@ -40,7 +41,6 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
 #include <Eigen/Eigenvalues>
-#include <Eigen/LU>
 
 #include <algorithm>
 #include <cmath>
@@ -50,6 +50,7 @@ namespace phri {
 class SingularDirectionWeight {
 public:
   using Matrix6d = Eigen::Matrix<double, 6, 6>;
+  using Vector6d = Eigen::Matrix<double, 6, 1>;
 
   /// sigma_0 [m/rad and rad/rad, J's rows mix both]: 0 turns the weighting off.
   /// num_joints: the Jacobians' columns, for the certificate's workspace (another width is tested
@@ -101,6 +102,8 @@ public:
   long decompositions() const { return decompositions_; }
   /// Updates since construction that Weyl's certificate answered without a test.
   long certified_skips() const { return certified_skips_; }
+  /// Tracked updates whose other eigenvalues Weyl's certificate answered without a Cholesky test.
+  long second_certified() const { return second_certified_; }
 
 private:
   // Whether J J^T - bound^2 I has a Cholesky factor: every singular value of J above bound.
@@ -114,6 +117,7 @@ private:
   // The eigen-decomposition of J J^T; remembers the weak direction when there is exactly one.
   bool decompose(double threshold) {
     ++decompositions_;
+    try_second_margin_ = true;
     eigen_.compute(jjt_);
     const Eigen::Matrix<double, 6, 1>& lambda = eigen_.eigenvalues();  // ascending
     has_weak_direction_ = lambda[0] < threshold && lambda[1] >= threshold;
@@ -125,37 +129,69 @@ private:
     return true;
   }
 
-  // Rayleigh-quotient iteration from the last weak direction; true (W formed) only when the result
-  // is checked to be the one eigenvalue below the threshold, to rounding.
+  // Rayleigh-quotient iteration from the last weak direction, in its Jacobi-Davidson form; true (W
+  // formed) only when the result is checked to be the one eigenvalue below the threshold, to rounding.
   bool track_weak_direction(double threshold) {
     const double scale = jjt_.norm() + threshold;
-    Eigen::Matrix<double, 6, 1> u = weak_;
-    double mu = u.dot(jjt_ * u);
-    bool converged = (jjt_ * u - mu * u).norm() <= 1e-14 * scale;
+    Vector6d u = weak_;
+    Vector6d w = jjt_ * u;
+    double mu = u.dot(w);
+    Vector6d residual = w - mu * u;
+    bool converged = residual.norm() <= 1e-14 * scale;
     for (int iteration = 0; iteration < 4 && !converged; ++iteration) {
+      // The step d on u's complement: (P (A - mu I) P + c u u^T) d = -r, P = I - u u^T, r = A u - mu u
+      // (u^T r = 0, so P (A - mu I) P = A - mu I - u r^T - r u^T). u + d is (A - mu I)^-1 u scaled,
+      // the RQI step, but the matrix is positive definite while mu stays below A's second eigenvalue
+      // (a Cholesky factor, no pivoting), and well conditioned where A - mu I is nearly singular.
       shifted_ = jjt_;
       shifted_.diagonal().array() -= mu;
-      lu_.compute(shifted_);
-      Eigen::Matrix<double, 6, 1> next = lu_.solve(u);
-      const double norm = next.norm();
+      shifted_.noalias() -= u * residual.transpose();
+      shifted_.noalias() -= residual * u.transpose();
+      shifted_.noalias() += scale * u * u.transpose();
+      llt_.compute(shifted_);
+      if (llt_.info() != Eigen::Success) return false;
+      u -= llt_.solve(residual);
+      const double norm = u.norm();
       if (!std::isfinite(norm) || norm == 0.0) return false;
-      u = next / norm;
-      mu = u.dot(jjt_ * u);
-      converged = (jjt_ * u - mu * u).norm() <= 1e-14 * scale;
+      u /= norm;
+      w.noalias() = jjt_ * u;
+      mu = u.dot(w);
+      residual = w - mu * u;
+      converged = residual.norm() <= 1e-14 * scale;
     }
-    if (!converged || mu >= threshold) return false;
-    // Every other eigenvalue >= the threshold: A - t I with u's eigenvalue lifted by c > t is PD.
-    shifted_ = jjt_;
-    shifted_.diagonal().array() -= threshold;
-    shifted_.noalias() += (2.0 * scale) * u * u.transpose();
-    llt_.compute(shifted_);
-    if (llt_.info() != Eigen::Success) return false;
+    if (!converged || mu >= threshold || !others_at_or_above(threshold, u, scale)) return false;
     weak_ = u;
     const double lambda = std::max(0.0, mu);
     weight_.setIdentity();
     weight_.noalias() -= (1.0 - std::min(1.0, lambda / threshold)) * u * u.transpose();
     smallest_singular_value_ = std::sqrt(lambda);
     return true;
+  }
+
+  // Whether every eigenvalue of A = J J^T but the one along u is >= the threshold t. A + c u u^T - b I
+  // positive definite gives lambda_1(A) >= b for any unit u (interlacing of a rank-one update), and by
+  // Weyl lambda_1 moves by at most ||A - A_c||_F: a test at b = 4 t carries to the next cycles while
+  // A stays within 3 t of the A_c it was made on. Below 4 t, b = t is tested every cycle, as before.
+  bool others_at_or_above(double threshold, const Vector6d& u, double scale) {
+    if (second_margin_ > 0.0 && (jjt_ - second_jjt_).squaredNorm() < second_margin_ * second_margin_) {
+      ++second_certified_;
+      return true;
+    }
+    second_margin_ = 0.0;
+    const auto lifted_positive_definite = [&](double bound) {
+      shifted_ = jjt_;
+      shifted_.diagonal().array() -= bound;
+      shifted_.noalias() += (2.0 * scale) * u * u.transpose();
+      llt_.compute(shifted_);
+      return llt_.info() == Eigen::Success;
+    };
+    if (try_second_margin_ && lifted_positive_definite(4.0 * threshold)) {
+      second_margin_ = 3.0 * threshold;
+      second_jjt_ = jjt_;
+      return true;
+    }
+    try_second_margin_ = false;  // until the next decomposition: lambda_1 is below 4 t
+    return lifted_positive_definite(threshold);
   }
 
   double sigma0_;
@@ -165,14 +201,17 @@ private:
   long certified_skips_ = 0;
   Eigen::MatrixXd certified_jacobian_;  // J_c: sigma_min(J_c) >= sigma_0 + certified_margin_
   double certified_margin_ = 0.0;       // 0: no certificate
-  Eigen::Matrix<double, 6, 1> weak_ = Eigen::Matrix<double, 6, 1>::Zero();
+  Vector6d weak_ = Vector6d::Zero();
+  Matrix6d second_jjt_ = Matrix6d::Zero();  // A_c: lambda_1(A_c) >= t + second_margin_
+  double second_margin_ = 0.0;              // 0: no certificate
+  bool try_second_margin_ = true;
+  long second_certified_ = 0;
   double smallest_singular_value_ = 0.0;
   Matrix6d jjt_ = Matrix6d::Zero();
   Matrix6d shifted_ = Matrix6d::Zero();
   Matrix6d weight_ = Matrix6d::Identity();
   Eigen::Matrix<double, 6, 1> factor_ = Eigen::Matrix<double, 6, 1>::Ones();
   Eigen::LLT<Matrix6d> llt_{6};
-  Eigen::PartialPivLU<Matrix6d> lu_{6};
   Eigen::SelfAdjointEigenSolver<Matrix6d> eigen_{6};
 };
 
