@@ -66,6 +66,7 @@ SimRobotConfig drop_plant(const DropShared& sh, int index) {
                                    &c.vendor.position_ki_Nm_per_rad_s}) {
       for (double& x : *v) x *= *o.vendor_gain_scale;
     }
+    c.physics_rate_Hz *= std::max(1.0, std::ceil(*o.vendor_gain_scale - 1e-9));
   }
   return c;
 }

@@ -104,7 +104,12 @@ struct DropTestOptions {
   bool model_mismatch = true;
   std::optional<double> cable_damping_Ns_per_m;
   std::optional<double> cable_stiffness_N_per_m;
-  std::optional<double> vendor_gain_scale;  ///< x the vendor position servo's kp, kd, ki
+  /// x the vendor position servo's kp, kd, ki. Above 1 the plant's physics rate goes up by the
+  /// same factor (rounded up to whole multiples of it): the servo is emulated at the physics step, and
+  /// its damping's discrete kd dt / B stays the main row's, so the row varies the gains, not how
+  /// faithfully the emulation integrates them (at x2 and 4 kHz, kd dt / B = 2.5 on joints 1-4: the
+  /// emulation's own Nyquist-rate ringing, not a property of Kinova's drive, whose rate is not published).
+  std::optional<double> vendor_gain_scale;
   std::optional<double> release_spread_scale;  ///< x both release spreads
 };
 

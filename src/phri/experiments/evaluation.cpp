@@ -244,9 +244,14 @@ std::vector<Variant> plant_variants() {
                "not documented by Kinova (reference section 2)",
                [](DropTestOptions& d) { d.servo_encoder = SimRobotConfig::Elasticity::Encoder::kLink; }});
   // Kinova publishes no servo gains (reference section 3: "actual gains ... NOT FOUND").
+  // Above x1 the physics rate rises with the gains (DropTestOptions::vendor_gain_scale says why).
   for (const double scale : {0.5, 2.0}) {
+    const double rate_factor = std::max(1.0, std::ceil(scale - 1e-9));
+    const std::string rate = rate_factor > 1.0 ? ", physics rate x " + format_general(rate_factor, 2) +
+                                                     " (the emulated servo's kd dt / B as the main row's)"
+                                               : "";
     v.push_back({"vendor_gains_x" + format_general(scale, 2), "vendor servo gains",
-                 "vendor servo gains x " + format_general(scale, 2), "no source (Kinova's gains are not published)",
+                 "vendor servo gains x " + format_general(scale, 2) + rate, "no source (Kinova's gains are not published)",
                  [scale](DropTestOptions& d) { d.vendor_gain_scale = scale; }});
   }
   return v;
