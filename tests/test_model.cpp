@@ -381,6 +381,55 @@ TEST(BatchMath, SinCosWithinAnUlpOfLibmAndLibmsOwnBeyondTheReduction) {
   }
 }
 
+// compute_with_shifted factors A and A + diag(d) in one pass: each factor and each solve equal
+// compute()'s bit for bit at every size (the 6- and 7-joint kernels and the general one), and a
+// refused A (indefinite, rescued by the shift) leaves the shifted factor good, and the other way round.
+TEST(SmallCholesky, FactoringWithAShiftedCopyGivesEachFactorBitForBit) {
+  std::mt19937 rng(45);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  for (int n = 1; n <= 12; ++n) {
+    const Eigen::MatrixXd random = Eigen::MatrixXd::NullaryExpr(n, n, [&] { return unit(rng); });
+    const Eigen::MatrixXd a = random * random.transpose() + 0.1 * Eigen::MatrixXd::Identity(n, n);
+    const Eigen::VectorXd shift = Eigen::VectorXd::NullaryExpr(n, [&] { return 0.5 + 0.5 * unit(rng); });
+    Eigen::MatrixXd a_shifted = a;
+    a_shifted.diagonal() += shift;
+    phri::SmallCholesky plain(n), shifted(n), plain_alone(n), shifted_alone(n);
+    ASSERT_TRUE(phri::SmallCholesky::compute_with_shifted(a, shift, plain, shifted)) << n;
+    ASSERT_TRUE(plain_alone.compute(a) && shifted_alone.compute(a_shifted));
+    EXPECT_EQ(Eigen::MatrixXd(plain.factor().triangularView<Eigen::Lower>()),
+              Eigen::MatrixXd(plain_alone.factor().triangularView<Eigen::Lower>())) << n;
+    EXPECT_EQ(Eigen::MatrixXd(shifted.factor().triangularView<Eigen::Lower>()),
+              Eigen::MatrixXd(shifted_alone.factor().triangularView<Eigen::Lower>())) << n;
+    const Eigen::VectorXd b = Eigen::VectorXd::NullaryExpr(n, [&] { return unit(rng); });
+    Eigen::VectorXd x1 = b, x2 = b, y1 = b, y2 = b;
+    plain.solve_in_place(x1);
+    plain_alone.solve_in_place(x2);
+    shifted.solve_in_place(y1);
+    shifted_alone.solve_in_place(y2);
+    EXPECT_EQ(x1, x2) << n;
+    EXPECT_EQ(y1, y2) << n;
+    EXPECT_LT((a_shifted * y1 - b).norm(), 1e-12 * (1.0 + y1.norm())) << n;
+  }
+  // Indefinite A, positive definite A + diag(d): only the shifted factor holds; and the other way round.
+  const Eigen::Matrix3d indefinite = Eigen::Vector3d(1.0, -0.5, 2.0).asDiagonal();
+  phri::SmallCholesky plain(3), shifted(3), alone(3);
+  EXPECT_FALSE(phri::SmallCholesky::compute_with_shifted(indefinite, Eigen::Vector3d::Ones(), plain, shifted));
+  EXPECT_FALSE(plain.ok());
+  EXPECT_TRUE(shifted.ok());
+  ASSERT_TRUE(alone.compute(Eigen::Matrix3d(Eigen::Vector3d(2.0, 0.5, 3.0).asDiagonal())));
+  EXPECT_EQ(Eigen::MatrixXd(shifted.factor().triangularView<Eigen::Lower>()),
+            Eigen::MatrixXd(alone.factor().triangularView<Eigen::Lower>()));
+  EXPECT_FALSE(phri::SmallCholesky::compute_with_shifted(Eigen::Matrix3d::Identity(), -2.0 * Eigen::Vector3d::Ones(), plain, shifted));
+  EXPECT_TRUE(plain.ok());
+  EXPECT_FALSE(shifted.ok());
+  // Sizes that do not match are the caller's error.
+  phri::SmallCholesky two(2);
+  EXPECT_THROW(phri::SmallCholesky::compute_with_shifted(Eigen::Matrix3d::Identity(), Eigen::Vector3d::Ones(), plain, two),
+               phri::ArgumentError);
+  EXPECT_THROW(phri::SmallCholesky::compute_with_shifted(Eigen::Matrix3d::Identity(), Eigen::Vector2d::Ones(), plain, shifted),
+               phri::ArgumentError);
+}
+
 TEST(SmallCholesky, AgreesWithEigensLltToRoundingAndRefusesWhatItRefuses) {
   std::mt19937 rng(44);
   std::uniform_real_distribution<double> unit(-1.0, 1.0);

@@ -256,6 +256,8 @@ Controller::Controller(LoadedRobot robot, const ControllerSettings& settings)
     static_friction_[i] = std::max(actuators_[i].friction.static_Nm, actuators_[i].friction.coulomb_Nm);
   }
   uncancelled_ = UncancelledPush(reflected_inertia_, supervisor_.ranges().transmission_compliance, settings.period_s);
+  // The uncancelled push's M + B, factored with M in compute_all_terms (one pass for both).
+  if (settings.observer_release_gain > 0.0) data_.rotor_inertia = reflected_inertia_;
   add_declared_tasks(settings.tasks);
   add_declared_constraints(settings.constraints);
 }

@@ -50,10 +50,17 @@ const Eigen::VectorXd& UncancelledPush::update(const Data& data, const Eigen::Ve
   from_motion_ = (qd - previous_qd_) / dt - *qdd_commanded;
   previous_qd_ = qd;
   from_torque_ = tau_fast - tau_ext;
-  inertia_ = data.mass_matrix;
-  inertia_.diagonal() += rotor_inertia_;
-  if (!inertia_llt_.compute(inertia_)) return acceleration_;
-  inertia_llt_.solve_in_place(from_torque_);
+  // M + B's factor from compute_all_terms when data carries this B (factored beside M), else here.
+  const bool factored = data.rotor_inertia.size() == rotor_inertia_.size() &&
+                        (data.rotor_inertia.array() == rotor_inertia_.array()).all();
+  const SmallCholesky& llt = factored ? data.mass_matrix_with_rotors_llt : inertia_llt_;
+  if (!factored) {
+    inertia_ = data.mass_matrix;
+    inertia_.diagonal() += rotor_inertia_;
+    inertia_llt_.compute(inertia_);
+  }
+  if (!llt.ok()) return acceleration_;
+  llt.solve_in_place(from_torque_);
   for (Eigen::Index i = 0; i < acceleration_.size(); ++i) {
     const double t = from_torque_[i], m = from_motion_[i];
     if (t > 0.0 && m > 0.0) acceleration_[i] = delivered_[i] * std::min(t, m);

@@ -37,7 +37,8 @@ public:
   /// of each transmission (empty, or 0 where rigid); period_s: the control period.
   UncancelledPush(const Eigen::VectorXd& rotor_inertia, const Eigen::VectorXd& compliance, double period_s);
 
-  /// One cycle. data: after compute_all_terms(q, qd) (M); tau_ext: the estimate the command cancels;
+  /// One cycle. data: after compute_all_terms(q, qd) (M; and M + B's factor when data.rotor_inertia
+  /// is this B, which the update then reuses); tau_ext: the estimate the command cancels;
   /// tau_fast: the observer's fast estimate; qd: this sample's velocity; qdd_commanded: the
   /// acceleration the last cycle's command asked for, or null when it sent none from the QP; dt: the
   /// time since that sample.

@@ -53,7 +53,8 @@ Eigen::Vector3d body_point_jdot_qdot(const Model& model, const Data& data, int b
 // ---- dynamics --------------------------------------------------------------------------
 /// Joint-space inertia matrix M(q) (composite rigid-body algorithm), into data.mass_matrix.
 const Eigen::MatrixXd& crba(const Model& model, Data& data, const Eigen::VectorXd& q);
-/// Cholesky factor of data.mass_matrix (after crba); false if M is not positive definite.
+/// Cholesky factor of data.mass_matrix (after crba); false if M is not positive definite. With
+/// data.rotor_inertia set, also the factor of M + diag(rotor_inertia) (its ok() says if it holds).
 bool compute_mass_matrix_cholesky(Data& data);
 /// x <- M^-1 x using the factor (after compute_mass_matrix_cholesky).
 void mass_matrix_solve_in_place(const Data& data, Eigen::Ref<Eigen::VectorXd> x);

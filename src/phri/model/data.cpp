@@ -13,6 +13,7 @@ Data::Data(const Model& model)
       body_forces(Matrix6Xd::Zero(6, model.nv())),
       mass_matrix(Eigen::MatrixXd::Zero(model.nv(), model.nv())),
       mass_matrix_llt(model.nv()),
+      mass_matrix_with_rotors_llt(model.nv()),
       tau(Eigen::VectorXd::Zero(model.nv())),
       nonlinear_effects(Eigen::VectorXd::Zero(model.nv())),
       gravity_torque(Eigen::VectorXd::Zero(model.nv())),

@@ -26,6 +26,11 @@ struct Data {
   Matrix6Xd body_forces;      ///< RNEA: net spatial force transmitted through joint i
   Eigen::MatrixXd mass_matrix;                 ///< M(q), armature included (crba)
   SmallCholesky mass_matrix_llt;  ///< compute_mass_matrix_cholesky
+  /// The drives' reflected rotor inertias B, where a user sets them (empty by default): then
+  /// compute_mass_matrix_cholesky also factors M + diag(B), what a torque step accelerates through
+  /// rigid gears, in the same pass as M (UncancelledPush reads it).
+  Eigen::VectorXd rotor_inertia;
+  SmallCholesky mass_matrix_with_rotors_llt;  ///< M + diag(rotor_inertia); meaningless while it is empty
   Eigen::VectorXd tau;                ///< rnea output
   Eigen::VectorXd nonlinear_effects;  ///< h(q, qd) = C(q, qd) qd + g(q)
   Eigen::VectorXd gravity_torque;     ///< g(q)

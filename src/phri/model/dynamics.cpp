@@ -153,7 +153,10 @@ const Eigen::MatrixXd& crba(const Model& model, Data& data, const Eigen::VectorX
 }
 
 bool compute_mass_matrix_cholesky(Data& data) {
-  return data.mass_matrix_llt.compute(data.mass_matrix);
+  if (data.rotor_inertia.size() == 0) return data.mass_matrix_llt.compute(data.mass_matrix);
+  SmallCholesky::compute_with_shifted(data.mass_matrix, data.rotor_inertia, data.mass_matrix_llt,
+                                      data.mass_matrix_with_rotors_llt);
+  return data.mass_matrix_llt.ok();
 }
 
 void mass_matrix_solve_in_place(const Data& data, Eigen::Ref<Eigen::VectorXd> x) {

@@ -43,6 +43,26 @@ class SmallCholesky {
     return ok_;
   }
 
+  // Factors A (into `plain`) and A + diag(shift) (into `shifted`), both of size(), in one pass: the
+  // two factorisations' latency chains (a square root and a division per column) interleave. Each
+  // factor is the one compute() gives, bit for bit (the same operations in the same order). Returns
+  // plain.ok() && shifted.ok().
+  static bool compute_with_shifted(const Eigen::Ref<const Eigen::MatrixXd>& a, const Eigen::VectorXd& shift,
+                                   SmallCholesky& plain, SmallCholesky& shifted) {
+    const Index n = plain.size();
+    check_size("SmallCholesky::compute_with_shifted", "rows", a.rows(), n);
+    check_size("SmallCholesky::compute_with_shifted", "cols", a.cols(), n);
+    check_size("SmallCholesky::compute_with_shifted", "shift", shift.size(), n);
+    check_size("SmallCholesky::compute_with_shifted", "shifted factor", shifted.size(), n);
+    Factors both{plain.l_.data(), plain.inverse_diagonal_.data(), shifted.l_.data(), shifted.inverse_diagonal_.data()};
+    const bool ok = n == 7   ? factor_pair_kernel<7>(n, a.data(), a.outerStride(), shift.data(), both)
+                    : n == 6 ? factor_pair_kernel<6>(n, a.data(), a.outerStride(), shift.data(), both)
+                             : factor_pair_kernel<0>(n, a.data(), a.outerStride(), shift.data(), both);
+    plain.ok_ = both.plain_ok;
+    shifted.ok_ = both.shifted_ok;
+    return ok;
+  }
+
   // x <- A^-1 x for a vector, or column by column for a matrix (rows == size(), else ArgumentError).
   template <typename Derived>
   void solve_in_place(Eigen::MatrixBase<Derived>& x) const {
@@ -81,6 +101,50 @@ class SmallCholesky {
       }
     }
     return true;
+  }
+
+  struct Factors {
+    double *plain_l, *plain_inverse_diagonal, *shifted_l, *shifted_inverse_diagonal;
+    bool plain_ok = true, shifted_ok = true;
+  };
+
+  // factor_kernel's steps on A and on A + diag(shift) side by side. A factor whose pivot fails stops
+  // being updated (its ok flag false); the other goes on.
+  template <int N>
+  static bool factor_pair_kernel(Index size, const double* a, Index lda, const double* shift, Factors& f) {
+    const Index n = N > 0 ? N : size;
+    double* l1 = f.plain_l;
+    double* l2 = f.shifted_l;
+    for (Index j = 0; j < n; ++j) {
+      for (Index i = j; i < n; ++i) l1[i + j * n] = l2[i + j * n] = a[i + j * lda];
+      l2[j + j * n] += shift[j];
+    }
+    for (Index j = 0; j < n && (f.plain_ok || f.shifted_ok); ++j) {
+      double* c1 = l1 + j * n;
+      double* c2 = l2 + j * n;
+      f.plain_ok = f.plain_ok && c1[j] > 0.0;
+      f.shifted_ok = f.shifted_ok && c2[j] > 0.0;
+      const double d1 = std::sqrt(f.plain_ok ? c1[j] : 1.0), d2 = std::sqrt(f.shifted_ok ? c2[j] : 1.0);
+      const double inv1 = 1.0 / d1, inv2 = 1.0 / d2;
+      c1[j] = d1;
+      c2[j] = d2;
+      f.plain_inverse_diagonal[j] = inv1;
+      f.shifted_inverse_diagonal[j] = inv2;
+      for (Index i = j + 1; i < n; ++i) {
+        c1[i] *= inv1;
+        c2[i] *= inv2;
+      }
+      for (Index k = j + 1; k < n; ++k) {
+        double* t1 = l1 + k * n;
+        double* t2 = l2 + k * n;
+        const double lkj1 = c1[k], lkj2 = c2[k];
+        for (Index i = k; i < n; ++i) {
+          t1[i] -= lkj1 * c1[i];
+          t2[i] -= lkj2 * c2[i];
+        }
+      }
+    }
+    return f.plain_ok && f.shifted_ok;
   }
 
   // Multiplies by the stored inverse pivots: a division on each step of the two dependent chains
