@@ -6,6 +6,7 @@
 // Each test compares with the same run without the fault where that is the reference.
 #include <phri/control/controller.hpp>
 #include <phri/core/error.hpp>
+#include <phri/experiments/run_validity.hpp>
 #include <phri/model/algorithms.hpp>
 #include <phri/sim/sim_robot.hpp>
 
@@ -265,6 +266,42 @@ TEST(Safety, ASafeStopAfterTheQpFailedUnderAPushKeepsResistingIt) {
     EXPECT_LT(rig.qd().cwiseAbs().maxCoeff(), 0.01);
     EXPECT_LE(rig.limit_excess_, 0.0);
   }
+}
+
+// A run's validity names why its QP fell back: under a 90 N push on the bracelet with the torque
+// limits cut (as above) the hold h - tau_ext asks one joint for more than its limit, and the reason
+// says which joint and how much, the largest |h_i - tau_ext_i| / limit_i over the fallback cycles
+// recomputed here from the controller's model terms and estimate.
+TEST(Safety, AQpFallbackUnderALoadBeyondAnActuatorIsNamedInTheRunsValidity) {
+  const Eigen::Vector3d force = 90.0 * joint_direction("bracelet_link", 1);
+  Rig rig(phri::ComplianceMode::kStiff, phri::LowLevelMode::kCurrent,
+          {hand_push("bracelet_link", Eigen::Vector3d::Zero(), force, 0.5, 2.0)}, [](phri::ControllerSettings& s) {
+            s.qp.torque_limit.resize(7);
+            s.qp.torque_limit << 30, 30, 30, 30, 8, 15, 8;
+          });
+  phri::RunValidity validity;
+  double worst = 0.0;
+  int worst_joint = -1;
+  long fallbacks = 0;
+  rig.run(1.5, {}, [&]() {
+    validity.check_cycle(rig.cycle_.status(), rig.cycle_, rig.command_, false, phri::LowLevelMode::kCurrent);
+    if (rig.cycle_.status() != phri::CycleStatus::kQpFallback) return;
+    ++fallbacks;
+    const Eigen::VectorXd hold = rig.cycle_.data().nonlinear_effects - rig.cycle_.external_torque();
+    for (int i = 0; i < 7; ++i) {
+      const double ratio = std::abs(hold[i]) / rig.cycle_.qp().torque_limit()[i];
+      if (ratio > worst) worst = ratio, worst_joint = i;
+    }
+  });
+  ASSERT_GT(fallbacks, 0) << "the push must make the QP fail for this test to mean anything";
+  EXPECT_EQ(validity.qp_fallbacks, fallbacks);
+  EXPECT_GT(worst, 1.0);
+  EXPECT_EQ(validity.fallback_hold_joint, worst_joint);
+  EXPECT_NEAR(validity.fallback_hold_ratio, worst, 1e-12);
+  const std::string why = validity.invalid_reason();
+  EXPECT_NE(why.find("joint " + std::to_string(worst_joint + 1) + " for "), std::string::npos) << why;
+  EXPECT_NE(why.find("beyond its actuator"), std::string::npos) << why;
+  EXPECT_FALSE(validity.valid());
 }
 
 // A robot that still obeys but asks for a safe stop (RobotState::stop_requested: the Kortex

@@ -158,6 +158,9 @@ public:
   const PowerForceLimitConstraint* power_force_limit() const { return power_force_limit_; }
   const CollisionData* collision_data() const { return self_collision_ ? &self_collision_->data() : nullptr; }
   const Eigen::VectorXd& torque_limit() const { return torque_limit_->torque_limit(); }
+  /// h - tau_ext of the last update: the torque that holds the arm still against the estimated
+  /// load; beyond torque_limit() on a joint, no command within the limits holds it.
+  const Eigen::VectorXd& hold_torque() const { return hold_torque_; }
   /// Per joint, after velocity_limit_fraction.
   const Eigen::VectorXd& velocity_limit() const { return velocity_limit_->velocity_limit(); }
   /// Joint position bounds the dampers keep: limit -+ d_s (infinite for continuous joints).

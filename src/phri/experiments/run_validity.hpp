@@ -21,6 +21,12 @@ struct RunValidity {
   double safe_stop_s = 0.0;
   std::string safe_stop_reason;   ///< the supervisor's fault, with its joint
   long loop_mismatch_cycles = 0;  ///< cycles the command's loop was not the loop the row names
+  /// Over the QP fallbacks, the largest |h - tau_ext|_i / torque limit_i (WholeBodyQp::hold_torque):
+  /// above 1, the estimated load asked a joint for more than its actuator gives, so the QP's bounds
+  /// could not all hold; with its joint (0-based) and torques.
+  double fallback_hold_ratio = 0.0;
+  int fallback_hold_joint = -1;
+  double fallback_hold_Nm = 0.0, fallback_limit_Nm = 0.0;
   std::string loop_ran;           ///< the loop commanded at the last cycle checked
 
   /// One cycle's bookkeeping; `expected` is checked only when `in_named_loop` (after the switch).
