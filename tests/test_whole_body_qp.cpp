@@ -560,14 +560,22 @@ TEST(SingularDirectionWeightTest, IsContinuousThroughTheSingularity) {
   EXPECT_LT(worst, 0.05);
 }
 
+namespace {
+
+// A random n x n orthogonal matrix (Q of a Gaussian matrix's QR), drawn from rng through normal.
+Eigen::MatrixXd random_orthogonal(int n, std::mt19937& rng, std::normal_distribution<double>& normal) {
+  return Eigen::HouseholderQR<Eigen::MatrixXd>(Eigen::MatrixXd::NullaryExpr(n, n, [&] { return normal(rng); })).householderQ();
+}
+
+}  // namespace
+
 // Along a path that stays near a singularity (one weak direction, turning a little each step) the
 // weight is tracked from the last weak direction instead of decomposed anew: the same W as a fresh
 // eigen-decomposition to 1e-12; two weak directions, or a jump, go back to the decomposition.
 TEST(SingularDirectionWeightTest, TrackingTheWeakDirectionGivesTheDecompositionsWeight) {
   std::mt19937 rng(11);
   std::normal_distribution<double> normal;
-  const Eigen::MatrixXd v = Eigen::HouseholderQR<Eigen::MatrixXd>(
-                                Eigen::MatrixXd::NullaryExpr(7, 7, [&] { return normal(rng); })).householderQ();
+  const Eigen::MatrixXd v = random_orthogonal(7, rng, normal);
   auto jacobian_at = [&](double t, double second) {
     // U turns with t; the weakest singular value goes through zero and back, the second stays put.
     Eigen::Matrix<double, 6, 6> generator = Eigen::Matrix<double, 6, 6>::Zero();
@@ -607,10 +615,8 @@ TEST(SingularDirectionWeightTest, TrackingTheWeakDirectionGivesTheDecompositions
 TEST(SingularDirectionWeightTest, TrackingCarriesTheOtherEigenvaluesCheckOnlyWhileItHolds) {
   std::mt19937 rng(5);
   std::normal_distribution<double> normal;
-  const Eigen::MatrixXd v = Eigen::HouseholderQR<Eigen::MatrixXd>(
-                                Eigen::MatrixXd::NullaryExpr(7, 7, [&] { return normal(rng); })).householderQ();
-  const Eigen::MatrixXd u = Eigen::HouseholderQR<Eigen::MatrixXd>(
-                                Eigen::MatrixXd::NullaryExpr(6, 6, [&] { return normal(rng); })).householderQ();
+  const Eigen::MatrixXd v = random_orthogonal(7, rng, normal);
+  const Eigen::MatrixXd u = random_orthogonal(6, rng, normal);
   const double sigma0 = 0.03;
   phri::SingularDirectionWeight tracked(sigma0, 7);
   double worst = 0.0;
@@ -645,10 +651,8 @@ TEST(SingularDirectionWeightTest, TrackingCarriesTheOtherEigenvaluesCheckOnlyWhi
 TEST(SingularDirectionWeightTest, WeylCertificateGivesTheTestsAnswerAlongAPath) {
   std::mt19937 rng(23);
   std::normal_distribution<double> normal;
-  const Eigen::MatrixXd v = Eigen::HouseholderQR<Eigen::MatrixXd>(
-                                Eigen::MatrixXd::NullaryExpr(7, 7, [&] { return normal(rng); })).householderQ();
-  const Eigen::MatrixXd u = Eigen::HouseholderQR<Eigen::MatrixXd>(
-                                Eigen::MatrixXd::NullaryExpr(6, 6, [&] { return normal(rng); })).householderQ();
+  const Eigen::MatrixXd v = random_orthogonal(7, rng, normal);
+  const Eigen::MatrixXd u = random_orthogonal(6, rng, normal);
   const double sigma0 = 0.03;
   phri::SingularDirectionWeight certified(sigma0, 7);
   int far_steps = 0;
