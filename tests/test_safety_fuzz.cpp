@@ -857,6 +857,31 @@ TEST(SafetyFuzz, ThirdPartyWristPushesTheObserverHasNotSeenYetReplayedPass) {
   }
 }
 
+// robots/ur5e, seed 2026 at 3000 pushes: pushes let go. A 177 N ramp on wrist_2_link, released at its
+// peak, left 16 N.m cancelled in the command: the QP asked -490 rad/s^2 of the -850 the bound needed
+// (the uncancelled push emptied the interval and the far bound split the difference), 1.10x. A wrist
+// hand-guided at 2.3 rad/s under full-body compliance, its 102 N push let go: 1.17x. The far bound
+// now yields to the shifted one (WholeBodyQp::bound_uncancelled_push).
+TEST(SafetyFuzz, ThirdPartyWristPushesLetGoReplayedPass) {
+  for (const char* run : {"push/null_space/custom/7", "push/full_body/torque/30"}) {
+    SCOPED_TRACE(run);
+    phri::SafetyFuzzOptions o = small_options("");
+    o.robot_folder = kRoot + "/robots/ur5e";
+    o.seed = 2026;
+    o.pushes = 3000;
+    o.replay = run;
+    const phri::SafetyFuzzResult r = phri::run_safety_fuzz(o);
+    ASSERT_FALSE(r.records.empty());
+    double worst_speed = 0.0;
+    for (const phri::FuzzRecord& x : r.records) {
+      EXPECT_FALSE(x.verdict.invalid) << x.run_id << " #" << x.index;
+      worst_speed = std::max(worst_speed, x.metrics.max_speed_ratio);
+    }
+    std::printf("%s (UR5e, seed 2026): %zu windows, max |qd| / limit %.3f\n", run, r.records.size(), worst_speed);
+    EXPECT_EQ(r.controller_failures(), 0) << phri::safety_fuzz_csv(r);
+  }
+}
+
 // Four windows of seed 31 put their fault on the very sample that carried the switch request; the
 // controller does not switch on a bad sample, so they ran the position loop and were invalid. A
 // fault after a switch now starts after the sample the reference switched on.

@@ -183,11 +183,29 @@ TEST_F(WholeBodyQpTest, AnUncancelledPushMovesTheBoundsInwardByItsAcceleration) 
   // Active on joint 2: the command plus the push lands on the damper's bound.
   EXPECT_NEAR(plain.desired_acceleration()[1], a.ub[1], 1e-6);
   EXPECT_NEAR(pushed.desired_acceleration()[1] + uncancelled[1], a.ub[1], 1e-6);
+  // A push larger than the room between the bounds: the far bound yields to the shifted one, so the
+  // arm gets the paper's upper bound (qdd_d + a_u = ub), where splitting the difference would have
+  // left it above.
+  Eigen::VectorXd wide = Eigen::VectorXd::Zero(7);
+  wide[4] = a.ub[4] - a.lb[4] + 1.0;
+  ASSERT_EQ(pushed.update(model_, data_, q, qd, tau_ext, 1e-3, nullptr, &wide), phri::WholeBodyQpStatus::kOk);
+  ASSERT_EQ(pushed.solve_count(), 2u) << "feasible with the shift: nothing relaxed";
+  EXPECT_EQ(pushed.qp_problem().lb[4], pushed.qp_problem().ub[4]);
+  EXPECT_NEAR(pushed.desired_acceleration()[4] + wide[4], a.ub[4], 1e-6);
+  EXPECT_GE(pushed.desired_acceleration()[4] + wide[4], a.lb[4]);
+  // Joint 2's upper bound is its joint-limit damper's (above), a position guard: a push the other way
+  // that empties the interval does not move it; the two split the difference as before.
+  Eigen::VectorXd against_limit = Eigen::VectorXd::Zero(7);
+  against_limit[1] = -(a.ub[1] - a.lb[1] + 1.0);
+  ASSERT_EQ(pushed.update(model_, data_, q, qd, tau_ext, 1e-3, nullptr, &against_limit), phri::WholeBodyQpStatus::kOk);
+  EXPECT_EQ(pushed.qp_problem().lb[1], pushed.qp_problem().ub[1]);
+  EXPECT_NEAR(pushed.qp_problem().ub[1], a.ub[1] + 0.5, 1e-9);
   // A push the torque limits cannot answer within the bounds: the shift is dropped (last), not the QP.
   Eigen::VectorXd beyond = Eigen::VectorXd::Zero(7);
   beyond[1] = 1e4;
+  const std::size_t solves = pushed.solve_count();
   ASSERT_EQ(pushed.update(model_, data_, q, qd, tau_ext, 1e-3, nullptr, &beyond), phri::WholeBodyQpStatus::kOk);
-  EXPECT_EQ(pushed.solve_count(), 3u);
+  EXPECT_EQ(pushed.solve_count(), solves + 2) << "infeasible with the shift, then without it";
   EXPECT_EQ(pushed.qp_problem().ub, a.ub);
   EXPECT_NEAR(pushed.desired_acceleration()[1], plain.desired_acceleration()[1], 1e-9);
   // Not finite: ignored (the bounds of tau_ext alone); the wrong size: invalid input.

@@ -115,6 +115,9 @@ public:
   }
 
   const Eigen::VectorXd& velocity_limit() const { return velocity_limit_; }
+  /// This cycle's bounds on qdd from the velocity limits alone (the last bound(context, ...)).
+  const Eigen::VectorXd& cycle_lower() const { return lower_; }
+  const Eigen::VectorXd& cycle_upper() const { return upper_; }
 
 private:
   Eigen::VectorXd velocity_limit_, gain_;

@@ -179,12 +179,29 @@ void WholeBodyQp::fill_constraints(const ConstraintContext& context) {
 }
 
 // The bounds on qdd hold the real acceleration (constraint.hpp): the command's qdd_d plus a_u, the
-// push the command does not cancel yet. Each bound only moves inward: ub - max(a_u, 0), lb - min(a_u, 0).
+// push the command does not cancel yet. Each bound only moves inward: ub - max(a_u, 0), lb - min(a_u, 0),
+// so an overestimate asks no acceleration beyond the paper's bounds. Where that empties the interval
+// and the far bound is the velocity limit's own, it yields to the shifted one: qdd_d = ub - a_u gives
+// the arm ub >= lb, where splitting the difference left it (lb + ub + a_u) / 2 > ub (replayed: a UR5e
+// wrist after a 177 N ramp let go, qdd_d -490 for -850 needed). A far bound that guards a position
+// (a joint-limit damper, a collision braking bound) does not yield: an overestimated a_u would drive
+// the joint into it (replayed: a UR5e dragged at its speed limit, through a joint limit).
 void WholeBodyQp::bound_uncancelled_push() {
   for (int i = 0; i < nv_; ++i) {
     const double a = (*qdd_uncancelled_)[i];
-    if (a > 0.0) problem_.ub[i] -= a;
-    if (a < 0.0) problem_.lb[i] -= a;
+    if (!(problem_.lb[i] <= problem_.ub[i])) continue;  // already empty: split below
+    if (a > 0.0) {
+      problem_.ub[i] -= a;
+      if (problem_.lb[i] > problem_.ub[i] && velocity_limit_ && problem_.lb[i] == velocity_limit_->cycle_lower()[i]) {
+        problem_.lb[i] = problem_.ub[i];
+      }
+    }
+    if (a < 0.0) {
+      problem_.lb[i] -= a;
+      if (problem_.ub[i] < problem_.lb[i] && velocity_limit_ && problem_.ub[i] == velocity_limit_->cycle_upper()[i]) {
+        problem_.ub[i] = problem_.lb[i];
+      }
+    }
   }
 }
 
