@@ -830,20 +830,15 @@ TEST(SafetyFuzz, FaultsInMotionFormerFailuresReplayedPass) {
   EXPECT_EQ(r.held_command_windows(), 1);
 }
 
-// robots/ur5e, the command line's protocol at 400 pushes (seed 777). Step and ramp pushes of 126-162 N
-// on the wrist took a wrist joint from rest past 1.17x its limit in a few milliseconds while the
-// observer (20 ms) had seen 40 % of the push: the QP's bounds held the command, not the arm. The
-// bounds now hold the push the command does not cancel yet (uncancelled_push.hpp). A +50 N.m spike
-// on a wrist's torque sensor for 100 cycles is no push: the motion does not show it (1.37x when the
-// fast estimate alone was believed, 0.09x now).
-TEST(SafetyFuzz, ThirdPartyWristPushesTheObserverHasNotSeenYetReplayedPass) {
-  for (const char* run : {"push/null_space/torque/3", "push/dual/torque/0", "push/stiff/custom/0",
-                          "fault/full_body/torque/spike_tau_50Nm/100"}) {
+// Replays UR5e windows of the command line's protocol (seed, pushes) and expects every one valid and
+// passed; prints each run's worst |qd| / limit.
+void expect_ur5e_windows_pass(std::uint64_t seed, int pushes, std::initializer_list<const char*> runs) {
+  for (const char* run : runs) {
     SCOPED_TRACE(run);
     phri::SafetyFuzzOptions o = small_options("");
     o.robot_folder = kRoot + "/robots/ur5e";
-    o.seed = 777;
-    o.pushes = 400;
+    o.seed = seed;
+    o.pushes = pushes;
     o.replay = run;
     const phri::SafetyFuzzResult r = phri::run_safety_fuzz(o);
     ASSERT_FALSE(r.records.empty());
@@ -852,9 +847,21 @@ TEST(SafetyFuzz, ThirdPartyWristPushesTheObserverHasNotSeenYetReplayedPass) {
       EXPECT_FALSE(x.verdict.invalid) << x.run_id << " #" << x.index;
       worst_speed = std::max(worst_speed, x.metrics.max_speed_ratio);
     }
-    std::printf("%s (UR5e, seed 777): %zu windows, max |qd| / limit %.3f\n", run, r.records.size(), worst_speed);
+    std::printf("%s (UR5e, seed %llu): %zu windows, max |qd| / limit %.3f\n", run,
+                static_cast<unsigned long long>(seed), r.records.size(), worst_speed);
     EXPECT_EQ(r.controller_failures(), 0) << phri::safety_fuzz_csv(r);
   }
+}
+
+// robots/ur5e, the command line's protocol at 400 pushes (seed 777). Step and ramp pushes of 126-162 N
+// on the wrist took a wrist joint from rest past 1.17x its limit in a few milliseconds while the
+// observer (20 ms) had seen 40 % of the push: the QP's bounds held the command, not the arm. The
+// bounds now hold the push the command does not cancel yet (uncancelled_push.hpp). A +50 N.m spike
+// on a wrist's torque sensor for 100 cycles is no push: the motion does not show it (1.37x when the
+// fast estimate alone was believed, 0.09x now).
+TEST(SafetyFuzz, ThirdPartyWristPushesTheObserverHasNotSeenYetReplayedPass) {
+  expect_ur5e_windows_pass(777, 400, {"push/null_space/torque/3", "push/dual/torque/0", "push/stiff/custom/0",
+                                      "fault/full_body/torque/spike_tau_50Nm/100"});
 }
 
 // robots/ur5e, seed 2026 at 3000 pushes: pushes let go. A 177 N ramp on wrist_2_link, released at its
@@ -863,23 +870,7 @@ TEST(SafetyFuzz, ThirdPartyWristPushesTheObserverHasNotSeenYetReplayedPass) {
 // hand-guided at 2.3 rad/s under full-body compliance, its 102 N push let go: 1.17x. The far bound
 // now yields to the shifted one (WholeBodyQp::bound_uncancelled_push).
 TEST(SafetyFuzz, ThirdPartyWristPushesLetGoReplayedPass) {
-  for (const char* run : {"push/null_space/custom/7", "push/full_body/torque/30"}) {
-    SCOPED_TRACE(run);
-    phri::SafetyFuzzOptions o = small_options("");
-    o.robot_folder = kRoot + "/robots/ur5e";
-    o.seed = 2026;
-    o.pushes = 3000;
-    o.replay = run;
-    const phri::SafetyFuzzResult r = phri::run_safety_fuzz(o);
-    ASSERT_FALSE(r.records.empty());
-    double worst_speed = 0.0;
-    for (const phri::FuzzRecord& x : r.records) {
-      EXPECT_FALSE(x.verdict.invalid) << x.run_id << " #" << x.index;
-      worst_speed = std::max(worst_speed, x.metrics.max_speed_ratio);
-    }
-    std::printf("%s (UR5e, seed 2026): %zu windows, max |qd| / limit %.3f\n", run, r.records.size(), worst_speed);
-    EXPECT_EQ(r.controller_failures(), 0) << phri::safety_fuzz_csv(r);
-  }
+  expect_ur5e_windows_pass(2026, 3000, {"push/null_space/custom/7", "push/full_body/torque/30"});
 }
 
 // Four windows of seed 31 put their fault on the very sample that carried the switch request; the
