@@ -185,20 +185,22 @@ void WholeBodyQp::fill_constraints(const ConstraintContext& context) {
 // the arm ub >= lb, where splitting the difference left it (lb + ub + a_u) / 2 > ub (replayed: a UR5e
 // wrist after a 177 N ramp let go, qdd_d -490 for -850 needed). A far bound that guards a position
 // (a joint-limit damper, a collision braking bound) does not yield: an overestimated a_u would drive
-// the joint into it (replayed: a UR5e dragged at its speed limit, through a joint limit).
+// the joint into it. An interval empty before the shift is split below, as before.
 void WholeBodyQp::bound_uncancelled_push() {
   for (int i = 0; i < nv_; ++i) {
     const double a = (*qdd_uncancelled_)[i];
-    if (!(problem_.lb[i] <= problem_.ub[i])) continue;  // already empty: split below
+    const bool open = problem_.lb[i] <= problem_.ub[i];
     if (a > 0.0) {
       problem_.ub[i] -= a;
-      if (problem_.lb[i] > problem_.ub[i] && velocity_limit_ && problem_.lb[i] == velocity_limit_->cycle_lower()[i]) {
+      if (open && problem_.lb[i] > problem_.ub[i] && velocity_limit_ &&
+          problem_.lb[i] == velocity_limit_->cycle_lower()[i]) {
         problem_.lb[i] = problem_.ub[i];
       }
     }
     if (a < 0.0) {
       problem_.lb[i] -= a;
-      if (problem_.ub[i] < problem_.lb[i] && velocity_limit_ && problem_.ub[i] == velocity_limit_->cycle_upper()[i]) {
+      if (open && problem_.ub[i] < problem_.lb[i] && velocity_limit_ &&
+          problem_.ub[i] == velocity_limit_->cycle_upper()[i]) {
         problem_.ub[i] = problem_.lb[i];
       }
     }
