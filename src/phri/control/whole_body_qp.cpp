@@ -183,7 +183,8 @@ void WholeBodyQp::fill_constraints(const ConstraintContext& context) {
 // so an overestimate asks no acceleration beyond the paper's bounds. Where that empties the interval
 // and the far bound is the velocity limit's own, it yields to the shifted one: qdd_d = ub - a_u gives
 // the arm ub >= lb, where splitting the difference left it (lb + ub + a_u) / 2 > ub (replayed: a UR5e
-// wrist after a 177 N ramp let go, qdd_d -490 for -850 needed). A far bound that guards a position
+// wrist after a 177 N ramp let go: qdd_d -310 to -460 rad/s^2 against 560-700 of estimated uncancelled
+// push, and the wrist went on accelerating to 1.10x its limit). A far bound that guards a position
 // (a joint-limit damper, a collision braking bound) does not yield: an overestimated a_u would drive
 // the joint into it. An interval empty before the shift is split below, as before.
 void WholeBodyQp::bound_uncancelled_push() {
