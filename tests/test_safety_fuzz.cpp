@@ -832,11 +832,11 @@ TEST(SafetyFuzz, FaultsInMotionFormerFailuresReplayedPass) {
 
 // Replays UR5e windows of the command line's protocol (seed, pushes) and expects every one valid and
 // passed; prints each run's worst |qd| / limit.
-void expect_ur5e_windows_pass(std::uint64_t seed, int pushes, std::initializer_list<const char*> runs) {
+void expect_windows_pass(const std::string& robot, std::uint64_t seed, int pushes, std::initializer_list<const char*> runs) {
   for (const char* run : runs) {
     SCOPED_TRACE(run);
     phri::SafetyFuzzOptions o = small_options("");
-    o.robot_folder = kRoot + "/robots/ur5e";
+    o.robot_folder = kRoot + "/robots/" + robot;
     o.seed = seed;
     o.pushes = pushes;
     o.replay = run;
@@ -847,7 +847,7 @@ void expect_ur5e_windows_pass(std::uint64_t seed, int pushes, std::initializer_l
       EXPECT_FALSE(x.verdict.invalid) << x.run_id << " #" << x.index;
       worst_speed = std::max(worst_speed, x.metrics.max_speed_ratio);
     }
-    std::printf("%s (UR5e, seed %llu): %zu windows, max |qd| / limit %.3f\n", run,
+    std::printf("%s (%s, seed %llu): %zu windows, max |qd| / limit %.3f\n", run, robot.c_str(),
                 static_cast<unsigned long long>(seed), r.records.size(), worst_speed);
     EXPECT_EQ(r.controller_failures(), 0) << phri::safety_fuzz_csv(r);
   }
@@ -860,7 +860,7 @@ void expect_ur5e_windows_pass(std::uint64_t seed, int pushes, std::initializer_l
 // on a wrist's torque sensor for 100 cycles is no push: the motion does not show it (1.37x when the
 // fast estimate alone was believed, 0.09x now).
 TEST(SafetyFuzz, ThirdPartyWristPushesTheObserverHasNotSeenYetReplayedPass) {
-  expect_ur5e_windows_pass(777, 400, {"push/null_space/torque/3", "push/dual/torque/0", "push/stiff/custom/0",
+  expect_windows_pass("ur5e", 777, 400, {"push/null_space/torque/3", "push/dual/torque/0", "push/stiff/custom/0",
                                       "fault/full_body/torque/spike_tau_50Nm/100"});
 }
 
@@ -871,7 +871,16 @@ TEST(SafetyFuzz, ThirdPartyWristPushesTheObserverHasNotSeenYetReplayedPass) {
 // (a wrist hand-guided at 2.3 rad/s under full-body compliance, its 102 N push let go) passed before
 // too; it failed (1.17x) with a torque side through M^-1 alone, tried and not kept, and stays as a check.
 TEST(SafetyFuzz, ThirdPartyWristPushesLetGoReplayedPass) {
-  expect_ur5e_windows_pass(2026, 3000, {"push/null_space/custom/7", "push/full_body/torque/30"});
+  expect_windows_pass("ur5e", 2026, 3000, {"push/null_space/custom/7", "push/full_body/torque/30"});
+}
+
+// robots/franka_panda, seed 31415 at 3000 pushes: a 5 N.m offset on joint 7's torque sensor for 100
+// cycles while the arm moves. The observer reads it as a push, stiff mode cancels it, and the command's
+// extra torque sped the light wrist up to 1.06-1.13x its limit before the torque-against-current check
+// stopped it; the uncancelled push was 0 (the torque side, fooled too, disagreed with the motion in
+// sign). Where the motion speeds a joint up, it is now taken alone (uncancelled_push.hpp).
+TEST(SafetyFuzz, ThirdPartyTorqueSensorOffsetWhileMovingReplayedPass) {
+  expect_windows_pass("franka_panda", 31415, 3000, {"motion/stiff/torque/offset_tau_5Nm"});
 }
 
 // Four windows of seed 31 put their fault on the very sample that carried the switch request; the

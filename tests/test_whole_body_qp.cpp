@@ -200,14 +200,26 @@ TEST_F(WholeBodyQpTest, AnUncancelledPushMovesTheBoundsInwardByItsAcceleration) 
   ASSERT_EQ(pushed.update(model_, data_, q, qd, tau_ext, 1e-3, nullptr, &against_limit), phri::WholeBodyQpStatus::kOk);
   EXPECT_EQ(pushed.qp_problem().lb[1], pushed.qp_problem().ub[1]);
   EXPECT_NEAR(pushed.qp_problem().ub[1], a.ub[1] + 0.5, 1e-9);
-  // A push the torque limits cannot answer within the bounds: the shift is dropped (last), not the QP.
+  // A push the torque limits cannot answer within the bounds: the shift is halved (a solve each) while
+  // the QP is infeasible with it, then dropped (last), never the QP. 1e4 rad/s^2 on joint 2: the
+  // bound held is a.ub - 1e4 / 2^k for the first k that is feasible, or a.ub once dropped.
   Eigen::VectorXd beyond = Eigen::VectorXd::Zero(7);
   beyond[1] = 1e4;
   const std::size_t solves = pushed.solve_count();
   ASSERT_EQ(pushed.update(model_, data_, q, qd, tau_ext, 1e-3, nullptr, &beyond), phri::WholeBodyQpStatus::kOk);
-  EXPECT_EQ(pushed.solve_count(), solves + 2) << "infeasible with the shift, then without it";
-  EXPECT_EQ(pushed.qp_problem().ub, a.ub);
-  EXPECT_NEAR(pushed.desired_acceleration()[1], plain.desired_acceleration()[1], 1e-9);
+  const std::size_t extra = pushed.solve_count() - solves;
+  ASSERT_GE(extra, 2u) << "infeasible with the whole shift";
+  ASSERT_LE(extra, 5u) << "three halvings, then without it";
+  if (extra == 5u) {
+    EXPECT_EQ(pushed.qp_problem().ub[1], a.ub[1]) << "dropped: the paper's bound";
+  } else {
+    EXPECT_LT(pushed.qp_problem().ub[1], a.ub[1]) << "a share held";
+  }
+  for (int i = 0; i < 7; ++i) {
+    if (i == 1) continue;
+    EXPECT_EQ(pushed.qp_problem().ub[i], a.ub[i]) << i;
+    EXPECT_EQ(pushed.qp_problem().lb[i], a.lb[i]) << i;
+  }
   // Not finite: ignored (the bounds of tau_ext alone); the wrong size: invalid input.
   Eigen::VectorXd bad = uncancelled;
   bad[3] = std::numeric_limits<double>::quiet_NaN();
@@ -220,9 +232,11 @@ TEST_F(WholeBodyQpTest, AnUncancelledPushMovesTheBoundsInwardByItsAcceleration) 
 
 // UncancelledPush against closed forms: a_u = (M + B)^-1 (tau_fast - tau_ext) from the torque side
 // (reference: Eigen's LDLT of M + diag(B)) and (qd - qd_prev) / dt - qdd_commanded from the motion;
-// per joint the smaller where they agree in sign, else 0. A torque-sensor spike the motion does not
-// show is no push; without a previous QP command there is no motion evidence.
-TEST(UncancelledPush, IsTheSmallerOfTheTorqueAndMotionEstimatesWhereTheyAgree) {
+// per joint the motion where it speeds the joint up (m qd > 0), else the smaller where they agree in
+// sign, else 0. A torque-sensor spike the motion does not show is no push; one the motion shows
+// speeding a joint up (the command cancelling a phantom) is; without a previous QP command there is
+// no motion evidence.
+TEST(UncancelledPush, IsTheMotionWhereItSpeedsAJointUpElseTheSmallerOfTheTwoWhereTheyAgree) {
   const phri::Model model = phri::Model::from_urdf_file(kGen3 + "gen3.urdf");
   phri::Data data(model);
   Eigen::VectorXd q(7), qd0(7);
@@ -248,6 +262,7 @@ TEST(UncancelledPush, IsTheSmallerOfTheTorqueAndMotionEstimatesWhereTheyAgree) {
     const char* what;
     double motion_share;  // the motion shows this share of the torque side's acceleration
   };
+  int sped_up_any = 0, slowed_any = 0;
   for (const Case c : {Case{"the motion shows the whole push", 1.0}, Case{"the motion shows half of it", 0.5},
                        Case{"the motion shows more", 1.5}, Case{"the motion goes the other way", -1.0},
                        Case{"no motion beyond the command (a sensor spike)", 0.0}}) {
@@ -260,8 +275,20 @@ TEST(UncancelledPush, IsTheSmallerOfTheTorqueAndMotionEstimatesWhereTheyAgree) {
     EXPECT_EQ(count.allocations(), 0u);
     EXPECT_LT((e.from_torque() - truth).cwiseAbs().maxCoeff(), 1e-9 * truth.cwiseAbs().maxCoeff());
     const double share = c.motion_share <= 0.0 ? 0.0 : std::min(c.motion_share, 1.0);
-    EXPECT_LT((a - share * truth).cwiseAbs().maxCoeff(), 1e-6 * truth.cwiseAbs().maxCoeff()) << a.transpose();
+    const Eigen::VectorXd motion = c.motion_share * truth;
+    int sped_up = 0;
+    for (int i = 0; i < 7; ++i) {
+      const bool speeds_up = motion[i] * qd1[i] > 0.0;
+      sped_up += speeds_up ? 1 : 0;
+      EXPECT_NEAR(a[i], speeds_up ? motion[i] : share * truth[i], 1e-6 * truth.cwiseAbs().maxCoeff()) << i;
+    }
+    if (c.motion_share != 0.0) {
+      sped_up_any += sped_up;
+      slowed_any += 7 - sped_up;
+    }
   }
+  EXPECT_GT(sped_up_any, 0) << "the cases exercise both rules";
+  EXPECT_GT(slowed_any, 0) << "the cases exercise both rules";
   // The previous cycle sent no QP command, or the estimate was forgotten: no motion evidence.
   phri::UncancelledPush e(rotor, Eigen::VectorXd(), dt);
   e.update(data, tau_ext, tau_fast, qd0, &commanded, dt);

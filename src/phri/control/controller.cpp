@@ -223,6 +223,8 @@ Controller::Controller(LoadedRobot robot, const ControllerSettings& settings)
       tau_ext_(Eigen::VectorXd::Zero(model_.nv())),
       tau_ext_fast_(Eigen::VectorXd::Zero(model_.nv())),
       uncancelled_(Eigen::VectorXd::Zero(model_.nv()), Eigen::VectorXd(), settings.period_s),
+      qdd_sent_(Eigen::VectorXd::Zero(model_.nv())),
+      sent_change_(Eigen::VectorXd::Zero(model_.nv())),
       trigger_filter_(settings.wrench_trigger_filter_s, settings.period_s),
       estimate_torque_(Eigen::VectorXd::Zero(model_.nv())),
       ft_fusion_(model_.nv(), settings.observer_gain, settings.period_s),
@@ -460,8 +462,21 @@ bool Controller::estimate_uncancelled_push(bool torque_loop, bool commanded_last
   // After missed periods the arm ran on a held command, and the fast observer's step (gain x dt)
   // overshoots: no motion evidence across a gap.
   const bool one_period = dt <= 1.5 * settings_.period_s;
-  uncancelled_.update(data_, tau_ext_, tau_ext_fast_, qd_, commanded_last && one_period ? &qp_.desired_acceleration() : nullptr, dt);
+  uncancelled_.update(data_, tau_ext_, tau_ext_fast_, qd_, commanded_last && one_period ? &qdd_sent_ : nullptr, dt);
   return true;
+}
+
+// The acceleration the command sent asks of the arm: the QP's qdd_d, plus (M + B)^-1 of what the
+// guards and the clamps changed in its torque. The motion is measured against it: a brake the
+// guard added, or a command cut at its torque limit, is the command's own doing, not a push.
+void Controller::note_sent_acceleration() {
+  qdd_sent_ = qp_.desired_acceleration();
+  if (guarded_tau_ == qp_.desired_torque() || data_.rotor_inertia.size() == 0 || !data_.mass_matrix_with_rotors_llt.ok()) {
+    return;
+  }
+  sent_change_ = guarded_tau_ - qp_.desired_torque();
+  data_.mass_matrix_with_rotors_llt.solve_in_place(sent_change_);
+  qdd_sent_ += sent_change_;
 }
 
 // Keeps the previous command while the supervisor holds the last good state (bounded: it turns
@@ -894,6 +909,7 @@ CycleStatus Controller::step(const RobotState& state, const ControllerTargets& t
   guarded_tau_ = qp_.desired_torque();
   guard_torque(guarded_tau_);
   low_level_.update(state, guarded_tau_, qp_.desired_acceleration(), command);
+  note_sent_acceleration();
   supervisor_.note_command(command);
   have_command_ = true;
   qp_commanded_ = true;

@@ -164,6 +164,7 @@ private:
   void select_external_torque();
   void bound_external_torque(Eigen::VectorXd& tau) const;
   bool estimate_uncancelled_push(bool torque_loop, bool commanded_last, double dt);
+  void note_sent_acceleration();
   void update_modes_and_targets();
   void shape_tasks();
   void guard_torque(Eigen::VectorXd& tau);
@@ -200,6 +201,8 @@ private:
   Eigen::VectorXd tau_ext_fast_;             // the observer's fast estimate, bounded as tau_ext_
   UncancelledPush uncancelled_;
   bool qp_commanded_ = false;                // the last cycle sent the QP's command
+  Eigen::VectorXd qdd_sent_;                 // what that command asks of the arm, the guards' change included
+  Eigen::VectorXd sent_change_;              // its part from the guards: (M + B)^-1 (guarded - QP torque)
   bool ft_torque_current_ = false;           // ft_torque_ is J^T F on this cycle's model terms
   Eigen::Matrix<double, 6, 2> wrench_history_ = Eigen::Matrix<double, 6, 2>::Zero();  // the two previous samples
   Vector6d wrench_median_ = Vector6d::Zero();

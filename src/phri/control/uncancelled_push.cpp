@@ -63,6 +63,10 @@ const Eigen::VectorXd& UncancelledPush::update(const Data& data, const Eigen::Ve
   llt.solve_in_place(from_torque_);
   for (Eigen::Index i = 0; i < acceleration_.size(); ++i) {
     const double t = from_torque_[i], m = from_motion_[i];
+    if (m * qd[i] > 0.0) {  // speeding the joint up: the motion alone (header)
+      acceleration_[i] = delivered_[i] * m;
+      continue;
+    }
     if (t > 0.0 && m > 0.0) acceleration_[i] = delivered_[i] * std::min(t, m);
     if (t < 0.0 && m < 0.0) acceleration_[i] = delivered_[i] * std::max(t, m);
   }

@@ -10,11 +10,15 @@
 // Two estimates of a_u, each fooled by a different fault:
 // - the observer's fast path (MomentumObserver::fast_external_torque, ~500/s): tau_true ~ tau_fast;
 //   a spike or offset on a torque sensor reads as a push;
-// - the arm's motion over the last period: (qd - qd_prev) / dt - qdd_d(prev); velocity noise and
-//   the torque loop's tracking error read as one.
-// acceleration() takes, per joint, the smaller of the two where they agree in sign, and 0 where they
-// do not: a push both the torque sensors and the motion show. WholeBodyQp's bounds hold for it.
-// Without motion evidence (the first cycle, after a cycle with no QP command) it is 0.
+// - the arm's motion over the last period: (qd - qd_prev) / dt - qdd_sent(prev), qdd_sent the
+//   acceleration the command sent asks (the QP's, plus what the guards changed in its torque);
+//   velocity noise and the torque loop's tracking error read as one.
+// acceleration() takes, per joint, the motion alone where it speeds the joint up (m qd > 0): that is
+// the direction that overspeeds, and where an offset on a torque sensor shows (the observer reads a
+// push that is not there, the command cancels it, and the torque side, fooled too, may disagree in
+// sign). Elsewhere the smaller of the two where they agree in sign, and 0 where they do not.
+// WholeBodyQp's bounds hold for it. Without motion evidence (the first cycle, after a cycle with no
+// QP command) it is 0.
 //
 // Both the motion estimate and the bound's counter-acceleration assume a command reaches the link
 // within the period, as through rigid gears. Through an elastic transmission (stiffness K behind a
@@ -40,8 +44,8 @@ public:
   /// One cycle. data: after compute_all_terms(q, qd) (M; and M + B's factor when data.rotor_inertia
   /// is this B, which the update then reuses); tau_ext: the estimate the command cancels;
   /// tau_fast: the observer's fast estimate; qd: this sample's velocity; qdd_commanded: the
-  /// acceleration the last cycle's command asked for, or null when it sent none from the QP; dt: the
-  /// time since that sample.
+  /// acceleration the last cycle's command asked of the arm (as sent), or null when it sent none from
+  /// the QP; dt: the time since that sample.
   const Eigen::VectorXd& update(const Data& data, const Eigen::VectorXd& tau_ext, const Eigen::VectorXd& tau_fast,
                                 const Eigen::VectorXd& qd, const Eigen::VectorXd* qdd_commanded, double dt);
   /// No estimate this cycle (a mode without it): the next update has no motion evidence either.

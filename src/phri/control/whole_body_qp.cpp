@@ -189,7 +189,7 @@ void WholeBodyQp::fill_constraints(const ConstraintContext& context) {
 // the joint into it. An interval empty before the shift is split below, as before.
 void WholeBodyQp::bound_uncancelled_push() {
   for (int i = 0; i < nv_; ++i) {
-    const double a = (*qdd_uncancelled_)[i];
+    const double a = uncancelled_share_ * (*qdd_uncancelled_)[i];
     const bool open = problem_.lb[i] <= problem_.ub[i];
     if (a > 0.0) {
       problem_.ub[i] -= a;
@@ -212,7 +212,13 @@ bool WholeBodyQp::relax_a_constraint() {
   for (const auto& constraint : constraints_) {
     if (constraint->relax()) return true;
   }
-  // Last: the uncancelled push's share of the bounds (the paper's bounds stay).
+  // Last: the uncancelled push's share of the bounds, halved up to three times (a push beyond what
+  // the torque limits can counter is countered as far as they allow, not left whole to the arm),
+  // then dropped (the paper's bounds stay).
+  if (qdd_uncancelled_ && uncancelled_share_ > 0.2) {
+    uncancelled_share_ *= 0.5;
+    return true;
+  }
   if (qdd_uncancelled_) {
     qdd_uncancelled_ = nullptr;
     return true;
@@ -234,6 +240,7 @@ WholeBodyQpStatus WholeBodyQp::update(const Model& model, const Data& data, cons
   data.mass_matrix_llt.solve_in_place(qdd_external_);
   // Not finite: ignored (tau_ext, checked above, still bounds the arm).
   qdd_uncancelled_ = uncancelled_acceleration && uncancelled_acceleration->allFinite() ? uncancelled_acceleration : nullptr;
+  uncancelled_share_ = 1.0;
 
   const TaskContext task_context{model, data, q, qd, tau_ext, qdd_external_, ee_wrench_world, dt};
   for (const auto& task : tasks_) task->update(task_context);

@@ -199,6 +199,7 @@ private:
   Eigen::VectorXd deadband_;
   Eigen::VectorXd qdd_external_, qdd_desired_, tau_desired_, last_good_tau_;
   const Eigen::VectorXd* qdd_uncancelled_ = nullptr;  // this update's; null: none, or dropped as infeasible
+  double uncancelled_share_ = 1.0;                     // the share of it the bounds hold (halved when infeasible)
   Eigen::VectorXd hold_torque_, inertia_diagonal_;  // the constraints' context
   Eigen::VectorXd hessian_diagonal_;                // the tasks' diagonal Hessian terms (ObjectiveTerms)
   WholeBodyQpStatus status_ = WholeBodyQpStatus::kOk;
