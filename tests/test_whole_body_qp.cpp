@@ -201,8 +201,9 @@ TEST_F(WholeBodyQpTest, AnUncancelledPushMovesTheBoundsInwardByItsAcceleration) 
   EXPECT_EQ(pushed.qp_problem().lb[1], pushed.qp_problem().ub[1]);
   EXPECT_NEAR(pushed.qp_problem().ub[1], a.ub[1] + 0.5, 1e-9);
   // A push the torque limits cannot answer within the bounds: the shift is halved (a solve each) while
-  // the QP is infeasible with it, then dropped (last), never the QP. 1e4 rad/s^2 on joint 2: the
-  // bound held is a.ub - 1e4 / 2^k for the first k that is feasible, or a.ub once dropped.
+  // the QP is infeasible with it, then dropped (last), never the QP. 1e4 rad/s^2 on joint 2: between
+  // one and four more solves; joint 2's upper bound below the paper's while a share is held, the
+  // paper's once dropped; the other joints' bounds untouched.
   Eigen::VectorXd beyond = Eigen::VectorXd::Zero(7);
   beyond[1] = 1e4;
   const std::size_t solves = pushed.solve_count();
