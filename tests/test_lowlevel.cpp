@@ -342,3 +342,53 @@ TEST(VendorLoops, FrictionAssistFollowsASlowSlideTheTaskStillAccelerates) {
 }
 
 }  // namespace
+
+// A loop entered from the drives' current starts from its average over the cycles before the
+// switch (first order, kEntryCurrentTime_s), so one noisy sample is not held as an offset: closed
+// forms for the custom loop's first current, a vendor loop's first set-point, and the average's
+// restart after a hold (the first reading then counts whole).
+TEST(LoopEntry, StartsFromTheMeasuredCurrentAveragedBeforeTheSwitchNotItsLastSample) {
+  const phri::ActuatorTable table = phri::ActuatorTable::from_yaml_file(kActuators);
+  const phri::CustomTorqueSettings settings;
+  const double weight = settings.period_s / (phri::LowLevelController::kEntryCurrentTime_s + settings.period_s);
+  const Eigen::VectorXd tau_d = Eigen::VectorXd::Zero(7), qdd = Eigen::VectorXd::Zero(7);
+  Eigen::VectorXd steady(7), spike(7);
+  for (int i = 0; i < 7; ++i) {
+    steady[i] = 0.05 + 0.01 * i;
+    spike[i] = i % 2 == 0 ? 0.05 : -0.03;
+  }
+  for (const phri::LowLevelMode loop : {phri::LowLevelMode::kCurrent, phri::LowLevelMode::kKinovaTorque}) {
+    SCOPED_TRACE(std::string(phri::to_string(loop)));
+    phri::LowLevelController low(table, settings, phri::LowLevelMode::kPosition);
+    phri::RobotState state = resting_state();
+    state.current.valid = true;
+    state.current_A = steady;
+    phri::RobotCommand command(7);
+    for (int k = 0; k < 400; ++k) low.update(state, tau_d, qdd, command);
+    state.current_A = steady + spike;  // the switch cycle's sample is off by the spike
+    low.request(loop);
+    low.update(state, tau_d, qdd, command);
+    ASSERT_EQ(command.mode, loop);
+    for (int i = 0; i < 7; ++i) {
+      const double entry = steady[i] + weight * spike[i];  // the average: the spike enters by its weight
+      if (loop == phri::LowLevelMode::kCurrent) {
+        EXPECT_NEAR(command.current_A[i], entry, 1e-12) << "joint " << i + 1;
+      } else {
+        EXPECT_NEAR(command.tau_Nm[i], table[i].torque_per_amp() * entry, 1e-12) << "joint " << i + 1;
+      }
+    }
+    // A hold starts the average again: the next entry reads the first sample after it whole.
+    low.hold(state.q_rad, command);
+    const Eigen::VectorXd after = steady - spike;
+    state.current_A = after;
+    low.request(loop);
+    low.update(state, tau_d, qdd, command);
+    for (int i = 0; i < 7; ++i) {
+      if (loop == phri::LowLevelMode::kCurrent) {
+        EXPECT_NEAR(command.current_A[i], after[i], 1e-12) << "joint " << i + 1;
+      } else {
+        EXPECT_NEAR(command.tau_Nm[i], table[i].torque_per_amp() * after[i], 1e-12) << "joint " << i + 1;
+      }
+    }
+  }
+}

@@ -28,6 +28,7 @@ LowLevelController::LowLevelController(const ActuatorTable& actuators, const Cus
       reflected_inertia_(Eigen::VectorXd::Zero(actuators.size())),
       feedforward_(Eigen::VectorXd::Zero(actuators.size())),
       entry_torque_(Eigen::VectorXd::Zero(actuators.size())),
+      measured_current_(Eigen::VectorXd::Zero(actuators.size())),
       offset_decay_(std::exp(-custom.period_s / kTorqueBlendTime)) {
   for (int i = 0; i < actuators.size(); ++i) {
     reflected_inertia_[i] = actuators[i].reflected_inertia_kgm2;
@@ -48,6 +49,7 @@ void LowLevelController::saturate_to_drive_range(Eigen::VectorXd& tau) const {
 }
 
 void LowLevelController::command_torque(const Eigen::VectorXd& tau, RobotCommand& command) {
+  current_samples_ = 0;
   switch (loop_) {
     case LowLevelMode::kPosition: return;
     case LowLevelMode::kKinovaTorque:
@@ -64,6 +66,7 @@ void LowLevelController::command_torque(const Eigen::VectorXd& tau, RobotCommand
 }
 
 void LowLevelController::hold(const Eigen::VectorXd& q, RobotCommand& command) {
+  current_samples_ = 0;  // the average restarts with the next reading (no state comes with a hold)
   if (loop_ != LowLevelMode::kPosition) ++switches_;
   loop_ = requested_ = LowLevelMode::kPosition;
   started_ = true;
@@ -75,6 +78,7 @@ void LowLevelController::hold(const Eigen::VectorXd& q, RobotCommand& command) {
 
 void LowLevelController::update(const RobotState& state, const Eigen::VectorXd& tau_desired,
                                 const Eigen::VectorXd& qdd_desired, RobotCommand& command) {
+  const bool current_known = track_current(state);
   const bool entering = !started_ || requested_ != loop_;
   if (requested_ != loop_) ++switches_;
   loop_ = requested_;
@@ -111,13 +115,7 @@ void LowLevelController::update(const RobotState& state, const Eigen::VectorXd& 
       // converts with), so the first command asks for the present current even when the drives'
       // true constant differs; without a current reading, the joint torque sensors (which miss
       // the friction and rotor torque between motor and sensor).
-      if (entering) {
-        if (state.current.valid && state.current_A.size() == torque_per_amp_.size()) {
-          torque_offset_ = torque_per_amp_.cwiseProduct(state.current_A) - tau_desired;
-        } else {
-          torque_offset_ = state.tau_sensor_Nm - tau_desired;
-        }
-      }
+      if (entering) torque_offset_ = entry_torque(state) - tau_desired;
       update_friction_assist(state.qd_rad_s, qdd_desired);
       command.tau_Nm = tau_desired + torque_offset_ + breakaway_;
       saturate_to_drive_range(command.tau_Nm);
@@ -137,8 +135,8 @@ void LowLevelController::update(const RobotState& state, const Eigen::VectorXd& 
       if (entering) {
         // Start from the current the drives carry; a robot without current readings (or with a
         // short vector): from the desired torque's nominal current.
-        if (state.current.valid && state.current_A.size() == entry_current_.size()) {
-          entry_current_ = state.current_A;
+        if (current_known) {
+          entry_current_ = measured_current_;
         } else {
           entry_current_ = tau_desired.cwiseQuotient(torque_per_amp_);
         }
@@ -152,9 +150,21 @@ void LowLevelController::update(const RobotState& state, const Eigen::VectorXd& 
   }
 }
 
+bool LowLevelController::track_current(const RobotState& state) {
+  if (!state.current.valid || state.current_A.size() != measured_current_.size() || !state.current_A.allFinite()) {
+    current_samples_ = 0;
+    return false;
+  }
+  ++current_samples_;
+  const double first_order = period_s_ / (kEntryCurrentTime_s + period_s_);
+  const double weight = std::max(first_order, 1.0 / static_cast<double>(current_samples_));
+  measured_current_ += weight * (state.current_A - measured_current_);
+  return true;
+}
+
 const Eigen::VectorXd& LowLevelController::entry_torque(const RobotState& state) {
-  if (state.current.valid && state.current_A.size() == torque_per_amp_.size()) {
-    entry_torque_ = torque_per_amp_.cwiseProduct(state.current_A);
+  if (current_samples_ > 0) {
+    entry_torque_ = torque_per_amp_.cwiseProduct(measured_current_);
   } else {
     entry_torque_ = state.tau_sensor_Nm;
   }

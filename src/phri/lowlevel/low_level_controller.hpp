@@ -18,6 +18,12 @@
 //   kCustom                   CustomTorqueController: motor current (reset bumplessly on entry
 //                             from the current the drives carry)
 //
+// "The current the drives carry" is the measured current averaged over the cycles before the
+// switch (first order, kEntryCurrentTime_s), not its last sample: the custom loop keeps its entry
+// offset for its integrator's leak time (1 s), and one sample's noise would be a torque offset held
+// that long (0.01 A of noise is 0.1 N.m through a generic drive's default K_T G_r, enough to spin a
+// light wrist whose rotor inertia is a default too).
+//
 // A requested switch takes effect at the next update(); every switch is counted and its torque
 // step (the change of the robot's measured motor torque across the switch is what a test checks)
 // can be logged from switch_count() and last_switch_time().
@@ -61,6 +67,9 @@ public:
   /// part of the gear friction through its torque-sensor feedback; without this a soft spring
   /// (posture, full-body end effector) stops short. 0: off (the paper's Kinova modes).
   static constexpr double kVendorBreakawayShare = 0.5;
+  /// [s] Time constant of the measured current's average that loops are entered from: the noise
+  /// of one sample divided by sqrt(2 tau / T) ~ 6; a current that changes across the switch lags by it.
+  static constexpr double kEntryCurrentTime_s = 0.02;
   /// While the same joint stays stuck and asked the same way, its share grows by this per second,
   /// up to 1 (the whole modelled static friction).
   static constexpr double kBreakawayShareRate_per_s = 1.0;
@@ -86,9 +95,12 @@ private:
   void update_friction_assist(const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd_desired);
   void plain_torque_feedforward(const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd_desired);
   void saturate_to_drive_range(Eigen::VectorXd& tau) const;
-  // The torque the motors produce now, as the Kinova loops' entry reads it: measured current x
-  // K_T G_r (nominal), else tau_s.
+  // The torque the motors produce now, as the torque loops' entry reads it: the averaged measured
+  // current x K_T G_r (nominal), else tau_s.
   const Eigen::VectorXd& entry_torque(const RobotState& state);
+  // Averages the measured current into measured_current_ (a running mean over the first samples
+  // after a gap, then first order); false without a usable reading.
+  bool track_current(const RobotState& state);
   CustomTorqueController custom_;
   double period_s_;
   LowLevelMode loop_;
@@ -108,6 +120,8 @@ private:
   Eigen::VectorXd reflected_inertia_;  // I_r per joint [kg.m^2]
   Eigen::VectorXd feedforward_;        // the plain torque mode's friction + rotor torque [N.m]
   Eigen::VectorXd entry_torque_;
+  Eigen::VectorXd measured_current_;  // the measured current, averaged (track_current) [A]
+  long current_samples_ = 0;          // readings averaged since the last gap
   bool breakaway_ramp_ = true;
   double offset_decay_ = 0.0;
 };
