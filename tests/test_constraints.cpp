@@ -168,6 +168,67 @@ TEST_F(ConstraintTest, BeyondTheLimitTheBoundReturnsAtItsGainWithinTheReserve) {
   EXPECT_NEAR(speed - 2.0, 0.6 * std::exp(-200.0 * 0.01), 1e-3);
 }
 
+// Release bound (velocity_limit_constraint.hpp), against its closed form: on the side the release
+// acceleration a_r points to, qdd <= (v - qd) / h - a_r (mirrored below) where that is tighter than the
+// damper; the other side, a zero a_r and a joint moving away from that side (the braking a push needs)
+// keep the paper's bounds; relax() drops it for the cycle; no a_r (null, wrong size, not finite): none.
+TEST_F(ConstraintTest, AReleaseBoundKeepsTheSpeedALetGoWouldReachWithinTheLimit) {
+  const Eigen::VectorXd v = Eigen::VectorXd::Constant(7, 3.0), gain = Eigen::VectorXd::Constant(7, 50.0);
+  const phri::VelocityLimitConstraint paper(v, gain);
+  phri::VelocityLimitConstraint limit(v, gain, {0.0, 0.5, 0.0});  // no reserve, no return gain: the bound alone
+  const Eigen::VectorXd tau_ext = Eigen::VectorXd::Zero(7), tau_max = Eigen::VectorXd::Constant(7, 100.0);
+  const Eigen::VectorXd inertia = Eigen::VectorXd::Constant(7, 0.5);
+  Eigen::VectorXd qd(7), hold = Eigen::VectorXd::Zero(7);
+  qd << 2.8, -2.8, 2.9, -1.0, 0.0, 2.95, -2.99;  // rad/s, against 3.0
+  const Eigen::VectorXd q = Eigen::VectorXd::Zero(7);
+  const phri::ConstraintContext context{model_, data_, q, qd, tau_ext, hold, tau_max, inertia};
+  Eigen::VectorXd release(7);
+  release << 300.0, -300.0, 0.0, 1000.0, -1000.0, -400.0, 200.0;  // rad/s^2
+  const double horizon = 2e-3;
+  Eigen::VectorXd lower = Eigen::VectorXd::Constant(7, -1e9), upper = Eigen::VectorXd::Constant(7, 1e9);
+  Eigen::VectorXd paper_lower(7), paper_upper(7);
+  paper.bound(qd, paper_lower, paper_upper);
+  limit.set_release(&release, horizon);
+  limit.begin_cycle();
+  limit.bound(context, lower, upper);
+  for (int i = 0; i < 7; ++i) {
+    const double up = release[i] > 0.0 ? std::min(paper_upper[i], (3.0 - qd[i]) / horizon - release[i]) : paper_upper[i];
+    const double down = release[i] < 0.0 ? std::max(paper_lower[i], (-3.0 - qd[i]) / horizon - release[i]) : paper_lower[i];
+    EXPECT_DOUBLE_EQ(upper[i], up) << i;
+    EXPECT_DOUBLE_EQ(lower[i], down) << i;
+  }
+  // Near the limit on a_r's side it binds: joint 1 at 2.8 rad/s keeps 0.2 / 2 ms - 300 = -200 rad/s^2
+  // (the damper allows +10), joint 2 mirrored; joint 4 (moving away, 4 rad/s from its + limit) and
+  // joint 5 (at rest, 3 rad/s from each) keep the damper's bounds although their a_r is 1000.
+  EXPECT_DOUBLE_EQ(upper[0], -200.0);
+  EXPECT_DOUBLE_EQ(lower[1], 200.0);
+  EXPECT_EQ(upper[3], paper_upper[3]);
+  EXPECT_EQ(lower[4], paper_lower[4]);
+  EXPECT_EQ(upper[4], paper_upper[4]);
+  // Relaxed (the QP infeasible with it): the paper's bounds.
+  ASSERT_TRUE(limit.relax());
+  lower.setConstant(-1e9);
+  upper.setConstant(1e9);
+  limit.bound(context, lower, upper);
+  EXPECT_EQ(lower, paper_lower);
+  EXPECT_EQ(upper, paper_upper);
+  // None given: none, and nothing for relax() to drop.
+  Eigen::VectorXd not_finite = release;
+  not_finite[2] = std::numeric_limits<double>::quiet_NaN();
+  const Eigen::VectorXd short_release = release.head(6);
+  const Eigen::VectorXd* no_release[] = {nullptr, &not_finite, &short_release};
+  for (const Eigen::VectorXd* none : no_release) {
+    limit.set_release(none, horizon);
+    limit.begin_cycle();
+    lower.setConstant(-1e9);
+    upper.setConstant(1e9);
+    limit.bound(context, lower, upper);
+    EXPECT_EQ(lower, paper_lower);
+    EXPECT_EQ(upper, paper_upper);
+    EXPECT_FALSE(limit.relax()) << "nothing to drop";
+  }
+}
+
 // Braking reserve (velocity_limit_constraint.hpp), against its closed form: full limit from
 // reserve_fraction x tau_max of reserve, linear below, min_speed_fraction at none; a joint faster
 // than its lowered limit is asked exactly the deceleration its reserve gives.

@@ -874,6 +874,15 @@ TEST(SafetyFuzz, ThirdPartyWristPushesLetGoReplayedPass) {
   expect_windows_pass("ur5e", 2026, 3000, {"push/null_space/custom/7", "push/full_body/torque/30"});
 }
 
+// robots/ur5e, pushes let go while the arm moves near its speed limit: the command still cancels the
+// push for the period before the motion shows the release and the one before the next command answers
+// it (seed 4711: a 9 N.m push on wrist_2 let go at 2.75 rad/s, -260 and -310 rad/s^2 in those two
+// periods, 1.07x). The velocity limits now bound the speed a release would reach (velocity_limit_constraint.hpp).
+TEST(SafetyFuzz, ThirdPartyWristPushesLetGoAtSpeedReplayedPass) {
+  expect_windows_pass("ur5e", 4711, 3000, {"push/full_body/torque/11"});
+  expect_windows_pass("ur5e", 777, 3000, {"push/dual/torque/13"});
+}
+
 // robots/franka_panda, seed 31415 at 3000 pushes: a 5 N.m offset on joint 7's torque sensor for 100
 // cycles while the arm moves. The observer reads it as a push, stiff mode cancels it, and the command's
 // extra torque sped the light wrist up to 1.06-1.13x its limit before the torque-against-current check

@@ -898,7 +898,7 @@ CycleStatus Controller::step(const RobotState& state, const ControllerTargets& t
   const bool wrench_usable = wrench_supervisor_.fresh() && wrench_.calibrated();
   const WholeBodyQpStatus qp_status =
       qp_.update(model_, data_, q_, qd_, tau_ext_, settings_.period_s, wrench_usable ? &wrench_.wrench_world() : nullptr,
-                 fast_estimate ? &uncancelled_.acceleration() : nullptr);
+                 fast_estimate ? &uncancelled_.acceleration() : nullptr, fast_estimate ? &uncancelled_.release_acceleration() : nullptr);
   check_qp(qp_status, state.time_s);
   if (supervisor_.safe_stop()) {
     safe_stop(true, command);

@@ -30,11 +30,13 @@ UncancelledPush::UncancelledPush(const Eigen::VectorXd& rotor_inertia, const Eig
       previous_qd_(Eigen::VectorXd::Zero(rotor_inertia.size())),
       from_torque_(Eigen::VectorXd::Zero(rotor_inertia.size())),
       from_motion_(Eigen::VectorXd::Zero(rotor_inertia.size())),
-      acceleration_(Eigen::VectorXd::Zero(rotor_inertia.size())) {}
+      acceleration_(Eigen::VectorXd::Zero(rotor_inertia.size())),
+      release_(Eigen::VectorXd::Zero(rotor_inertia.size())) {}
 
 void UncancelledPush::forget() {
   have_previous_ = false;
   acceleration_.setZero();
+  release_.setZero();
 }
 
 const Eigen::VectorXd& UncancelledPush::update(const Data& data, const Eigen::VectorXd& tau_ext,
@@ -43,13 +45,6 @@ const Eigen::VectorXd& UncancelledPush::update(const Data& data, const Eigen::Ve
   const bool have_motion = have_previous_ && qdd_commanded && dt > 0.0;
   have_previous_ = true;
   acceleration_.setZero();
-  if (!have_motion) {
-    previous_qd_ = qd;
-    return acceleration_;
-  }
-  from_motion_ = (qd - previous_qd_) / dt - *qdd_commanded;
-  previous_qd_ = qd;
-  from_torque_ = tau_fast - tau_ext;
   // M + B's factor from compute_all_terms when data carries this B (factored beside M), else here.
   const bool factored = data.rotor_inertia.size() == rotor_inertia_.size() &&
                         (data.rotor_inertia.array() == rotor_inertia_.array()).all();
@@ -59,6 +54,19 @@ const Eigen::VectorXd& UncancelledPush::update(const Data& data, const Eigen::Ve
     inertia_.diagonal() += rotor_inertia_;
     inertia_llt_.compute(inertia_);
   }
+  release_.setZero();
+  if (llt.ok()) {
+    release_ = -tau_ext;
+    llt.solve_in_place(release_);
+    release_.array() *= delivered_.array();
+  }
+  if (!have_motion) {
+    previous_qd_ = qd;
+    return acceleration_;
+  }
+  from_motion_ = (qd - previous_qd_) / dt - *qdd_commanded;
+  previous_qd_ = qd;
+  from_torque_ = tau_fast - tau_ext;
   if (!llt.ok()) return acceleration_;
   llt.solve_in_place(from_torque_);
   for (Eigen::Index i = 0; i < acceleration_.size(); ++i) {

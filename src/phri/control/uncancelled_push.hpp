@@ -52,6 +52,9 @@ public:
   void forget();
 
   const Eigen::VectorXd& acceleration() const { return acceleration_; }
+  /// What the arm would get if the push ended now, the command still cancelling tau_ext:
+  /// f (M + B)^-1 (-tau_ext) (the last update's; 0 before one).
+  const Eigen::VectorXd& release_acceleration() const { return release_; }
   /// The two estimates of the last update: (M + B)^-1 (tau_fast - tau_ext), and the motion's.
   const Eigen::VectorXd& from_torque() const { return from_torque_; }
   const Eigen::VectorXd& from_motion() const { return from_motion_; }
@@ -64,7 +67,7 @@ private:
   SmallCholesky inertia_llt_;
   Eigen::VectorXd previous_qd_;
   bool have_previous_ = false;
-  Eigen::VectorXd from_torque_, from_motion_, acceleration_;
+  Eigen::VectorXd from_torque_, from_motion_, acceleration_, release_;
 };
 
 }  // namespace phri

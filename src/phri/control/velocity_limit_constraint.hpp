@@ -13,6 +13,17 @@
 // lowered limit is asked no more deceleration than its reserve gives (reserve / (M_ii lambda) of
 // speed per cycle's bound), and with a negative reserve no less acceleration than the torque limit
 // forces, so the lowered limit never makes the QP infeasible by itself.
+//
+// Release bound (ours, not the paper's). In a torque loop the command cancels the estimated push;
+// if the hand lets go, the arm gets a_r = (M + B)^-1 (-tau_ext) on top of qdd_d until the motion
+// shows the release (one period) and the next command answers it (one more): over that horizon
+// h = 2 dt the bounds do not see it coming. So on the side a_r points to, qdd_d + a_r is held to
+// what keeps the speed within the limit over h: qdd_d <= (v - qd) / h - a_r (a_r > 0; mirrored
+// below). It bounds the speed reached, not the way there: near the limit it is the tighter bound,
+// away from it (500/s against the damper's 50/s) it never binds, so a joint braking against a push
+// keeps the damper's whole range. (Lowering v itself by h |a_r| instead throttled that braking
+// through the damper's gain and left a UR5e pinned on its self-collision bounds.) set_release()
+// gives a_r and h each cycle; dropped by relax() like the return gain.
 #include <phri/control/constraint.hpp>
 
 #include <Eigen/Core>
@@ -39,20 +50,35 @@ public:
         gain_(gain),
         reserve_(reserve),
         lower_(Eigen::VectorXd::Zero(velocity_limit.size())),
-        upper_(Eigen::VectorXd::Zero(velocity_limit.size())) {}
+        upper_(Eigen::VectorXd::Zero(velocity_limit.size())),
+        release_(Eigen::VectorXd::Zero(velocity_limit.size())) {}
+
+  /// The release bound's acceleration a_r for this cycle (header), or null for none; horizon_s: the
+  /// time before a command answers a release (2 control periods).
+  void set_release(const Eigen::VectorXd* release_acceleration, double horizon_s) {
+    if (!release_acceleration || release_acceleration->size() != release_.size() || !release_acceleration->allFinite() ||
+        !(horizon_s > 0.0)) {
+      release_.setZero();
+      return;
+    }
+    release_ = *release_acceleration;
+    release_horizon_ = horizon_s;
+  }
 
   std::string_view type() const override { return "velocity_limit"; }
   void begin_cycle() override { relaxed_ = false; }
   /// Tightens the bounds by the reserve-lowered limits, with the return gain unless relaxed.
   void bound(const ConstraintContext& context, Eigen::Ref<Eigen::VectorXd> lower,
              Eigen::Ref<Eigen::VectorXd> upper) override {
-    bound(context.qd, context.hold_torque, context.torque_limit, context.inertia_diagonal, lower_, upper_, !relaxed_);
+    bound(context.qd, context.hold_torque, context.torque_limit, context.inertia_diagonal, lower_, upper_, !relaxed_,
+          !relaxed_);
     lower = lower.cwiseMax(lower_);
     upper = upper.cwiseMin(upper_);
   }
-  /// Drops the return gain for this cycle (the paper's bounds rather than the fallback brake).
+  /// Drops the return gain and the release bound for this cycle (the paper's bounds rather than
+  /// the fallback brake).
   bool relax() override {
-    if (relaxed_ || !returning_) return false;
+    if (relaxed_ || (!returning_ && !release_bound_)) return false;
     relaxed_ = true;
     return true;
   }
@@ -68,17 +94,28 @@ public:
   /// The same with each direction's limit lowered by its braking reserve (header). hold: h - tau_ext;
   /// inertia: the diagonal of M (what one N.m of reserve decelerates).
   /// with_return: the return gain beyond the limit (deceleration()); returning() then tells whether
-  /// it asked more than the paper's gain on some joint.
+  /// it asked more than the paper's gain on some joint. with_release: the release bound (header).
   void bound(const Eigen::VectorXd& qd, const Eigen::VectorXd& hold, const Eigen::VectorXd& torque_limit,
              const Eigen::VectorXd& inertia, Eigen::Ref<Eigen::VectorXd> lower, Eigen::Ref<Eigen::VectorXd> upper,
-             bool with_return = true) {
+             bool with_return = true, bool with_release = false) {
     returning_ = false;
+    release_bound_ = false;
     for (int i = 0; i < qd.size(); ++i) {
       const double up_reserve = torque_limit[i] + hold[i], down_reserve = torque_limit[i] - hold[i];
       const double up = speed_limit(i, up_reserve, torque_limit[i], qd[i], inertia[i]);
       const double down = speed_limit(i, down_reserve, torque_limit[i], -qd[i], inertia[i]);
       upper[i] = -deceleration(i, qd[i] - up, up_reserve, inertia[i], with_return);
       lower[i] = deceleration(i, -qd[i] - down, down_reserve, inertia[i], with_return);
+      if (!with_release || release_[i] == 0.0) continue;
+      if (release_[i] > 0.0) {
+        const double released = (velocity_limit_[i] - qd[i]) / release_horizon_ - release_[i];
+        release_bound_ = release_bound_ || released < upper[i];
+        upper[i] = std::min(upper[i], released);
+      } else {
+        const double released = (-velocity_limit_[i] - qd[i]) / release_horizon_ - release_[i];
+        release_bound_ = release_bound_ || released > lower[i];
+        lower[i] = std::max(lower[i], released);
+      }
     }
   }
 
@@ -123,8 +160,11 @@ private:
   Eigen::VectorXd velocity_limit_, gain_;
   BrakingReserveSettings reserve_;
   bool returning_ = false;  // the last bound() asked more than the paper's gain somewhere
-  bool relaxed_ = false;    // the return gain dropped for this cycle
+  bool relaxed_ = false;    // the return gain and the release bound dropped for this cycle
+  bool release_bound_ = false;  // the last bound() was tightened by the release bound somewhere
   Eigen::VectorXd lower_, upper_;  // this cycle's bounds before tightening the QP's
+  Eigen::VectorXd release_;       // a_r (set_release), zero for none
+  double release_horizon_ = 2e-3;  // h [s]
 };
 
 }  // namespace phri

@@ -228,7 +228,8 @@ bool WholeBodyQp::relax_a_constraint() {
 
 WholeBodyQpStatus WholeBodyQp::update(const Model& model, const Data& data, const Eigen::VectorXd& q,
                                      const Eigen::VectorXd& qd, const Eigen::VectorXd& tau_ext, double dt,
-                                     const Vector6d* ee_wrench_world, const Eigen::VectorXd* uncancelled_acceleration) {
+                                     const Vector6d* ee_wrench_world, const Eigen::VectorXd* uncancelled_acceleration,
+                                     const Eigen::VectorXd* release_acceleration) {
   if (!q.allFinite() || !qd.allFinite() || !tau_ext.allFinite() || !data.mass_matrix.allFinite() ||
       (uncancelled_acceleration && uncancelled_acceleration->size() != nv_)) {
     tau_desired_ = last_good_tau_;
@@ -250,6 +251,8 @@ WholeBodyQpStatus WholeBodyQp::update(const Model& model, const Data& data, cons
   inertia_diagonal_ = data.mass_matrix.diagonal();
   const ConstraintContext constraint_context{model, data, q, qd, tau_ext, hold_torque_, torque_limit(), inertia_diagonal_};
   for (const auto& constraint : constraints_) constraint->begin_cycle();
+  // The motion shows a release one period late and the next command answers it (velocity_limit_constraint.hpp).
+  if (velocity_limit_) velocity_limit_->set_release(release_acceleration, 2.0 * dt);
   fill_constraints(constraint_context);
 
   last_solve_options_ = {.warm_start = warm_, .reuse_hessian_factor = false};

@@ -132,11 +132,14 @@ public:
   /// One control cycle. `data`: after compute_all_terms(q, qd) on the controller's (link-side)
   /// model; tau_ext: estimated external torque; ee_wrench_world: the F/T wrench at the end effector
   /// (TaskContext), or null; uncancelled_acceleration: what the push does to the arm beyond what
-  /// the command cancels (UncancelledPush), or null: the bounds on qdd hold for it too. Returns the
-  /// status; results below.
+  /// the command cancels (UncancelledPush), or null: the bounds on qdd hold for it too;
+  /// release_acceleration: what the arm would get if the push ended now (UncancelledPush), or null:
+  /// the velocity limits bound the speed it would reach (velocity_limit_constraint.hpp). Returns the status;
+  /// results below.
   WholeBodyQpStatus update(const Model& model, const Data& data, const Eigen::VectorXd& q, const Eigen::VectorXd& qd,
                           const Eigen::VectorXd& tau_ext, double dt, const Vector6d* ee_wrench_world = nullptr,
-                          const Eigen::VectorXd* uncancelled_acceleration = nullptr);
+                          const Eigen::VectorXd* uncancelled_acceleration = nullptr,
+                          const Eigen::VectorXd* release_acceleration = nullptr);
 
   const Eigen::VectorXd& desired_acceleration() const { return qdd_desired_; }
   /// The soft dead band of tau_ext in the compliant terms, per joint [N.m].
