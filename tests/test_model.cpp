@@ -382,7 +382,8 @@ TEST(BatchMath, SinCosWithinAnUlpOfLibmAndLibmsOwnBeyondTheReduction) {
 }
 
 // compute_with_shifted factors A and A + diag(d) in one pass: each factor and each solve equal
-// compute()'s bit for bit at every size (the 6- and 7-joint kernels and the general one), and a
+// compute()'s bit for bit at every size (the 6- and 7-joint kernels and the general one), as do the
+// paired solves (solve_pair_in_place) each single solve's; and a
 // refused A (indefinite, rescued by the shift) leaves the shifted factor good, and the other way round.
 TEST(SmallCholesky, FactoringWithAShiftedCopyGivesEachFactorBitForBit) {
   std::mt19937 rng(45);
@@ -409,6 +410,13 @@ TEST(SmallCholesky, FactoringWithAShiftedCopyGivesEachFactorBitForBit) {
     EXPECT_EQ(x1, x2) << n;
     EXPECT_EQ(y1, y2) << n;
     EXPECT_LT((a_shifted * y1 - b).norm(), 1e-12 * (1.0 + y1.norm())) << n;
+    // Two right-hand sides solved side by side: each bit for bit its own solve.
+    const Eigen::VectorXd c = Eigen::VectorXd::NullaryExpr(n, [&] { return unit(rng); });
+    Eigen::VectorXd pair_b = b, pair_c = c, single_c = c;
+    plain.solve_pair_in_place(pair_b, pair_c);
+    plain.solve_in_place(single_c);
+    EXPECT_EQ(pair_b, x1) << n;
+    EXPECT_EQ(pair_c, single_c) << n;
   }
   // Indefinite A, positive definite A + diag(d): only the shifted factor holds; and the other way round.
   const Eigen::Matrix3d indefinite = Eigen::Vector3d(1.0, -0.5, 2.0).asDiagonal();
@@ -428,6 +436,8 @@ TEST(SmallCholesky, FactoringWithAShiftedCopyGivesEachFactorBitForBit) {
                phri::ArgumentError);
   EXPECT_THROW(phri::SmallCholesky::compute_with_shifted(Eigen::Matrix3d::Identity(), Eigen::Vector2d::Ones(), plain, shifted),
                phri::ArgumentError);
+  Eigen::VectorXd three = Eigen::VectorXd::Ones(3), two_long = Eigen::VectorXd::Ones(2);
+  EXPECT_THROW(plain.solve_pair_in_place(three, two_long), phri::ArgumentError);
 }
 
 TEST(SmallCholesky, AgreesWithEigensLltToRoundingAndRefusesWhatItRefuses) {

@@ -70,7 +70,13 @@ public:
       return false;
     }
     certified_margin_ = 0.0;
-    jjt_.noalias() = jacobian * jacobian.transpose();
+    // J J^T as a sum of the columns' fixed-size 6 x 6 outer products (the same sums in the same
+    // order as the product, which for a dynamic J runs a coefficient-wise loop at run-time length).
+    jjt_.setZero();
+    for (Eigen::Index c = 0; c < jacobian.cols(); ++c) {
+      const Vector6d column = jacobian.col(c);
+      jjt_.noalias() += column * column.transpose();
+    }
     const double threshold = sigma0_ * sigma0_;
     // Near a singularity last cycle: the tracked weak direction, checked exact, decides at once.
     if (has_weak_direction_ && track_weak_direction(threshold)) return active_ = true;

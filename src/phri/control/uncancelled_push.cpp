@@ -54,21 +54,21 @@ const Eigen::VectorXd& UncancelledPush::update(const Data& data, const Eigen::Ve
     inertia_.diagonal() += rotor_inertia_;
     inertia_llt_.compute(inertia_);
   }
-  release_.setZero();
-  if (llt.ok()) {
-    release_ = -tau_ext;
-    llt.solve_in_place(release_);
-    release_.array() *= delivered_.array();
+  if (have_motion) {
+    from_motion_ = (qd - previous_qd_) / dt - *qdd_commanded;
+    from_torque_ = tau_fast - tau_ext;
   }
-  if (!have_motion) {
-    previous_qd_ = qd;
-    return acceleration_;
-  }
-  from_motion_ = (qd - previous_qd_) / dt - *qdd_commanded;
   previous_qd_ = qd;
-  from_torque_ = tau_fast - tau_ext;
+  release_.setZero();
   if (!llt.ok()) return acceleration_;
-  llt.solve_in_place(from_torque_);
+  release_ = -tau_ext;
+  if (have_motion) {
+    llt.solve_pair_in_place(release_, from_torque_);
+  } else {
+    llt.solve_in_place(release_);
+  }
+  release_.array() *= delivered_.array();
+  if (!have_motion) return acceleration_;
   for (Eigen::Index i = 0; i < acceleration_.size(); ++i) {
     const double t = from_torque_[i], m = from_motion_[i];
     if (m * qd[i] > 0.0) {  // speeding the joint up: the motion alone (header)

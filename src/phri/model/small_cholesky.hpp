@@ -76,6 +76,21 @@ class SmallCholesky {
     solve_in_place(x);
   }
 
+  // x <- A^-1 x and y <- A^-1 y, each bit for bit solve_in_place's, with the two solves' dependent
+  // chains interleaved (each step waits on the one before; side by side, one hides the other's latency).
+  void solve_pair_in_place(Eigen::VectorXd& x, Eigen::VectorXd& y) const {
+    check_size("SmallCholesky::solve_pair_in_place", "rows", x.size(), l_.rows());
+    check_size("SmallCholesky::solve_pair_in_place", "rows", y.size(), l_.rows());
+    const Index n = l_.rows();
+    if (n == 7) {
+      solve_pair_kernel<7>(n, l_.data(), inverse_diagonal_.data(), x.data(), y.data());
+    } else if (n == 6) {
+      solve_pair_kernel<6>(n, l_.data(), inverse_diagonal_.data(), x.data(), y.data());
+    } else {
+      solve_pair_kernel<0>(n, l_.data(), inverse_diagonal_.data(), x.data(), y.data());
+    }
+  }
+
  private:
   // N > 0: the size known to the compiler; 0: read from `size`. Right-looking: once column j is
   // final it updates the trailing columns, each a contiguous axpy.
@@ -162,6 +177,31 @@ class SmallCholesky {
       double s = x[k];
       for (Index i = k + 1; i < n; ++i) s -= lk[i] * x[i];
       x[k] = s * inverse_diagonal[k];
+    }
+  }
+
+  // solve_kernel on two right-hand sides, step by step.
+  template <int N>
+  static void solve_pair_kernel(Index size, const double* l, const double* inverse_diagonal, double* x, double* y) {
+    const Index n = N > 0 ? N : size;
+    for (Index k = 0; k < n; ++k) {
+      double s = x[k], t = y[k];
+      for (Index i = 0; i < k; ++i) {
+        s -= l[k + i * n] * x[i];
+        t -= l[k + i * n] * y[i];
+      }
+      x[k] = s * inverse_diagonal[k];
+      y[k] = t * inverse_diagonal[k];
+    }
+    for (Index k = n - 1; k >= 0; --k) {
+      const double* lk = l + k * n;
+      double s = x[k], t = y[k];
+      for (Index i = k + 1; i < n; ++i) {
+        s -= lk[i] * x[i];
+        t -= lk[i] * y[i];
+      }
+      x[k] = s * inverse_diagonal[k];
+      y[k] = t * inverse_diagonal[k];
     }
   }
 
