@@ -892,6 +892,15 @@ TEST(SafetyFuzz, ThirdPartyTorqueSensorOffsetWhileMovingReplayedPass) {
   expect_windows_pass("franka_panda", 31415, 3000, {"motion/stiff/torque/offset_tau_5Nm"});
 }
 
+// robots/franka_panda, seed 27182 at 3000 pushes: a 105 N ramp on panda_link7 holding 81 % of joint
+// 1's torque while the joint ran toward its limit (the damper asked 8.06 rad/s^2 of braking, the torque
+// left gave less: QP infeasible), and a 165 N step on panda_link6 needing 98 % of a joint's torque. Both
+// ended on the fallback brake and a safe stop, through joint limits by 4.9 and 0.9 mrad. The QP now
+// brakes with the largest share of the dampers' demands the torque limits allow (scaled braking).
+TEST(SafetyFuzz, ThirdPartyBrakingBeyondTheTorqueLeftReplayedPass) {
+  expect_windows_pass("franka_panda", 27182, 3000, {"push/full_body/custom/4", "push/dual/torque/0"});
+}
+
 // Four windows of seed 31 put their fault on the very sample that carried the switch request; the
 // controller does not switch on a bad sample, so they ran the position loop and were invalid. A
 // fault after a switch now starts after the sample the reference switched on.

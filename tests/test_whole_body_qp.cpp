@@ -17,6 +17,7 @@
 #include <unsupported/Eigen/MatrixFunctions>
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <random>
 
@@ -390,20 +391,79 @@ TEST_F(WholeBodyQpTest, InvalidInputHoldsTheLastCommandAndInfeasibleBrakes) {
   EXPECT_NEAR(qp.desired_torque()[1], -qp.torque_limit()[1], 1e-9);
 }
 
-// The fallback brake, scaled to the torque limits, is what the arm does: its torques are
-// M qdd + h - tau_ext exactly (none clipped), within the limits, and it brakes every moving joint
-// in the brake's direction; before, a joint near its limit lost the torque that braking its
-// neighbours through M asked of it, and sped up (safety-fuzz seed 2718: 1.88 -> 2.51 rad/s).
+// Joint 2 inside its damper band, running into it, with `hold` of its 30 N.m taken by holding a
+// push; the others 15 N.m beyond what holds them.
+struct BrakingCase {
+  Eigen::VectorXd q, qd, tau_ext;
+  phri::WholeBodyQpSettings settings;
+};
+BrakingCase braking_case(const Eigen::VectorXd& q0, const phri::Model& model, phri::Data& data, double hold) {
+  BrakingCase c{q0, Eigen::VectorXd(7), Eigen::VectorXd::Zero(7), gen3_settings()};
+  c.q[1] = 2.24 - 0.02;
+  c.qd << 0.8, 1.3, -0.8, 0.8, -1.0, 1.0, -1.0;
+  phri::compute_all_terms(model, data, c.q, c.qd);
+  c.tau_ext[1] = data.nonlinear_effects[1] + hold;
+  c.settings.torque_limit = data.nonlinear_effects.cwiseAbs() + Eigen::VectorXd::Constant(7, 15.0);
+  c.settings.torque_limit[1] = 30.0;
+  return c;
+}
+
+// The dampers ask joint 2 for more braking than the 3 N.m its limit leaves beyond holding a push
+// (27 of 30 N.m): the QP answers with the largest common share of the bounds' braking demands the
+// torque rows allow, not the fallback. Its torques are M qdd + h - tau_ext within the limits, the
+// bounds it held are the demands scaled by that share, and 2^-9 more is infeasible (a separate solver).
+TEST_F(WholeBodyQpTest, BrakingBeyondTheTorqueLeftIsScaledToTheLargestShareTheLimitsAllow) {
+  const BrakingCase c = braking_case(q_, model_, data_, 27.0);
+  phri::WholeBodyQp qp(model_, nullptr, c.settings);
+  set_tasks(qp, 0.0, 1.0);
+  ASSERT_EQ(qp.update(model_, data_, c.q, c.qd, c.tau_ext, 1e-3), phri::WholeBodyQpStatus::kBrakingScaled);
+  EXPECT_TRUE(phri::solved(qp.status()));
+  const double share = qp.braking_share();
+  EXPECT_GT(share, 0.0);
+  EXPECT_LT(share, 1.0);
+  const Eigen::VectorXd realised = data_.mass_matrix * qp.desired_acceleration() + data_.nonlinear_effects - c.tau_ext;
+  EXPECT_LT((realised - qp.desired_torque()).cwiseAbs().maxCoeff(), 1e-9);
+  EXPECT_TRUE((qp.desired_torque().cwiseAbs().array() <= c.settings.torque_limit.array() + 1e-9).all());
+  // The problem as last solved carries the scaled bounds: joint 2's asks it to brake, and holds.
+  phri::QpProblem problem = qp.qp_problem();
+  ASSERT_LT(problem.ub[1], 0.0);
+  EXPECT_TRUE((qp.desired_acceleration().array() <= problem.ub.array() + 1e-9).all());
+  EXPECT_TRUE((qp.desired_acceleration().array() >= problem.lb.array() - 1e-9).all());
+  const double more = (share + std::ldexp(1.0, -9)) / share;
+  for (int i = 0; i < 7; ++i) {
+    if (problem.ub[i] < 0.0) problem.ub[i] *= more;
+    if (problem.lb[i] > 0.0) problem.lb[i] *= more;
+  }
+  phri::QpSolver separate(7, 0, problem.A.rows());
+  EXPECT_EQ(separate.solve(problem), phri::QpStatus::kInfeasible);
+  // The bisection's solves run in the cycle: no allocation.
+  phri::test::AllocationCounter count;
+  {
+    phri::test::NoMallocScope no_malloc;
+    EXPECT_EQ(qp.update(model_, data_, c.q, c.qd, c.tau_ext, 1e-3), phri::WholeBodyQpStatus::kBrakingScaled);
+  }
+  EXPECT_EQ(count.allocations(), 0u);
+  // Within the limits the same state solves in full (share 1).
+  phri::WholeBodyQpSettings roomy = c.settings;
+  roomy.torque_limit[1] = 60.0;
+  phri::WholeBodyQp full(model_, nullptr, roomy);
+  set_tasks(full, 0.0, 1.0);
+  EXPECT_EQ(full.update(model_, data_, c.q, c.qd, c.tau_ext, 1e-3), phri::WholeBodyQpStatus::kOk);
+  EXPECT_EQ(full.braking_share(), 1.0);
+}
+
+// The fallback brake, scaled to the torque limits, is what the arm does when the QP is infeasible
+// (here the same braking case with the scaled braking off): its torques are M qdd + h - tau_ext
+// exactly (none clipped), within the limits, and it brakes every moving joint in the brake's
+// direction; before, a joint near its limit lost the torque that braking its neighbours through M
+// asked of it, and sped up (safety-fuzz seed 2718: 1.88 -> 2.51 rad/s).
 TEST_F(WholeBodyQpTest, TheFallbackBrakeIsScaledToTheTorqueLimitsAndRealisesItsAcceleration) {
-  Eigen::VectorXd q = q_, qd(7);
-  q[1] = 2.24 - 0.02;  // inside joint 2's damper band, moving into it: the damper asks more than 30 N.m gives
-  qd << 0.8, 1.3, -0.8, 0.8, -1.0, 1.0, -1.0;
-  phri::compute_all_terms(model_, data_, q, qd);
-  Eigen::VectorXd tau_ext = Eigen::VectorXd::Zero(7);
-  tau_ext[1] = data_.nonlinear_effects[1] + 27.0;  // joint 2 needs -27 of its 30 N.m just to hold
-  phri::WholeBodyQpSettings settings = gen3_settings();  // the others: 15 N.m beyond what holds them
-  settings.torque_limit = data_.nonlinear_effects.cwiseAbs() + Eigen::VectorXd::Constant(7, 15.0);
-  settings.torque_limit[1] = 30.0;
+  const BrakingCase c = braking_case(q_, model_, data_, 27.0);
+  const Eigen::VectorXd& q = c.q;
+  const Eigen::VectorXd& qd = c.qd;
+  const Eigen::VectorXd& tau_ext = c.tau_ext;
+  phri::WholeBodyQpSettings settings = c.settings;
+  settings.scale_braking = false;
   phri::WholeBodyQp qp(model_, nullptr, settings);
   set_tasks(qp, 0.0, 1.0);
   ASSERT_EQ(qp.update(model_, data_, q, qd, tau_ext, 1e-3), phri::WholeBodyQpStatus::kQpInfeasible);

@@ -16,7 +16,7 @@ void bind_control_enums(py::module_& m) {
   bind_enum<ComplianceMode, kComplianceModeCount>(m, "ComplianceMode",
                                                  "The paper's compliance modes: stiff, null_space, full_body, dual.");
   bind_enum<CycleStatus, 6>(m, "CycleStatus", "What a controller step did (ok, or why it held or braked).");
-  bind_enum<WholeBodyQpStatus, 5>(m, "WholeBodyQpStatus", "Outcome of the whole-body QP in the last step.");
+  bind_enum<WholeBodyQpStatus, 6>(m, "WholeBodyQpStatus", "Outcome of the whole-body QP in the last step.");
   bind_enum<SupervisorState, 3>(m, "SupervisorState", "Safety supervisor: normal, degraded, safe_stop.");
   bind_enum<SafetyFault, static_cast<int>(SafetyFault::kLast) + 1>(m, "SafetyFault",
                                                                   "Why a sample was implausible or a safe stop began.");

@@ -111,7 +111,7 @@ std::string Logger::legend_yaml(const std::vector<std::string>& pfl_links) {
   }
   legend_entry(out, "controller_status", {WholeBodyQpStatus::kOk, WholeBodyQpStatus::kQpInfeasible,
                                           WholeBodyQpStatus::kQpIterationLimit, WholeBodyQpStatus::kQpFailed,
-                                          WholeBodyQpStatus::kInvalidInput});
+                                          WholeBodyQpStatus::kInvalidInput, WholeBodyQpStatus::kBrakingScaled});
   legend_entry(out, "qp_status", {QpStatus::kOptimal, QpStatus::kInfeasible, QpStatus::kIterationLimit,
                                   QpStatus::kInvalidInput, QpStatus::kNumericalError});
   out += "pfl_link:\n  -1: none\n";

@@ -776,7 +776,7 @@ void Controller::check_qp(WholeBodyQpStatus qp_status, double t) {
     supervisor_.report(SafetyFault::kQpFailure, t);
     return;
   }
-  qp_fallbacks_in_row_ = qp_status == WholeBodyQpStatus::kOk ? 0 : qp_fallbacks_in_row_ + 1;
+  qp_fallbacks_in_row_ = solved(qp_status) ? 0 : qp_fallbacks_in_row_ + 1;
   if (static_cast<double>(qp_fallbacks_in_row_) * settings_.period_s > settings_.safety.max_qp_fallback_s) {
     supervisor_.report(SafetyFault::kQpFailure, t);
   }
@@ -913,7 +913,7 @@ CycleStatus Controller::step(const RobotState& state, const ControllerTargets& t
   supervisor_.note_command(command);
   have_command_ = true;
   qp_commanded_ = true;
-  status_ = qp_status != WholeBodyQpStatus::kOk ? CycleStatus::kQpFallback
+  status_ = !solved(qp_status)                 ? CycleStatus::kQpFallback
             : targets_accepted                 ? CycleStatus::kOk
                                                : CycleStatus::kTargetsRejected;
   return status_;

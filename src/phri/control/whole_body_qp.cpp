@@ -122,6 +122,8 @@ void WholeBodyQp::resize_problem() {
   for (const auto& constraint : constraints_) rows += constraint->num_rows();
   problem_.resize(nv_, 0, rows);
   solver_.resize(nv_, 0, rows);
+  braking_lb_.resize(nv_);
+  braking_ub_.resize(nv_);
   warm_ = false;
 }
 
@@ -230,6 +232,7 @@ WholeBodyQpStatus WholeBodyQp::update(const Model& model, const Data& data, cons
                                      const Eigen::VectorXd& qd, const Eigen::VectorXd& tau_ext, double dt,
                                      const Vector6d* ee_wrench_world, const Eigen::VectorXd* uncancelled_acceleration,
                                      const Eigen::VectorXd* release_acceleration) {
+  braking_share_ = 1.0;
   if (!q.allFinite() || !qd.allFinite() || !tau_ext.allFinite() || !data.mass_matrix.allFinite() ||
       (uncancelled_acceleration && uncancelled_acceleration->size() != nv_)) {
     tau_desired_ = last_good_tau_;
@@ -266,6 +269,8 @@ WholeBodyQpStatus WholeBodyQp::update(const Model& model, const Data& data, cons
     qp = solver_.solve(problem_, last_solve_options_);
     ++solve_count_;
   }
+  const bool scaled = qp == QpStatus::kInfeasible && settings_.scale_braking && scale_braking();
+  if (scaled) qp = solver_.status();
   if (qp == QpStatus::kOptimal && solver_.x().allFinite()) {
     warm_ = true;
     qdd_desired_ = solver_.x();
@@ -273,7 +278,7 @@ WholeBodyQpStatus WholeBodyQp::update(const Model& model, const Data& data, cons
     tau_desired_.noalias() = data.mass_matrix * qdd_desired_;
     tau_desired_ += data.nonlinear_effects - tau_ext;
     last_good_tau_ = tau_desired_;
-    status_ = WholeBodyQpStatus::kOk;
+    status_ = scaled ? WholeBodyQpStatus::kBrakingScaled : WholeBodyQpStatus::kOk;
     return status_;
   }
   warm_ = false;
@@ -282,6 +287,47 @@ WholeBodyQpStatus WholeBodyQp::update(const Model& model, const Data& data, cons
                                               : WholeBodyQpStatus::kQpFailed;
   fallback_brake(data, qd, tau_ext);
   return status_;
+}
+
+// The bounds that ask the arm to accelerate (ub < 0 or lb > 0: the dampers braking a joint toward
+// a limit, the push's shift) cut to `share` of what they ask; the others as filled.
+void WholeBodyQp::set_braking_share(double share) {
+  for (int i = 0; i < nv_; ++i) {
+    problem_.ub[i] = braking_ub_[i] < 0.0 ? share * braking_ub_[i] : braking_ub_[i];
+    problem_.lb[i] = braking_lb_[i] > 0.0 ? share * braking_lb_[i] : braking_lb_[i];
+  }
+}
+
+// Infeasible after the relaxations: when the torque limits leave less braking than the dampers ask
+// (a push holding most of a joint's torque while it runs toward a limit), the largest common share
+// of those demands the rows still allow, by bisection to 2^-10. Share 0 (no braking asked) first:
+// infeasible, the push is beyond the actuators and the fallback brakes. The rows (torque limits,
+// collision distances) are kept as they are. The solver ends on the problem at the share found.
+bool WholeBodyQp::scale_braking() {
+  constexpr int kBisections = 10;
+  braking_lb_ = problem_.lb;
+  braking_ub_ = problem_.ub;
+  const auto solve_at = [&](double share) {
+    set_braking_share(share);
+    last_solve_options_ = {.warm_start = false, .reuse_hessian_factor = false};
+    ++solve_count_;
+    return solver_.solve(problem_, last_solve_options_) == QpStatus::kOptimal;
+  };
+  if (!solve_at(0.0)) {
+    problem_.lb = braking_lb_;
+    problem_.ub = braking_ub_;
+    return false;
+  }
+  double feasible = 0.0, infeasible = 1.0;
+  bool last_feasible = true;
+  for (int k = 0; k < kBisections; ++k) {
+    const double share = 0.5 * (feasible + infeasible);
+    last_feasible = solve_at(share);
+    (last_feasible ? feasible : infeasible) = share;
+  }
+  if (!last_feasible) solve_at(feasible);
+  braking_share_ = feasible;
+  return true;
 }
 
 // Safe fallback: a joint damping brake qdd = -D qd, clipped to the joint bounds where they allow it,

@@ -78,6 +78,9 @@ struct WholeBodyQpSettings {
   /// stays above 0.05, so its figures are the paper's; the outstretched elbow (q4 = 0) is below.
   double singular_value_threshold = 0.03;
   double brake_damping = 20.0;    ///< 1/s, the fallback's joint damping brake
+  /// When the QP is infeasible: the largest common share of the bounds' braking demands the torque
+  /// rows allow (kBrakingScaled) before the fallback brake; false: the fallback at once.
+  bool scale_braking = true;
   /// Power and force limiting (power_force_limit.hpp; not in the paper): empty, off. Needs the
   /// collision capsules (their end points are the points it bounds).
   std::optional<PowerForceLimitSettings> power_force_limit;
@@ -92,6 +95,10 @@ enum class WholeBodyQpStatus {
   kQpIterationLimit,   ///< fallback brake used
   kQpFailed,           ///< invalid QP data (NaN) or numerical error: fallback brake used
   kInvalidInput,       ///< non-finite state or tau_ext: last finite command held
+  /// The dampers asked for more braking than the torque limits leave (a push that takes most of a
+  /// joint's torque while it runs toward a limit): the QP's solution with the largest common share
+  /// of those demands the limits allow (WholeBodyQp::braking_share()), no fallback.
+  kBrakingScaled,
 };
 constexpr std::string_view to_string(WholeBodyQpStatus status) {
   switch (status) {
@@ -100,8 +107,13 @@ constexpr std::string_view to_string(WholeBodyQpStatus status) {
     case WholeBodyQpStatus::kQpIterationLimit: return "qp_iteration_limit";
     case WholeBodyQpStatus::kQpFailed: return "qp_failed";
     case WholeBodyQpStatus::kInvalidInput: return "invalid_input";
+    case WholeBodyQpStatus::kBrakingScaled: return "braking_scaled";
   }
   return "unknown";
+}
+/// Whether the QP gave the command (in full, or with its braking scaled), i.e. no fallback.
+constexpr bool solved(WholeBodyQpStatus status) {
+  return status == WholeBodyQpStatus::kOk || status == WholeBodyQpStatus::kBrakingScaled;
 }
 
 class WholeBodyQp {
@@ -149,6 +161,8 @@ public:
   WholeBodyQpStatus status() const { return status_; }
   QpStatus qp_status() const { return solver_.status(); }
   int qp_iterations() const { return solver_.iterations(); }
+  /// The share of the bounds' braking demands the last update held: 1, except under kBrakingScaled.
+  double braking_share() const { return braking_share_; }
   /// For recorders outside the cycle (bench/record_qps.cpp): the QP as last solved (H, g, rows and
   /// bounds of the last update; after a relaxation, the relaxed one), the solver (its results, and
   /// the active set the next warm start begins from), the options of the last solve and the number
@@ -183,6 +197,8 @@ private:
   void fill_constraints(const ConstraintContext& context);
   void bound_uncancelled_push();
   bool relax_a_constraint();
+  bool scale_braking();
+  void set_braking_share(double share);
   void resize_problem();
   void fallback_brake(const Data& data, const Eigen::VectorXd& qd, const Eigen::VectorXd& tau_ext);
 
@@ -203,6 +219,8 @@ private:
   Eigen::VectorXd qdd_external_, qdd_desired_, tau_desired_, last_good_tau_;
   const Eigen::VectorXd* qdd_uncancelled_ = nullptr;  // this update's; null: none, or dropped as infeasible
   double uncancelled_share_ = 1.0;                     // the share of it the bounds hold (halved when infeasible)
+  Eigen::VectorXd braking_lb_, braking_ub_;            // the bounds before scale_braking()
+  double braking_share_ = 1.0;
   Eigen::VectorXd hold_torque_, inertia_diagonal_;  // the constraints' context
   Eigen::VectorXd hessian_diagonal_;                // the tasks' diagonal Hessian terms (ObjectiveTerms)
   WholeBodyQpStatus status_ = WholeBodyQpStatus::kOk;
