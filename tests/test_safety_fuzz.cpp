@@ -901,6 +901,16 @@ TEST(SafetyFuzz, ThirdPartyBrakingBeyondTheTorqueLeftReplayedPass) {
   expect_windows_pass("franka_panda", 27182, 3000, {"push/full_body/custom/4", "push/dual/torque/0"});
 }
 
+// robots/ur5e at 3000 pushes: 180 and 130 N steps on wrist_3_link near a self-collision pair. The
+// bounds, shifted by the uncancelled push, asked joint 5 to brake hard; the collision rows, read on
+// the command alone, took that braking for motion toward the pair, and the shift was halved away as
+// infeasible: 1.40x and 1.15x the wrist's speed limit. The rows on the motion now hold the real
+// acceleration as the bounds do.
+TEST(SafetyFuzz, ThirdPartyWristStepNearACollisionPairReplayedPass) {
+  expect_windows_pass("ur5e", 8128, 3000, {"push/dual/custom/3"});
+  expect_windows_pass("ur5e", 777, 3000, {"push/dual/custom/22"});
+}
+
 // Four windows of seed 31 put their fault on the very sample that carried the switch request; the
 // controller does not switch on a bad sample, so they ran the position loop and were invalid. A
 // fault after a switch now starts after the sample the reference switched on.

@@ -19,6 +19,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <random>
 
 namespace {
@@ -184,16 +185,17 @@ TEST_F(WholeBodyQpTest, AnUncancelledPushMovesTheBoundsInwardByItsAcceleration) 
   // Active on joint 2: the command plus the push lands on the damper's bound.
   EXPECT_NEAR(plain.desired_acceleration()[1], a.ub[1], 1e-6);
   EXPECT_NEAR(pushed.desired_acceleration()[1] + uncancelled[1], a.ub[1], 1e-6);
-  // A push larger than the room between the bounds: the far bound yields to the shifted one, so the
-  // arm gets the paper's upper bound (qdd_d + a_u = ub), where splitting the difference would have
-  // left it above.
+  // A push larger than the room between the bounds: the far bound (the velocity limit's) moves by
+  // a_u too, so the arm's acceleration spans the paper's [lb, ub], where splitting the difference
+  // would have left it above ub.
   Eigen::VectorXd wide = Eigen::VectorXd::Zero(7);
   wide[4] = a.ub[4] - a.lb[4] + 1.0;
   ASSERT_EQ(pushed.update(model_, data_, q, qd, tau_ext, 1e-3, nullptr, &wide), phri::WholeBodyQpStatus::kOk);
   ASSERT_EQ(pushed.solve_count(), 2u) << "feasible with the shift: nothing relaxed";
-  EXPECT_EQ(pushed.qp_problem().lb[4], pushed.qp_problem().ub[4]);
-  EXPECT_NEAR(pushed.desired_acceleration()[4] + wide[4], a.ub[4], 1e-6);
-  EXPECT_GE(pushed.desired_acceleration()[4] + wide[4], a.lb[4]);
+  EXPECT_NEAR(pushed.qp_problem().lb[4], a.lb[4] - wide[4], 1e-9);
+  EXPECT_NEAR(pushed.qp_problem().ub[4], a.ub[4] - wide[4], 1e-9);
+  EXPECT_LE(pushed.desired_acceleration()[4] + wide[4], a.ub[4] + 1e-6);
+  EXPECT_GE(pushed.desired_acceleration()[4] + wide[4], a.lb[4] - 1e-6);
   // Joint 2's upper bound is its joint-limit damper's (above), a position guard: a push the other way
   // that empties the interval does not move it; the two split the difference as before.
   Eigen::VectorXd against_limit = Eigen::VectorXd::Zero(7);
@@ -230,6 +232,81 @@ TEST_F(WholeBodyQpTest, AnUncancelledPushMovesTheBoundsInwardByItsAcceleration) 
   EXPECT_EQ(pushed.qp_problem().lb, a.lb);
   const Eigen::VectorXd short_vector = Eigen::VectorXd::Zero(6);
   EXPECT_EQ(pushed.update(model_, data_, q, qd, tau_ext, 1e-3, nullptr, &short_vector), phri::WholeBodyQpStatus::kInvalidInput);
+}
+
+// A guard on joint 5 of the kind a collision pair near the wrist makes: an upper bound on qdd_5 (and
+// +-50 rad/s^2 on qdd_4), and a row on the motion l <= qdd_5 - 0.2 qdd_4 that braking joint 5 hard
+// would cross (as a collision row reads braking toward the pair).
+class WristGuard final : public phri::Constraint {
+public:
+  WristGuard(double upper, double row_lower) : upper_(upper), row_lower_(row_lower) {}
+  std::string_view type() const override { return "wrist_guard"; }
+  int num_rows() const override { return 1; }
+  void bound(const phri::ConstraintContext&, Eigen::Ref<Eigen::VectorXd> lower, Eigen::Ref<Eigen::VectorXd> upper) override {
+    upper[4] = std::min(upper[4], upper_);
+    lower[3] = std::max(lower[3], -50.0);
+    upper[3] = std::min(upper[3], 50.0);
+  }
+  void fill_rows(const phri::ConstraintContext&, Eigen::Ref<Eigen::MatrixXd> a, Eigen::Ref<Eigen::VectorXd> l,
+                 Eigen::Ref<Eigen::VectorXd> u) override {
+    a.setZero();
+    a(0, 4) = 1.0;
+    a(0, 3) = -0.2;
+    l[0] = row_lower_;
+    u[0] = std::numeric_limits<double>::infinity();
+  }
+
+private:
+  double upper_, row_lower_;
+};
+
+// Rows on the motion hold the real acceleration qdd_d + a_u as the bounds do: both sides move by
+// A a_u; the torque rows (the command's torque) stay. A push on the wrist that the bound answers by
+// braking joint 5 hard: with the row read on the command alone the two contradict each other and the
+// shift would be halved away (a UR5e's wrist, safety-fuzz seed 8128 push/dual/custom/3, reached
+// 1.40x its speed limit that way); on the real motion they agree, solved at once.
+TEST_F(WholeBodyQpTest, AnUncancelledPushShiftsTheRowsOnTheMotionButNotTheTorqueRows) {
+  constexpr double kUpper = 20.0, kRowLower = -30.0, kPush = 500.0;
+  phri::WholeBodyQp plain(model_, nullptr, loose_settings()), pushed(model_, nullptr, loose_settings());
+  for (phri::WholeBodyQp* qp : {&plain, &pushed}) {
+    qp->add_constraint(std::make_unique<WristGuard>(kUpper, kRowLower));
+    set_tasks(*qp, 0.0, 0.0);
+  }
+  const Eigen::VectorXd tau_ext = Eigen::VectorXd::Zero(7);
+  Eigen::VectorXd uncancelled = Eigen::VectorXd::Zero(7);
+  uncancelled[3] = 40.0;
+  uncancelled[4] = kPush;
+  ASSERT_EQ(plain.update(model_, data_, q_, qd_, tau_ext, 1e-3), phri::WholeBodyQpStatus::kOk);
+  const std::size_t solves = pushed.solve_count();
+  ASSERT_EQ(pushed.update(model_, data_, q_, qd_, tau_ext, 1e-3, nullptr, &uncancelled), phri::WholeBodyQpStatus::kOk);
+  EXPECT_EQ(pushed.solve_count() - solves, 1u) << "consistent on the real motion: nothing halved";
+
+  const phri::QpProblem &a = plain.qp_problem(), &b = pushed.qp_problem();
+  ASSERT_EQ(a.A.rows(), 8);  // the torque rows, then the guard's
+  EXPECT_EQ(b.l.head(7), a.l.head(7));
+  EXPECT_EQ(b.u.head(7), a.u.head(7));
+  const double row_push = uncancelled[4] - 0.2 * uncancelled[3];
+  EXPECT_NEAR(b.l[7], kRowLower - row_push, 1e-12);
+  EXPECT_EQ(b.u[7], std::numeric_limits<double>::infinity());
+  // The real acceleration keeps both the bound and the row; the command within its torque rows.
+  const Eigen::VectorXd real = pushed.desired_acceleration() + uncancelled;
+  EXPECT_NEAR(real[4], kUpper, 1e-6);
+  EXPECT_GE(real[4] - 0.2 * real[3], kRowLower - 1e-9);
+  const Eigen::VectorXd torque_rows = data_.mass_matrix * pushed.desired_acceleration();
+  EXPECT_TRUE((torque_rows.array() >= b.l.head(7).array() - 1e-9).all());
+  EXPECT_TRUE((torque_rows.array() <= b.u.head(7).array() + 1e-9).all());
+  // The row read on the command alone contradicts the shifted bound (a separate solver).
+  phri::QpProblem unshifted = b;
+  unshifted.l[7] = kRowLower;
+  phri::QpSolver separate(7, 0, unshifted.A.rows());
+  EXPECT_EQ(separate.solve(unshifted), phri::QpStatus::kInfeasible);
+  // In the cycle: no allocation.
+  phri::test::AllocationCounter count;
+  {
+    phri::test::NoMallocScope no_malloc;
+    EXPECT_EQ(pushed.update(model_, data_, q_, qd_, tau_ext, 1e-3, nullptr, &uncancelled), phri::WholeBodyQpStatus::kOk);
+  }
+  EXPECT_EQ(count.allocations(), 0u);
 }
 
 // UncancelledPush against closed forms: a_u = (M + B)^-1 (tau_fast - tau_ext) from the torque side

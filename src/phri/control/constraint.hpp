@@ -40,6 +40,10 @@ public:
   /// Tightens the bounds on qdd: lower = max(lower, ...), upper = min(upper, ...).
   virtual void bound(const ConstraintContext& /*context*/, Eigen::Ref<Eigen::VectorXd> /*lower*/,
                      Eigen::Ref<Eigen::VectorXd> /*upper*/) {}
+  /// Whether its rows bound the arm's motion (a distance, a point's speed), so that they hold for
+  /// the push the command does not cancel yet as the bounds do; false for rows on the command's
+  /// own torque (TorqueLimitConstraint).
+  virtual bool rows_bound_the_motion() const { return true; }
   /// Fills its num_rows() rows: l <= a qdd <= u.
   virtual void fill_rows(const ConstraintContext& /*context*/, Eigen::Ref<Eigen::MatrixXd> /*a*/,
                          Eigen::Ref<Eigen::VectorXd> /*l*/, Eigen::Ref<Eigen::VectorXd> /*u*/) {}

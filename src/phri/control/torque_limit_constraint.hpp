@@ -15,6 +15,8 @@ public:
 
   std::string_view type() const override { return "torque_limit"; }
   int num_rows() const override { return static_cast<int>(torque_limit_.size()); }
+  /// Its rows hold the torque the command asks, whatever the push adds to the motion.
+  bool rows_bound_the_motion() const override { return false; }
   void fill_rows(const ConstraintContext& context, Eigen::Ref<Eigen::MatrixXd> a, Eigen::Ref<Eigen::VectorXd> l,
                  Eigen::Ref<Eigen::VectorXd> u) override {
     rows(context.data, context.tau_ext, a, l, u);

@@ -17,8 +17,8 @@
 // the direction that overspeeds, and where an offset on a torque sensor shows (the observer reads a
 // push that is not there, the command cancels it, and the torque side, fooled too, may disagree in
 // sign). Elsewhere the smaller of the two where they agree in sign, and 0 where they do not.
-// WholeBodyQp's bounds hold for it. Without motion evidence (the first cycle, after a cycle with no
-// QP command) it is 0.
+// WholeBodyQp's bounds and its rows on the motion hold for it. Without motion evidence (the first
+// cycle, after a cycle with no QP command) it is 0.
 //
 // Both the motion estimate and the bound's counter-acceleration assume a command reaches the link
 // within the period, as through rigid gears. Through an elastic transmission (stiffness K behind a

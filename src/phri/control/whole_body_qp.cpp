@@ -122,6 +122,7 @@ void WholeBodyQp::resize_problem() {
   for (const auto& constraint : constraints_) rows += constraint->num_rows();
   problem_.resize(nv_, 0, rows);
   solver_.resize(nv_, 0, rows);
+  row_shift_.resize(rows);
   braking_lb_.resize(nv_);
   braking_ub_.resize(nv_);
   warm_ = false;
@@ -171,6 +172,7 @@ void WholeBodyQp::fill_constraints(const ConstraintContext& context) {
     const int n = constraint->num_rows();
     if (n == 0) continue;
     constraint->fill_rows(context, problem_.A.middleRows(row, n), problem_.l.segment(row, n), problem_.u.segment(row, n));
+    if (qdd_uncancelled_ && constraint->rows_bound_the_motion()) shift_rows_by_uncancelled_push(row, n);
     row += n;
   }
   if (qdd_uncancelled_) bound_uncancelled_push();
@@ -183,11 +185,10 @@ void WholeBodyQp::fill_constraints(const ConstraintContext& context) {
 // The bounds on qdd hold the real acceleration (constraint.hpp): the command's qdd_d plus a_u, the
 // push the command does not cancel yet. Each bound only moves inward: ub - max(a_u, 0), lb - min(a_u, 0),
 // so an overestimate asks no acceleration beyond the paper's bounds. Where that empties the interval
-// and the far bound is the velocity limit's own, it yields to the shifted one: qdd_d = ub - a_u gives
-// the arm ub >= lb, where splitting the difference left it (lb + ub + a_u) / 2 > ub (replayed: a UR5e
-// wrist after a 177 N ramp let go: qdd_d -310 to -460 rad/s^2 against 560-700 of estimated uncancelled
-// push, and the wrist went on accelerating to 1.10x its limit). A far bound that guards a position
-// (a joint-limit damper, a collision braking bound) does not yield: an overestimated a_u would drive
+// and the far bound is the velocity limit's own, it moves too: the arm's acceleration qdd_d + a_u
+// then spans the paper's [lb, ub] (splitting the difference left it at (lb + ub + a_u) / 2 > ub; a
+// single point qdd_d = ub - a_u left no room for a collision row). A far bound that guards a position
+// (a joint-limit damper, a collision braking bound) does not move: an overestimated a_u would drive
 // the joint into it. An interval empty before the shift is split below, as before.
 void WholeBodyQp::bound_uncancelled_push() {
   for (int i = 0; i < nv_; ++i) {
@@ -197,17 +198,30 @@ void WholeBodyQp::bound_uncancelled_push() {
       problem_.ub[i] -= a;
       if (open && problem_.lb[i] > problem_.ub[i] && velocity_limit_ &&
           problem_.lb[i] == velocity_limit_->cycle_lower()[i]) {
-        problem_.lb[i] = problem_.ub[i];
+        problem_.lb[i] -= a;
       }
     }
     if (a < 0.0) {
       problem_.lb[i] -= a;
       if (open && problem_.ub[i] < problem_.lb[i] && velocity_limit_ &&
           problem_.ub[i] == velocity_limit_->cycle_upper()[i]) {
-        problem_.ub[i] = problem_.lb[i];
+        problem_.ub[i] -= a;
       }
     }
   }
+}
+
+// A row on the motion holds the real acceleration too: l <= a (qdd_d + a_u) <= u, so both sides
+// move by a a_u (at the bounds' share), outward as well as inward: a command that brakes a joint
+// against the push is no motion toward a collision pair while the push cancels it, and a row that
+// read it so would leave the bounds' shift infeasible, to be halved and dropped. a_u is measured
+// motion where it speeds a joint up (uncancelled_push.hpp). The torque rows bound the command: kept.
+void WholeBodyQp::shift_rows_by_uncancelled_push(Eigen::Index row, int n) {
+  auto shift = row_shift_.head(n);
+  shift.noalias() = problem_.A.middleRows(row, n) * *qdd_uncancelled_;
+  shift *= uncancelled_share_;
+  problem_.l.segment(row, n) -= shift;
+  problem_.u.segment(row, n) -= shift;
 }
 
 bool WholeBodyQp::relax_a_constraint() {

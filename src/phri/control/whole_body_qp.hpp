@@ -144,7 +144,8 @@ public:
   /// One control cycle. `data`: after compute_all_terms(q, qd) on the controller's (link-side)
   /// model; tau_ext: estimated external torque; ee_wrench_world: the F/T wrench at the end effector
   /// (TaskContext), or null; uncancelled_acceleration: what the push does to the arm beyond what
-  /// the command cancels (UncancelledPush), or null: the bounds on qdd hold for it too;
+  /// the command cancels (UncancelledPush), or null: the bounds on qdd and the rows on the motion
+  /// (Constraint::rows_bound_the_motion) hold for it too;
   /// release_acceleration: what the arm would get if the push ended now (UncancelledPush), or null:
   /// the velocity limits bound the speed it would reach (velocity_limit_constraint.hpp). Returns the status;
   /// results below.
@@ -196,6 +197,7 @@ private:
   void assemble_objective();
   void fill_constraints(const ConstraintContext& context);
   void bound_uncancelled_push();
+  void shift_rows_by_uncancelled_push(Eigen::Index row, int n);
   bool relax_a_constraint();
   bool scale_braking();
   void set_braking_share(double share);
@@ -219,6 +221,7 @@ private:
   Eigen::VectorXd qdd_external_, qdd_desired_, tau_desired_, last_good_tau_;
   const Eigen::VectorXd* qdd_uncancelled_ = nullptr;  // this update's; null: none, or dropped as infeasible
   double uncancelled_share_ = 1.0;                     // the share of it the bounds hold (halved when infeasible)
+  Eigen::VectorXd row_shift_;                          // a a_u of one constraint's rows (scratch)
   Eigen::VectorXd braking_lb_, braking_ub_;            // the bounds before scale_braking()
   double braking_share_ = 1.0;
   Eigen::VectorXd hold_torque_, inertia_diagonal_;  // the constraints' context
