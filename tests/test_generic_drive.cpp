@@ -420,6 +420,91 @@ TEST(GenericDrive, TheHoldGivesWayUnderALoadAsItsOwnGainsSay) {
   EXPECT_GT(deflection_own, 1.5 * deflection_default);  // the softer stated hold gives way more
 }
 
+// robots/franka_panda at q2 = -0.16: joints 1 and 3 nearly share an axis, and their counter-rotation
+// is far lighter than either M_ii the hold's gains come from. With the damping explicit at the 4 kHz
+// step (kd h above that mode's inertia) the hold rang at the step's Nyquist rate: the 1 kHz samples
+// read +-0.55 rad/s on joints 1 and 3 with the arm still (safety-fuzz seed 16180, two windows failed
+// as moving after their safe stop). The plant now applies the drive's damping within its step: after
+// a push the hold comes to rest, the sampled velocity is the motion (finite differences of q), and
+// the motor's torque is K_T G_r times its current, damping included.
+TEST(GenericDrive, TheHoldComesToRestOnALightModeOfTheArm) {
+  phri::Config config = run_config(kRoot + "/robots/franka_panda");
+  config.plant.friction_scale = 0.0;
+  config.plant.noise.torque_sensor_std_Nm = config.plant.noise.velocity_std_rad_s = config.plant.noise.current_std_A = 0.0;
+  config.plant.noise.encoder_counts_per_rev = 0.0;
+  config.plant.initial_q_rad = {0.45, -0.16, 0.0, -2.356, 0.0, 1.571, 0.785};
+  config.plant.disturbances = {phri::test::hand_push("panda_link3", Eigen::Vector3d::Zero(), Eigen::Vector3d(0.0, 80.0, 0.0), 0.05, 0.1)};
+  phri::SimRobot robot(config.plant);
+  phri::RobotCommand hold(robot.dof());
+  hold.mode = L::kPosition;
+  hold.q_rad = start_posture(config.plant);
+  const double period = robot.period_s();
+  Eigen::VectorXd q_previous = robot.truth().q_rad;
+  double late_speed = 0.0, late_mismatch = 0.0, moved = 0.0, torque_error = 0.0;
+  for (int k = 0; k < 1000; ++k) {
+    robot.read();
+    ASSERT_EQ(robot.write(hold), phri::WriteStatus::kOk);
+    const auto& t = robot.truth();
+    moved = std::max(moved, (t.q_rad - hold.q_rad).cwiseAbs().maxCoeff());
+    for (int i = 0; i < robot.dof(); ++i) {
+      const double torque_per_amp = robot.plant_actuators()[i].torque_per_amp();
+      torque_error = std::max(torque_error, std::abs(t.tau_motor_Nm[i] - torque_per_amp * t.current_A[i]));
+    }
+    if (k >= 500) {  // 0.35 s after the push
+      late_speed = std::max(late_speed, t.qd_rad_s.cwiseAbs().maxCoeff());
+      late_mismatch = std::max(late_mismatch, (t.qd_rad_s - (t.q_rad - q_previous) / period).cwiseAbs().maxCoeff());
+    }
+    q_previous = t.q_rad;
+  }
+  std::printf("Panda hold at q2 = -0.16 after an 80 N push on panda_link3: moved %.3f mrad, late |qd| max %.2e rad/s, "
+              "|qd - dq/dt| max %.2e rad/s\n", 1e3 * moved, late_speed, late_mismatch);
+  EXPECT_GT(moved, 1e-4) << "the push moved the arm";
+  EXPECT_LT(late_speed, 1e-3);
+  EXPECT_LT(late_mismatch, 1e-3);
+  EXPECT_LT(torque_error, 1e-9);
+}
+
+// The hold's tick with its damping left to the plant: unsaturated, the current is the rest of the PD
+// (hold + kp e + kd qd_d) over K_T G_r, not clamped on its own, and implicit_damping() is kd; where
+// the whole PD is beyond the current limit, the current is the limit's and nothing is left to the
+// plant; not allowed (elastic plants), the whole PD as before.
+TEST(GenericDrive, TheHoldLeavesItsDampingToThePlantOnlyWithinTheCurrentLimit) {
+  const phri::Config config = run_config(generic_folder());
+  const phri::ActuatorTable table = config.plant.plant_actuators();
+  const int n = table.size();
+  const std::vector<double> kp(static_cast<std::size_t>(n), 1000.0), kd(static_cast<std::size_t>(n), 20.0);
+  phri::RobotCommand command(n);
+  command.mode = L::kPosition;
+  command.q_rad.setZero();
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(n), tau_entry = Eigen::VectorXd::Zero(n);
+  const int j = n - 1;
+  const double k = table[j].torque_per_amp(), limit = table[j].current_limit_A * k;
+  Eigen::VectorXd current(n);
+  for (const bool allowed : {true, false}) {
+    SCOPED_TRACE(allowed ? "allowed" : "not allowed");
+    phri::GenericDrive drive(table, kp, kd, 1e-3);
+    drive.allow_implicit_damping(allowed);
+    drive.begin_cycle(command, false, zero, tau_entry);
+    // The P term alone is past the limit, the damping brings the whole back within it.
+    Eigen::VectorXd q = zero, qd = zero;
+    q[j] = -1.2 * limit / 1000.0;  // kp e = 1.2 limit
+    qd[j] = 0.5 * limit / 20.0;    // kd qd = 0.5 limit
+    drive.tick(q, qd, zero, true, current);
+    if (allowed) {
+      EXPECT_NEAR(current[j] * k, 1.2 * limit, 1e-9 * limit);
+      EXPECT_EQ(drive.implicit_damping(j), 20.0);
+    } else {
+      EXPECT_NEAR(current[j] * k, 0.7 * limit, 1e-9 * limit);
+      EXPECT_EQ(drive.implicit_damping(j), 0.0);
+    }
+    // The whole PD past the limit: saturated, nothing left to the plant.
+    qd[j] = 0.1 * limit / 20.0;
+    drive.tick(q, qd, zero, true, current);
+    EXPECT_NEAR(current[j], table[j].current_limit_A, 1e-12);
+    EXPECT_EQ(drive.implicit_damping(j), 0.0);
+  }
+}
+
 TEST(GenericDrive, HoldsItsPoseWithinOneMillimetreWithItsStatedGains) {
   Session s(M::kNullSpace, L::kPosition, {}, own_gains_folder());
   const Eigen::Vector3d start = s.flange();

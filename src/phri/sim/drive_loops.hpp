@@ -62,6 +62,15 @@ public:
   /// The arm starts the simulation already holding itself: the position hold carries `tau` [N.m]
   /// (the gravity torque of the initial pose) from the first tick.
   virtual void start_holding(const Eigen::VectorXd& tau) = 0;
+
+  /// Whether a tick may leave its damping on the joint velocity to the plant (SimRobot allows it
+  /// where the motor torque acts on the link itself: rigid transmissions).
+  virtual void allow_implicit_damping(bool /*allowed*/) {}
+  /// The damping c [N.m.s/rad] of `joint` the last tick left out of its current: the plant applies
+  /// -c qd within its step, on the velocity at the step's end (implicit), as a drive's continuous
+  /// loop does; an explicit -c qd_meas rings at the step's rate on a light mode of the arm when
+  /// c h exceeds that mode's inertia. 0: none.
+  virtual double implicit_damping(int /*joint*/) const { return 0.0; }
 };
 
 }  // namespace phri

@@ -28,6 +28,7 @@ GenericDrive::GenericDrive(const ActuatorTable& drives, const std::vector<double
   tau_des_ = Eigen::VectorXd::Zero(n);
   current_des_ = Eigen::VectorXd::Zero(n);
   last_qd_meas_ = Eigen::VectorXd::Zero(n);
+  implicit_damping_ = Eigen::VectorXd::Zero(n);
 }
 
 void GenericDrive::hold_gains(const Eigen::VectorXd& inertia, const GenericHoldGains& given, std::vector<double>& kp,
@@ -81,10 +82,21 @@ void GenericDrive::tick(const Eigen::VectorXd& q_meas, const Eigen::VectorXd& qd
   last_qd_meas_ = qd_meas;
   for (int i = 0; i < dof(); ++i) {
     double tau = 0.0;
+    implicit_damping_[i] = 0.0;
     switch (mode_) {
-      case LowLevelMode::kPosition:
-        tau = hold_torque_[i] + kp_[i] * (q_des_[i] - q_meas[i]) + kd_[i] * (qd_des_[i] - qd_meas[i]);
+      case LowLevelMode::kPosition: {
+        const double without_damping = hold_torque_[i] + kp_[i] * (q_des_[i] - q_meas[i]) + kd_[i] * qd_des_[i];
+        tau = without_damping - kd_[i] * qd_meas[i];
+        // Unsaturated: the damping goes to the plant's step (header), and the current sent is the
+        // rest of it, not clamped on its own (with the damping the motor stays within its limit);
+        // saturated, the current is the limit's.
+        if (implicit_allowed_ && std::abs(tau) <= current_limit_[i] * torque_per_amp_[i]) {
+          implicit_damping_[i] = kd_[i];
+          current_out[i] = without_damping / torque_per_amp_[i];
+          continue;
+        }
         break;
+      }
       case LowLevelMode::kTorque:
         tau = std::clamp(tau_des_[i], -torque_limit_[i], torque_limit_[i]);
         break;

@@ -7,6 +7,11 @@
 //   the torque the motor carried when the mode was entered, with the drive's own gains (robot.yaml
 //   or the plant YAML: drive.position_hold; by default hold_gains' rule, not Kinova's servo gains):
 //     tau = tau_entry + Kp (q_d - q) + Kd (qd_d - qd)
+//   On a rigid plant the -Kd qd term is applied by the plant within its step (implicit_damping())
+//   while the current stays below its limit: a joint pair whose axes nearly align (a Panda at
+//   q2 ~ -0.16) has a counter-rotation mode far lighter than either M_ii, on which the explicit
+//   term rang at the physics step's Nyquist rate. (It acts on the true velocity: the velocity
+//   sensor's noise no longer enters the hold's damping.)
 //   qd_d = (q_d[k] - q_d[k-1]) / T_control from streamed set-points (0 when none is new), clipped
 //   to the joint velocity limit. tau_entry = the motor torque of the previous tick minus the P
 //   term: entering is bumpless, and an arm entering at rest keeps holding its weight with no
@@ -58,6 +63,8 @@ public:
   bool uses_velocity() const override { return mode_ == LowLevelMode::kPosition; }
   bool uses_torque() const override { return false; }
   void start_holding(const Eigen::VectorXd& tau) override { hold_torque_ = tau; }
+  void allow_implicit_damping(bool allowed) override { implicit_allowed_ = allowed; }
+  double implicit_damping(int joint) const override { return implicit_damping_[joint]; }
 
   /// The position hold's torque offset [N.m] (tests, logs).
   const Eigen::VectorXd& hold_torque() const { return hold_torque_; }
@@ -72,6 +79,8 @@ private:
   bool entered_ = false;
   Eigen::VectorXd q_des_, qd_des_, hold_torque_, tau_des_, current_des_;
   Eigen::VectorXd last_qd_meas_;  // the velocity the drive last measured (bumpless position entry)
+  bool implicit_allowed_ = false;
+  Eigen::VectorXd implicit_damping_;  // per joint, the last tick's (implicit_damping())
 };
 
 }  // namespace phri

@@ -413,8 +413,8 @@ void SimRobot::allocate_buffers() {
   state_ = RobotState(n_);
   // Per-step buffers and truth, sized once here: read() and write() do not allocate.
   for (Eigen::VectorXd* v : {&q_meas_, &qd_meas_, &tau_meas_, &current_, &tau_motor_, &tau_viscous_, &tau_dry_, &tau_s_,
-                             &deflection_torque_, &v_before_, &f_dry_, &damping_, &qdd_, &truth_.q_rad, &truth_.qd_rad_s,
-                             &truth_.qdd_rad_s2, &truth_.current_A, &truth_.tau_motor_Nm, &truth_.tau_friction_Nm,
+                             &hold_damping_, &deflection_torque_, &v_before_, &f_dry_, &damping_, &qdd_, &truth_.q_rad,
+                             &truth_.qd_rad_s, &truth_.qdd_rad_s2, &truth_.current_A, &truth_.tau_motor_Nm, &truth_.tau_friction_Nm,
                              &truth_.tau_transmitted_Nm, &truth_.q_motor_rad, &q_before_}) {
     *v = Eigen::VectorXd::Zero(n_);
   }
@@ -552,6 +552,7 @@ void SimRobot::start_drives_holding(const Eigen::VectorXd& hold) {
     q_meas_[i] = quantize(servo_position(i));
   }
   drive_ = make_drive_loops(config_, hold_kp_, hold_kd_);
+  drive_->allow_implicit_damping(!elastic());
   drive_->begin_cycle(command_, false, q_meas_, vendor_torque());
   drive_->start_holding(vendor_torque());
 }
@@ -729,6 +730,10 @@ void SimRobot::finish_rigid() {
     qdd_[i] = (v1 - v_before_[i]) / m_->opt.timestep;
     tau_viscous_[i] = -viscous_[i] * v1;
     tau_dry_[i] = f_dry_[i] - (damping_[i] - viscous_[i]) * v1;
+    if (hold_damping_[i] != 0.0) {  // the motor carried the drive's damping too
+      tau_motor_[i] -= hold_damping_[i] * v1;
+      current_[i] = tau_motor_[i] / torque_per_amp_[i];
+    }
     tau_s_[i] = tau_motor_[i] + tau_viscous_[i] + tau_dry_[i] - armature_[i] * qdd_[i];
   }
 }
@@ -777,10 +782,18 @@ void SimRobot::substep(bool last_of_period) {
   drive_->tick(q_meas_, qd_meas_, tau_meas_, filter_phase_ == 0, current_);
 
   // 3. Joint torques: rigid, motor and the explicit part of the dry friction; elastic, the spring.
+  //    A rigid joint's drive damping c (DriveLoops::implicit_damping) acts as -c v1 like the viscous
+  //    friction: -c v0 here, the rest through dof_damping in the step's implicit part.
   for (int i = 0; i < n_; ++i) {
     const int d = dadr_[static_cast<std::size_t>(i)];
     tau_motor_[i] = torque_per_amp_[i] * current_[i];
-    d_->qfrc_applied[d] = elastic() ? f_dry_[i] : tau_motor_[i] + f_dry_[i];
+    if (elastic()) {
+      d_->qfrc_applied[d] = f_dry_[i];
+      continue;
+    }
+    hold_damping_[i] = drive_->implicit_damping(i);
+    d_->qfrc_applied[d] = tau_motor_[i] + f_dry_[i] - hold_damping_[i] * v_before_[i];
+    m_->dof_damping[d] = damping_[i] + hold_damping_[i];
   }
 
   // 4. External forces.

@@ -248,6 +248,7 @@ private:
 
   // per-step buffers
   Eigen::VectorXd q_meas_, qd_meas_, tau_meas_, current_, tau_motor_, tau_viscous_, tau_dry_, tau_s_, deflection_torque_;
+  Eigen::VectorXd hold_damping_;  // the drive's damping applied within the step (DriveLoops::implicit_damping)
   Eigen::VectorXd v_before_, f_dry_, damping_, qdd_;
   Vector6d wrench_true_ = Vector6d::Zero();
   Vector6d wrench_meas_ = Vector6d::Zero();
