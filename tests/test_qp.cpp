@@ -680,6 +680,37 @@ TEST(QpSolver, WarmStartAcrossPerturbedProblems) {
   EXPECT_LT(warm_iterations, cold_iterations);
 }
 
+// Rows with no finite side are neither copied nor scanned: a solver that kept earlier problems'
+// rows in their place answers every later problem to the bit as a fresh solver does, cold and from
+// the same warm start, on the small-n path and on the blocked one (n >= 16).
+TEST(QpSolver, RowsThatBoundNothingAreNeverRead) {
+  Rng rng(44);
+  for (const Index n : {Index{7}, Index{20}}) {
+    const Index m_in = 3 * n;
+    QpSolver kept(n, 1, m_in);
+    for (int t = 0; t < 60; ++t) {
+      QpProblem p = random_problem(rng, {n, 1, m_in}, 2.0, true, 10.0);
+      for (Index i = 0; i < m_in; ++i) {
+        if (!rng.chance(0.5)) continue;
+        p.A.row(i) = 1e3 * rng.gaussian(n).transpose();  // what a stale copy would hold if read
+        p.l(i) = rng.chance(0.5) ? -kInf : -1e21;
+        p.u(i) = rng.chance(0.5) ? kInf : 1e22;
+      }
+      const bool warm = t % 2 == 1;
+      QpSolver fresh(n, 1, m_in);
+      if (warm) {
+        ASSERT_TRUE(fresh.set_active_set(kept.active_rows(), kept.active_bounds()));
+      }
+      const QpStatus status = kept.solve(p, {.warm_start = warm});
+      ASSERT_EQ(fresh.solve(p, {.warm_start = warm}), status) << "n " << n << ", problem " << t;
+      EXPECT_EQ(kept.iterations(), fresh.iterations()) << "n " << n << ", problem " << t;
+      EXPECT_TRUE(kept.x() == fresh.x()) << "n " << n << ", problem " << t;
+      EXPECT_TRUE(kept.row_multipliers() == fresh.row_multipliers()) << "n " << n << ", problem " << t;
+      if (status == QpStatus::kOptimal) expect_kkt(p, kept, 1e-7, "problem " + std::to_string(t));
+    }
+  }
+}
+
 TEST(QpSolver, WarmStartIgnoresAbsentSidesAndBadSizes) {
   QpProblem p;
   p.resize(2, 0, 1);

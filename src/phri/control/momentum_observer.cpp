@@ -60,7 +60,11 @@ const Eigen::VectorXd& MomentumObserver::update(const Data& data, const Eigen::V
   // The joint's speed over the last ~10 ms: an elastic joint's ringing (fast, tiny) is no motion.
   release_velocity_ += (dt / (kReleaseVelocityFilter_s + dt)) * (qd - release_velocity_);
   // The kick the arm would get if every push were gone and the controller still cancelled r:
-  // -M^-1 r. Only where it drives a fast joint along its motion does the release path act.
+  // -M^-1 r. Only where it drives a fast joint along its motion does the release path act (no fast
+  // joint: no kick to compute).
+  bool any_fast = false;
+  for (Eigen::Index j = 0; j < residual_.size(); ++j) any_fast |= std::abs(release_velocity_[j]) > release_speed_[j];
+  if (!any_fast) return residual_;
   release_kick_ = -residual_;
   data.mass_matrix_llt.solve_in_place(release_kick_);
   bool kick_along_motion = false;

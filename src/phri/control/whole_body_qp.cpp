@@ -255,7 +255,7 @@ WholeBodyQpStatus WholeBodyQp::update(const Model& model, const Data& data, cons
   }
   // qdd_ext = M^-1 tau_ext: what the push alone would do to the arm (through the dead band).
   soft_deadband(tau_ext, deadband_, qdd_external_);
-  data.mass_matrix_llt.solve_in_place(qdd_external_);
+  if (!qdd_external_.isZero(0.0)) data.mass_matrix_llt.solve_in_place(qdd_external_);  // else exactly 0
   // Not finite: ignored (tau_ext, checked above, still bounds the arm).
   qdd_uncancelled_ = uncancelled_acceleration && uncancelled_acceleration->allFinite() ? uncancelled_acceleration : nullptr;
   uncancelled_share_ = 1.0;

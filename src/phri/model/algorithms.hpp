@@ -62,7 +62,8 @@ void mass_matrix_solve_in_place(const Data& data, Eigen::Ref<Eigen::VectorXd> x)
 /// Inverse dynamics tau = M(q) qdd + h(q, qd) (recursive Newton-Euler), into data.tau.
 const Eigen::VectorXd& rnea(const Model& model, Data& data, const Eigen::VectorXd& q,
                             const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd);
-/// h(q, qd) = C(q, qd) qd + g(q), into data.nonlinear_effects.
+/// h(q, qd) = C(q, qd) qd + g(q), into data.nonlinear_effects (the same pass leaves g(q) and C^T qd in
+/// data.gravity_torque and data.coriolis_transpose_qd, as compute_all_terms does).
 const Eigen::VectorXd& nonlinear_effects(const Model& model, Data& data, const Eigen::VectorXd& q,
                                          const Eigen::VectorXd& qd);
 /// g(q), into data.gravity_torque (body velocities and accelerations in data are kept).

@@ -61,6 +61,7 @@ struct CollisionData {
   // point of its axis; per pair a lower bound on the distance and an upper bound on -d(distance)/dt.
   Eigen::Matrix3Xd capsule_center;
   Eigen::VectorXd capsule_speed;
+  Eigen::VectorXd capsule_angular_speed;  ///< |omega| of the capsule's body (workspace)
   Eigen::VectorXd distance_lower_bound;
   Eigen::VectorXd approach_speed_bound;
   // Set at construction from the capsules' shapes: per capsule the axis's midpoint in its body's

@@ -114,6 +114,13 @@ void composite_rigid_body_from_placements(const Model& model, Data& data) {
   });
 }
 
+// I_i v_i, the body's momentum, for every backward sweep (Newton-Euler and C^T qd). Out of line so
+// that each rounds it the same way: inlined, GCC contracts its multiply-adds into FMAs differently
+// where the result has one use and where it has two.
+[[gnu::noinline]] Vector6d body_momentum(const Data& data, int i) {
+  return data.body_inertias[static_cast<std::size_t>(i)].apply(data.body_velocities.col(i));
+}
+
 // Backward Newton-Euler sweep with the body velocities and accelerations already in Data.
 // Gravity enters as an upward acceleration of the base, (-g; 0).
 void newton_euler_backward(const Model& model, Data& data, const Eigen::VectorXd* qdd,
@@ -124,7 +131,7 @@ void newton_euler_backward(const Model& model, Data& data, const Eigen::VectorXd
     const WorldInertia& inertia = data.body_inertias[static_cast<std::size_t>(i)];
     const Vector6d v = data.body_velocities.col(i);
     const Vector6d a = data.body_accelerations.col(i) + base_acceleration;
-    Vector6d f = inertia.apply(a) + force_cross(v, inertia.apply(v));
+    Vector6d f = inertia.apply(a) + force_cross(v, body_momentum(data, i));
     if (i + 1 < model.nq()) f += data.body_forces.col(i + 1);
     data.body_forces.col(i) = f;
     tau[i] = data.motion_subspace.col(i).dot(f);
@@ -171,8 +178,10 @@ const Eigen::VectorXd& rnea(const Model& model, Data& data, const Eigen::VectorX
   return data.tau;
 }
 
-const Eigen::VectorXd& nonlinear_effects(const Model& model, Data& data, const Eigen::VectorXd& q,
-                                         const Eigen::VectorXd& qd) {
+namespace {
+
+// Placements, velocities, the drift accelerations (qdd = 0) and the bodies' world inertias.
+void kinematics_with_drift(const Model& model, Data& data, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
   forward_kinematics(model, data, q, qd);
   for (int i = 0; i < model.nq(); ++i) {
     const Vector6d s = data.motion_subspace.col(i);
@@ -181,7 +190,41 @@ const Eigen::VectorXd& nonlinear_effects(const Model& model, Data& data, const E
     data.body_accelerations.col(i) = a;
   }
   update_body_inertias(model, data);
-  newton_euler_backward(model, data, nullptr, data.nonlinear_effects);
+}
+
+
+// h(q, qd) (the Newton-Euler sweep with qdd = 0), g(q) and C^T qd in one backward pass, each
+// body's inertia and momentum I_i v_i formed once for the three.
+void nonlinear_gravity_and_coriolis_transpose_backward(const Model& model, Data& data) {
+  Vector6d base_acceleration;
+  base_acceleration << -model.gravity(), Eigen::Vector3d::Zero();
+  Vector6d gravity_force = Vector6d::Zero(), momentum = Vector6d::Zero();
+  for (int i = model.nq() - 1; i >= 0; --i) {
+    const WorldInertia& inertia = data.body_inertias[static_cast<std::size_t>(i)];
+    const Vector6d v = data.body_velocities.col(i);
+    const Vector6d momentum_i = body_momentum(data, i);
+    const Vector6d a = data.body_accelerations.col(i) + base_acceleration;
+    Vector6d f = inertia.apply(a) + force_cross(v, momentum_i);
+    if (i + 1 < model.nq()) f += data.body_forces.col(i + 1);
+    data.body_forces.col(i) = f;
+    const auto s = data.motion_subspace.col(i);
+    data.nonlinear_effects[i] = s.dot(f);
+    gravity_force += inertia.apply(base_acceleration);
+    data.gravity_torque[i] = s.dot(gravity_force);
+    momentum += momentum_i;
+    data.coriolis_transpose_qd[i] =
+        i == 0 ? 0.0  // the base does not move
+               : motion_cross(data.body_velocities.col(i - 1), data.motion_subspace.col(i)).dot(momentum);
+  }
+}
+
+}  // namespace
+
+// Through compute_all_terms' own passes, so that both give h to the bit (g and C^T qd come along).
+const Eigen::VectorXd& nonlinear_effects(const Model& model, Data& data, const Eigen::VectorXd& q,
+                                         const Eigen::VectorXd& qd) {
+  kinematics_with_drift(model, data, q, qd);
+  nonlinear_gravity_and_coriolis_transpose_backward(model, data);
   return data.nonlinear_effects;
 }
 
@@ -197,22 +240,11 @@ namespace {
 // Body i's step of the backward pass of C^T qd: the subtree's momentum gains I_i v_i, and
 // dT/dq_i = (v_{i-1} x S_i) . H_i.
 void coriolis_transpose_step(const Data& data, int i, Vector6d& momentum, Eigen::VectorXd& out) {
-  momentum += data.body_inertias[static_cast<std::size_t>(i)].apply(data.body_velocities.col(i));
+  momentum += body_momentum(data, i);
   out[i] = i == 0 ? 0.0  // the base does not move
                   : motion_cross(data.body_velocities.col(i - 1), data.motion_subspace.col(i)).dot(momentum);
 }
 
-// g(q) and C^T qd in one backward pass over the same inertias (each as its own pass computes it).
-void gravity_and_coriolis_transpose_backward(const Model& model, Data& data) {
-  Vector6d base_acceleration;
-  base_acceleration << -model.gravity(), Eigen::Vector3d::Zero();
-  Vector6d force = Vector6d::Zero(), momentum = Vector6d::Zero();
-  for (int i = model.nq() - 1; i >= 0; --i) {
-    force += data.body_inertias[static_cast<std::size_t>(i)].apply(base_acceleration);
-    data.gravity_torque[i] = data.motion_subspace.col(i).dot(force);
-    coriolis_transpose_step(data, i, momentum, data.coriolis_transpose_qd);
-  }
-}
 
 }  // namespace
 
@@ -227,9 +259,9 @@ const Eigen::VectorXd& coriolis_transpose_times_velocity(const Model& model, Dat
 
 bool compute_all_terms(const Model& model, Data& data, const Eigen::VectorXd& q,
                        const Eigen::VectorXd& qd) {
-  nonlinear_effects(model, data, q, qd);  // placements, velocities, drift accelerations, inertias
+  kinematics_with_drift(model, data, q, qd);
+  nonlinear_gravity_and_coriolis_transpose_backward(model, data);
   update_frame_placements(model, data);
-  gravity_and_coriolis_transpose_backward(model, data);
   composite_rigid_body(model, data);
   return compute_mass_matrix_cholesky(data);
 }

@@ -196,6 +196,8 @@ void QpSolver::resize(Index n, Index m_eq, Index m_in) {
   row_scale_.setZero(m_rows_);
   row_peak_.setZero(std::max(m_eq_, m_in_));
   row_values_.setZero(m_in_);
+  live_rows_.assign(static_cast<std::size_t>(m_in_), 0);
+  live_row_count_ = 0;
   lower_.setZero(m_all);
   upper_.setZero(m_all);
   g_.setZero(n_);
@@ -309,26 +311,42 @@ void QpSolver::invert_factor() {
 
 // ------------------------------------------------------------------------------------ input
 
-// Copies the rows of `a` (m x n) into rows_ from column `first` on, scaled to unit length, with
-// row_scale_ = 1 / |row| (0 for an all-zero row). Returns the first row holding NaN or Inf, or -1.
+// Scales the rows of `a` (m x n) to unit length, row_scale_ = 1 / |row| (0 for an all-zero row) from
+// index `first` on, and copies into rows_ the rows listed in `copy` (count of them; nullptr: all).
+// Returns the first row holding NaN or Inf, or -1: every row is checked, copied or not.
 // The squared norms accumulate down the contiguous columns of `a` and the square roots and
 // divisions go through Eigen's vectorised array functions in one batch; one row at a time,
 // their latency dominated the whole load. The largest |entry| of each row, accumulated in the
 // same pass, tells an all-zero row (a constraint that bounds nothing this cycle: most
 // self-collision pairs) without reading it again across the columns.
-Index QpSolver::load_rows(const Eigen::MatrixXd& a, Index first) {
+Index QpSolver::load_rows(const Eigen::MatrixXd& a, Index first, const Index* copy, Index count) {
   const Index n = n_;
   const Index m = a.rows();
   if (m == 0) return -1;
   double* scale = row_scale_.data() + first;
   double* peak = row_peak_.data();  // per row, max |a_ij| (NaN skipped: the sum of squares shows it)
-  for (Index i = 0; i < m; ++i) scale[i] = peak[i] = 0.0;
-  for (Index j = 0; j < n; ++j) {
-    const double* col = a.col(j).data();
-    for (Index i = 0; i < m; ++i) {
-      scale[i] += col[i] * col[i];
-      peak[i] = std::max(peak[i], std::abs(col[i]));
+  // Four rows at a time, their sums in registers down the columns; the last m % 4 one by one.
+  const double* data = a.data();
+  Index i0 = 0;
+  for (; i0 + 4 <= m; i0 += 4) {
+    Eigen::Array4d squares = Eigen::Array4d::Zero(), largest = Eigen::Array4d::Zero();
+    for (Index j = 0; j < n; ++j) {
+      const Eigen::Array4d v = Eigen::Map<const Eigen::Array4d>(data + j * m + i0);
+      squares += v * v;
+      largest = largest.max(v.abs());
     }
+    Eigen::Map<Eigen::Array4d>(scale + i0) = squares;
+    Eigen::Map<Eigen::Array4d>(peak + i0) = largest;
+  }
+  for (; i0 < m; ++i0) {
+    double squares = 0.0, largest = 0.0;
+    for (Index j = 0; j < n; ++j) {
+      const double v = data[j * m + i0];
+      squares += v * v;
+      largest = std::max(largest, std::abs(v));
+    }
+    scale[i0] = squares;
+    peak[i0] = largest;
   }
   auto scales = row_scale_.segment(first, m).array();
   scales = scales.sqrt().inverse();
@@ -352,10 +370,19 @@ Index QpSolver::load_rows(const Eigen::MatrixXd& a, Index first) {
       has_null_rows_ |= scale[i] == 0.0;
     }
   }
-  for (Index j = 0; j < n; ++j) {
-    const double* col = a.col(j).data();
-    double* dst = rows_.data() + j + first * n;
-    for (Index i = 0; i < m; ++i) dst[i * n] = col[i] * scale[i];
+  if (copy == nullptr) {
+    for (Index j = 0; j < n; ++j) {
+      const double* col = a.col(j).data();
+      double* dst = rows_.data() + j + first * n;
+      for (Index i = 0; i < m; ++i) dst[i * n] = col[i] * scale[i];
+    }
+    return -1;
+  }
+  for (Index t = 0; t < count; ++t) {
+    const Index i = copy[t] - first;
+    const double* src = a.data() + i;
+    double* dst = rows_.data() + (first + i) * n;
+    for (Index j = 0; j < n; ++j) dst[j] = src[j * m] * scale[i];
   }
   return -1;
 }
@@ -369,7 +396,13 @@ Index check_sides(const Eigen::VectorXd& lo, const Eigen::VectorXd& hi, Index m,
   const bool has_hi = hi.size() > 0;
   bool bad = false;
   if (has_lo && has_hi) {
-    for (Index i = 0; i < m; ++i) bad |= !(lo(i) <= hi(i)) | (lo(i) == kInf) | (hi(i) == -kInf);
+    // hi - lo >= 0 fails exactly for NaN, lo > hi, lo = hi = +inf and lo = hi = -inf (inf - inf is
+    // NaN), and the difference of two doubles is never of the wrong sign: one vectorised test.
+    const double* l = lo.data();
+    const double* u = hi.data();
+    Index failures = 0;
+    for (Index i = 0; i < m; ++i) failures += !(u[i] - l[i] >= 0.0);
+    bad = failures > 0;
   } else if (has_lo) {
     for (Index i = 0; i < m; ++i) bad |= !(lo(i) < kInf);
   } else if (has_hi) {
@@ -387,16 +420,31 @@ Index check_sides(const Eigen::VectorXd& lo, const Eigen::VectorXd& hi, Index m,
   return -1;
 }
 
-// lower/upper in the scaled units, -inf/+inf for absent sides.
+// Writes to out the indices first + i of the m rows with a side inside (-big, big) (NaN: not
+// listed, check_sides refuses it); returns their count.
+Index list_live_rows(const Eigen::VectorXd& lo, const Eigen::VectorXd& hi, Index m, Index first, double big,
+                     Index* out) {
+  const bool has_lo = lo.size() > 0;
+  const bool has_hi = hi.size() > 0;
+  Index live = 0;
+  for (Index i = 0; i < m; ++i) {
+    out[live] = first + i;
+    live += (has_lo && lo(i) > -big) | (has_hi && hi(i) < big);
+  }
+  return live;
+}
+
+// lower/upper in the scaled units (scale nullptr: unscaled, the bounds), -inf/+inf for absent sides.
 void convert_sides(const Eigen::VectorXd& lo, const Eigen::VectorXd& hi, const double* scale, Index m, double big,
                    double* lower, double* upper) {
+  const auto scaled = [scale](double v, Index i) { return scale == nullptr ? v : v * scale[i]; };
   if (lo.size() > 0) {
-    for (Index i = 0; i < m; ++i) lower[i] = lo(i) <= -big ? -kInf : lo(i) * scale[i];
+    for (Index i = 0; i < m; ++i) lower[i] = lo(i) <= -big ? -kInf : scaled(lo(i), i);
   } else {
     for (Index i = 0; i < m; ++i) lower[i] = -kInf;
   }
   if (hi.size() > 0) {
-    for (Index i = 0; i < m; ++i) upper[i] = hi(i) >= big ? kInf : hi(i) * scale[i];
+    for (Index i = 0; i < m; ++i) upper[i] = hi(i) >= big ? kInf : scaled(hi(i), i);
   } else {
     for (Index i = 0; i < m; ++i) upper[i] = kInf;
   }
@@ -439,8 +487,12 @@ QpInvalidReason QpSolver::load(const QpProblem& p, bool reuse_factor) {
     invalid_index_ = first_non_finite_row(p.b_eq);
     return QpInvalidReason::kNonFiniteEqualityTarget;
   }
-  if ((invalid_index_ = load_rows(p.A_eq, 0)) >= 0) return QpInvalidReason::kNonFiniteEqualityRows;
-  if ((invalid_index_ = load_rows(p.A, m_eq_)) >= 0) return QpInvalidReason::kNonFiniteInequalityRows;
+  if ((invalid_index_ = load_rows(p.A_eq, 0, nullptr, 0)) >= 0) return QpInvalidReason::kNonFiniteEqualityRows;
+  // The inequality rows with a finite side; the rest bound nothing: neither copied nor scanned.
+  live_row_count_ = list_live_rows(p.l, p.u, m_in_, m_eq_, big, live_rows_.data());
+  if ((invalid_index_ = load_rows(p.A, m_eq_, live_rows_.data(), live_row_count_)) >= 0) {
+    return QpInvalidReason::kNonFiniteInequalityRows;
+  }
 
   bool inverted = false;
   if ((invalid_index_ = check_sides(p.l, p.u, m_in_, inverted)) >= 0) {
@@ -452,16 +504,7 @@ QpInvalidReason QpSolver::load(const QpProblem& p, bool reuse_factor) {
 
   for (Index k = 0; k < m_eq_; ++k) lower_(k) = upper_(k) = p.b_eq(k) * row_scale_(k);
   convert_sides(p.l, p.u, row_scale_.data() + m_eq_, m_in_, big, lower_.data() + m_eq_, upper_.data() + m_eq_);
-  if (p.lb.size() > 0) {
-    for (Index j = 0; j < n; ++j) lower_(m_rows_ + j) = p.lb(j) <= -big ? -kInf : p.lb(j);
-  } else {
-    lower_.tail(n).setConstant(-kInf);
-  }
-  if (p.ub.size() > 0) {
-    for (Index j = 0; j < n; ++j) upper_(m_rows_ + j) = p.ub(j) >= big ? kInf : p.ub(j);
-  } else {
-    upper_.tail(n).setConstant(kInf);
-  }
+  convert_sides(p.lb, p.ub, nullptr, n, big, lower_.data() + m_rows_, upper_.data() + m_rows_);
 
   if (has_null_rows_) {
     // An all-zero equality row reads 0 = b: skipped as dependent, its consistency decided here.
@@ -652,12 +695,15 @@ bool QpSolver::most_violated(Index& best_k, int& best_sign) {
     }
   };
   if (n_ >= kLargeRows) {
+    // Rows outside the live list hold stale values; they are not read.
     columns_dot(rows_.data() + m_eq_ * n_, n_, n_, m_in_, x_.data(), row_values_.data());
-    for (Index i = 0; i < m_in_; ++i) {
-      if (sign_[static_cast<std::size_t>(m_eq_ + i)] == 0) consider(m_eq_ + i, row_values_(i));
+    for (Index i = 0; i < live_row_count_; ++i) {
+      const Index k = live_rows_[static_cast<std::size_t>(i)];
+      if (sign_[static_cast<std::size_t>(k)] == 0) consider(k, row_values_(k - m_eq_));
     }
   } else {
-    for (Index k = m_eq_; k < m_rows_; ++k) {
+    for (Index i = 0; i < live_row_count_; ++i) {
+      const Index k = live_rows_[static_cast<std::size_t>(i)];
       if (sign_[static_cast<std::size_t>(k)] == 0) consider(k, dot(rows_.col(k).data(), x_.data(), n_));
     }
   }

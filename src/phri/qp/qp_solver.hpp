@@ -102,7 +102,7 @@ public:
 
 private:
   QpInvalidReason load(const QpProblem& problem, bool reuse_factor);
-  Index load_rows(const Eigen::MatrixXd& a, Index first);
+  Index load_rows(const Eigen::MatrixXd& a, Index first, const Index* copy, Index count);
   QpInvalidReason factorize(const Eigen::Ref<const Eigen::MatrixXd>& hessian, Index& bad_index);
   void invert_factor();
   void start_working_set(bool warm);
@@ -130,7 +130,8 @@ private:
   Eigen::MatrixXd inv_chol_;
   bool has_factor_ = false;
 
-  // Rows of A_eq and A, transposed (one contiguous column per row) and scaled to unit length.
+  // Rows of A_eq and A, transposed (one contiguous column per row) and scaled to unit length; an
+  // inequality row outside live_rows_ is not copied (its column holds an earlier solve's row).
   Eigen::MatrixXd rows_;
   Eigen::VectorXd row_scale_;  // 1 / |row|, 0 for an all-zero row
   Eigen::VectorXd row_peak_;   // load_rows' scratch: max |entry| per row
@@ -151,6 +152,11 @@ private:
   Eigen::VectorXd dir_;             // R^-1 d1: dual step direction
   Eigen::VectorXd work_;
   Eigen::VectorXd row_values_;      // A x (scaled rows), for the large-n scan
+  // The inequality rows with a finite side (the others can never be violated nor enter), in order,
+  // as constraint indices: only these are copied and scanned (most self-collision pairs bound
+  // nothing in a cycle).
+  std::vector<Index> live_rows_;
+  Index live_row_count_ = 0;
 
   // Published results.
   QpStatus status_ = QpStatus::kInvalidInput;
