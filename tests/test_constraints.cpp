@@ -452,4 +452,48 @@ TEST_F(ConstraintTest, CollisionBrakingStopsAFastApproachBeforeTheSafetyDistance
   EXPECT_GT(damper.min_acceleration(0.03, -1.5), 90.0);
 }
 
+// The broad phase's decision without the square root (collision_braking_left_out) is the braking
+// bound's own, on random states and on approaches within a few ulp of the square-root end, the
+// linear end, zero, and non-finite inputs and settings.
+TEST(CollisionBraking, TheLeftOutTestAgreesWithTheBoundEverywhere) {
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double d_s = 0.015;
+  std::mt19937_64 rng(44);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  long checked = 0, boundary = 0;
+  const auto agree = [&](double d, double d_dot, const phri::CollisionBrakingSettings& b) {
+    const bool left_out = phri::collision_braking_bound(d, d_dot, d_s, b) == -kInf;
+    EXPECT_EQ(phri::collision_braking_left_out(d, d_dot, d_s, b), left_out)
+        << "d " << d << ", d_dot " << d_dot << ", a " << b.deceleration << ", gain " << b.gain;
+    ++checked;
+  };
+  for (int k = 0; k < 20000; ++k) {
+    const phri::CollisionBrakingSettings b{unit(rng) < 0.05 ? 0.0 : 0.1 + 10.0 * unit(rng), 1.0 + 100.0 * unit(rng)};
+    const double d = -0.05 + 1.5 * unit(rng);
+    agree(d, -3.0 + 4.0 * unit(rng), b);
+    // Approaches at the two ends of the profile, stepped by ulps across each.
+    const double x = std::max(d - d_s, 0.0);
+    for (const double end : {0.5 * std::sqrt(2.0 * b.deceleration * x), 0.5 * (0.2 * b.gain * x)}) {
+      double approach = end;
+      for (int step = 0; step < 3; ++step) approach = std::nextafter(approach, -kInf);
+      for (int step = 0; step < 6; ++step, approach = std::nextafter(approach, kInf)) {
+        agree(d, -approach, b);
+        ++boundary;
+      }
+    }
+  }
+  const phri::CollisionBrakingSettings b{3.0, 50.0};
+  for (const double d : {-kInf, -1.0, 0.0, d_s, 0.1, 1e300, kInf, nan}) {
+    for (const double d_dot : {-kInf, -1e300, -1.0, -1e-300, 0.0, 1.0, kInf, nan}) {
+      agree(d, d_dot, b);
+      agree(d, d_dot, {kInf, 50.0});
+      agree(d, d_dot, {3.0, kInf});
+      agree(d, d_dot, {nan, 50.0});
+    }
+  }
+  EXPECT_GT(boundary, 200000);
+  EXPECT_GT(checked, 220000);
+}
+
 }  // namespace

@@ -41,14 +41,29 @@ struct ObjectiveTerms {
   // w ||W^1/2 (A qdd - b)||^2 with W A given (weighted_rows; A itself when W = I): H += w A^T W A,
   // g -= w (W A)^T b. H's lower triangle from column dots, mirrored, so H stays exactly symmetric;
   // Eigen's product of two dynamic matrices takes its blocked GEMM path at a task's sizes (6 x 7).
+  // A pose task's six rows take fixed-size column dots (a dynamic dot's run-time length costs more
+  // than its six products).
   void add_least_squares(double w, const Eigen::MatrixXd& rows, const Eigen::MatrixXd& weighted_rows,
                          const Eigen::Ref<const Eigen::VectorXd>& reference) {
-    const Eigen::Index n = rows.cols();
+    if (rows.rows() == 6 && weighted_rows.rows() == 6 && reference.size() == 6) {
+      using Column = Eigen::Map<const Eigen::Matrix<double, 6, 1>>;
+      add_least_squares(w, rows.cols(), [&](Eigen::Index c) { return Column(rows.col(c).data()); },
+                        [&](Eigen::Index c) { return Column(weighted_rows.col(c).data()); }, Column(reference.data()));
+      return;
+    }
+    add_least_squares(w, rows.cols(), [&](Eigen::Index c) { return rows.col(c); },
+                      [&](Eigen::Index c) { return weighted_rows.col(c); }, reference);
+  }
+
+private:
+  template <class Column, class WeightedColumn, class Reference>
+  void add_least_squares(double w, Eigen::Index n, const Column& column, const WeightedColumn& weighted_column,
+                         const Reference& reference) {
     for (Eigen::Index j = 0; j < n; ++j) {
-      const auto weighted = weighted_rows.col(j);
+      const auto weighted = weighted_column(j);
       gradient[j] -= w * weighted.dot(reference);
       for (Eigen::Index i = j; i < n; ++i) {
-        const double term = w * rows.col(i).dot(weighted);
+        const double term = w * column(i).dot(weighted);
         hessian(i, j) += term;
         if (i != j) hessian(j, i) += term;
       }

@@ -3,6 +3,7 @@
 #include <phri/model/algorithms.hpp>
 
 #include <array>
+#include <cmath>
 
 namespace phri {
 namespace {
@@ -114,11 +115,25 @@ void composite_rigid_body_from_placements(const Model& model, Data& data) {
   });
 }
 
-// I_i v_i, the body's momentum, for every backward sweep (Newton-Euler and C^T qd). Out of line so
-// that each rounds it the same way: inlined, GCC contracts its multiply-adds into FMAs differently
-// where the result has one use and where it has two.
-[[gnu::noinline]] Vector6d body_momentum(const Data& data, int i) {
-  return data.body_inertias[static_cast<std::size_t>(i)].apply(data.body_velocities.col(i));
+// I_i v_i, the body's momentum (WorldInertia::apply), for every backward sweep (Newton-Euler and
+// C^T qd), with each multiply-add an explicit fma: left to itself GCC contracts them into FMAs
+// differently where the result has one use and where it has two, and the sweeps that share this
+// momentum must round it alike (nonlinear_effects, C^T qd and compute_all_terms agree to the bit).
+[[gnu::always_inline]] inline Vector6d body_momentum(const Data& data, int i) {
+  const WorldInertia& inertia = data.body_inertias[static_cast<std::size_t>(i)];
+  const auto motion = data.body_velocities.col(i);
+  const double vx = motion[0], vy = motion[1], vz = motion[2], wx = motion[3], wy = motion[4], wz = motion[5];
+  const double hx = inertia.first_moment.x(), hy = inertia.first_moment.y(), hz = inertia.first_moment.z();
+  const Eigen::Matrix3d& r = inertia.rotational;
+  const double m = inertia.mass;
+  Vector6d f;
+  f[0] = std::fma(m, vx, -std::fma(hy, wz, -(hz * wy)));  // m v - h x w
+  f[1] = std::fma(m, vy, -std::fma(hz, wx, -(hx * wz)));
+  f[2] = std::fma(m, vz, -std::fma(hx, wy, -(hy * wx)));
+  f[3] = std::fma(r(0, 0), wx, std::fma(r(0, 1), wy, std::fma(r(0, 2), wz, std::fma(hy, vz, -(hz * vy)))));  // I w + h x v
+  f[4] = std::fma(r(1, 0), wx, std::fma(r(1, 1), wy, std::fma(r(1, 2), wz, std::fma(hz, vx, -(hx * vz)))));
+  f[5] = std::fma(r(2, 0), wx, std::fma(r(2, 1), wy, std::fma(r(2, 2), wz, std::fma(hx, vy, -(hy * vx)))));
+  return f;
 }
 
 // Backward Newton-Euler sweep with the body velocities and accelerations already in Data.

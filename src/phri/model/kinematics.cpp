@@ -154,16 +154,18 @@ void frame_jacobian(const Model& model, const Data& data, int frame_id, Referenc
                     Eigen::Ref<Eigen::MatrixXd> jacobian) {
   check_size("frame_jacobian", "jacobian rows", jacobian.rows(), 6);
   check_size("frame_jacobian", "jacobian cols", jacobian.cols(), model.nv());
-  jacobian.setZero();
   const Frame& frame = model.frame(frame_id);
+  const int columns = frame.body + 1;  // the joints that move the frame; the rest are zero
+  jacobian.rightCols(model.nv() - columns).setZero();
+  if (rf == ReferenceFrame::kWorld) {
+    jacobian.leftCols(columns) = data.motion_subspace.leftCols(columns);
+    return;
+  }
   const Eigen::Isometry3d& oMf = data.frame_placements[static_cast<std::size_t>(frame_id)];
-  for (int j = 0; j <= frame.body; ++j) {
+  const Eigen::Vector3d p = oMf.translation();
+  for (int j = 0; j < columns; ++j) {
     const auto s = data.motion_subspace.col(j);
-    if (rf == ReferenceFrame::kWorld) {
-      jacobian.col(j) = s;
-      continue;
-    }
-    Eigen::Vector3d lin = s.head<3>() + s.tail<3>().cross(oMf.translation());
+    Eigen::Vector3d lin = s.head<3>() + s.tail<3>().cross(p);
     Eigen::Vector3d ang = s.tail<3>();
     if (rf == ReferenceFrame::kLocal) {
       lin = oMf.linear().transpose() * lin;
