@@ -207,7 +207,6 @@ void kinematics_with_drift(const Model& model, Data& data, const Eigen::VectorXd
   update_body_inertias(model, data);
 }
 
-
 // h(q, qd) (the Newton-Euler sweep with qdd = 0), g(q) and C^T qd in one backward pass, each
 // body's inertia and momentum I_i v_i formed once for the three.
 void nonlinear_gravity_and_coriolis_transpose_backward(const Model& model, Data& data) {
@@ -259,7 +258,6 @@ void coriolis_transpose_step(const Data& data, int i, Vector6d& momentum, Eigen:
   out[i] = i == 0 ? 0.0  // the base does not move
                   : motion_cross(data.body_velocities.col(i - 1), data.motion_subspace.col(i)).dot(momentum);
 }
-
 
 }  // namespace
 

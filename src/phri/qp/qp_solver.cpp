@@ -324,7 +324,7 @@ Index QpSolver::load_rows(const Eigen::MatrixXd& a, Index first, const Index* co
   const Index m = a.rows();
   if (m == 0) return -1;
   double* scale = row_scale_.data() + first;
-  double* peak = row_peak_.data();  // per row, max |a_ij| (NaN skipped: the sum of squares shows it)
+  double* peak = row_peak_.data();  // per row, max |a_ij| (read only where the squares sum to zero: no NaN)
   // Four rows at a time, their sums in registers down the columns; the last m % 4 one by one.
   const double* data = a.data();
   Index i0 = 0;
