@@ -3,6 +3,7 @@
 // forward-kinematics check from Kinova's numbers, URDF validation errors, zero heap allocation.
 #include <phri/core/error.hpp>
 #include <phri/model/algorithms.hpp>
+#include <phri/model/fixed_size_ldlt.hpp>
 #include <phri/core/batch_math.hpp>
 #include <phri/model/model.hpp>
 #include <phri/model/small_cholesky.hpp>
@@ -495,6 +496,55 @@ TEST(SmallCholesky, AgreesWithEigensLltToRoundingAndRefusesWhatItRefuses) {
   EXPECT_THROW(factor.compute(Eigen::MatrixXd::Identity(3, 4)), phri::ArgumentError);
   Eigen::VectorXd too_long = Eigen::VectorXd::Ones(4);
   EXPECT_THROW(factor.solve_in_place(too_long), phri::ArgumentError);
+}
+
+// FixedSizeLdlt (the singular-direction weight's 6 x 6 tests and solves) against Eigen's LLT and its
+// defining identity: L D L^T rebuilt from the pivots equals A, the solve's backward error is at
+// rounding, and definiteness is decided as the spectrum says, down to eigenvalues of 1e-10 ||A||.
+template <int N>
+void check_fixed_size_ldlt(std::mt19937& rng) {
+  using Matrix = Eigen::Matrix<double, N, N>;
+  using Vector = Eigen::Matrix<double, N, 1>;
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  for (int trial = 0; trial < 200; ++trial) {
+    const Matrix q = Eigen::HouseholderQR<Matrix>(Matrix::NullaryExpr([&] { return unit(rng); })).householderQ();
+    for (const double smallest : {1.0, 1e-3, 1e-6, 1e-10, -1e-10, -1e-3}) {
+      Vector spectrum = Vector::NullaryExpr([&] { return 1.0 + unit(rng); }).cwiseMax(smallest);
+      spectrum[trial % N] = smallest;
+      Matrix a = q * spectrum.asDiagonal() * q.transpose();
+      a = (0.5 * (a + a.transpose())).eval();
+      Matrix upper_garbage = a;
+      upper_garbage.template triangularView<Eigen::StrictlyUpper>().setConstant(std::nan(""));
+      phri::FixedSizeLdlt<N> ldlt;
+      const bool definite = ldlt.compute(upper_garbage);
+      EXPECT_EQ(definite, smallest > 0.0) << N << " smallest eigenvalue " << smallest;
+      EXPECT_EQ(ldlt.ok(), definite);
+      if (!definite) continue;
+      const double condition = 2.0 / smallest;
+      const Eigen::LLT<Matrix> reference(a);
+      const Vector d = reference.matrixL().toDenseMatrix().diagonal().cwiseAbs2();
+      EXPECT_LT(((ldlt.pivots() - d).cwiseQuotient(d)).cwiseAbs().maxCoeff(), 1e-15 * N * condition) << N;
+      const Vector b = Vector::NullaryExpr([&] { return unit(rng); });
+      const Vector x = ldlt.solve(b);
+      EXPECT_LT((a * x - b).norm() / (2.0 * x.norm()), 1e-14 * N) << N << " smallest " << smallest;  // ||A|| <= 2
+      EXPECT_LT((x - reference.solve(b)).norm() / x.norm(), 1e-15 * N * condition) << N << " smallest " << smallest;
+    }
+  }
+  // A NaN on or below the diagonal is refused; the refusal holds until the next factor.
+  Matrix not_a_number = Matrix::Identity();
+  not_a_number(N - 1, 0) = std::nan("");
+  phri::FixedSizeLdlt<N> ldlt;
+  EXPECT_FALSE(ldlt.compute(not_a_number));
+  EXPECT_FALSE(ldlt.ok());
+  EXPECT_TRUE(ldlt.compute(Matrix::Identity()));
+}
+
+TEST(FixedSizeLdlt, FactorsSolvesAndDecidesDefinitenessAsTheSpectrumSays) {
+  std::mt19937 rng(2026);
+  check_fixed_size_ldlt<1>(rng);
+  check_fixed_size_ldlt<3>(rng);
+  check_fixed_size_ldlt<6>(rng);
+  check_fixed_size_ldlt<7>(rng);
 }
 
 // ------------------------------------------------------------------- Kinova's own FK figures

@@ -23,22 +23,24 @@
 // nothing steps when eigenvectors swap. When every sigma_i >= sigma_0 the weight is the identity
 // and the task is exactly the paper's (W is then not even formed: update() says false).
 //
-// The test is cheap: every sigma_i >= sigma_0 exactly when J J^T - sigma_0^2 I has a Cholesky
-// factor (6 x 6). Near a singularity one direction is weak, cycle after cycle, and its direction
+// The test is cheap: every sigma_i >= sigma_0 exactly when J J^T - sigma_0^2 I is positive
+// definite, which a 6 x 6 root-free Cholesky (L D L^T, model/fixed_size_ldlt.hpp) decides.
+// Near a singularity one direction is weak, cycle after cycle, and its direction
 // moves little in a millisecond: W = I - (1 - f_w) u_w u_w^T is then updated from the last u_w by
-// Rayleigh-quotient iteration (cubic convergence; one or two 6 x 6 Cholesky solves in its
+// Rayleigh-quotient iteration (cubic convergence; one or two 6 x 6 factorisations in its
 // Jacobi-Davidson form) and accepted only when checked exact: the residual |A u - mu u| at rounding
-// level, mu below sigma_0^2, and every other eigenvalue at or above it (A - b I + c u u^T has a
-// Cholesky factor for b = sigma_0^2, or did for b = 4 sigma_0^2 on an A within Weyl's distance).
+// level, mu below sigma_0^2, and every other eigenvalue at or above it (A - b I + c u u^T positive
+// definite for b = sigma_0^2, or for b = 4 or 2 sigma_0^2 on an A within Weyl's distance).
 // Otherwise (first cycle near the singularity, two weak directions, a check failing) the
 // eigen-decomposition decides, as it always did.
 //
 // Far from a singularity most cycles need no test at all. Weyl's inequality for singular values,
 // sigma_i(J) >= sigma_i(J_c) - ||J - J_c||_2 >= sigma_i(J_c) - ||J - J_c||_F, carries a certificate
-// sigma_min(J_c) >= b (a Cholesky factor of J_c J_c^T - b^2 I, b = 4 or 2 sigma_0) to every later J
+// sigma_min(J_c) >= b (J_c J_c^T - b^2 I positive definite, b = 4 or 2 sigma_0) to every later J
 // with ||J - J_c||_F < b - sigma_0: the same answer as the test, for 42 multiply-adds. The arm moves
 // J by ~1e-3 a millisecond; the certificate lasts tens of cycles. Fixed-size, no allocation.
-#include <Eigen/Cholesky>
+#include <phri/model/fixed_size_ldlt.hpp>
+
 #include <Eigen/Core>
 #include <Eigen/Eigenvalues>
 
@@ -81,7 +83,7 @@ public:
     // Near a singularity last cycle: the tracked weak direction, checked exact, decides at once.
     if (has_weak_direction_ && track_weak_direction(threshold)) return active_ = true;
     // Every sigma_i >= sigma_0 exactly when J J^T - sigma_0^2 I is positive definite (Sylvester):
-    // a 6 x 6 Cholesky decides it; the eigen-decomposition only runs when some sigma_i is below.
+    // a 6 x 6 L D L^T decides it; the eigen-decomposition only runs when some sigma_i is below.
     // After a pass, 2 sigma_0 and then 4 sigma_0 are tried for the certificate above.
     if (positive_definite_above(sigma0_)) {
       has_weak_direction_ = false;
@@ -108,22 +110,20 @@ public:
   long decompositions() const { return decompositions_; }
   /// Updates since construction that Weyl's certificate answered without a test.
   long certified_skips() const { return certified_skips_; }
-  /// Tracked updates whose other eigenvalues Weyl's certificate answered without a Cholesky test.
+  /// Tracked updates whose other eigenvalues Weyl's certificate answered without a factorisation.
   long second_certified() const { return second_certified_; }
 
 private:
-  // Whether J J^T - bound^2 I has a Cholesky factor: every singular value of J above bound.
+  // Whether J J^T - bound^2 I is positive definite: every singular value of J above bound.
   bool positive_definite_above(double bound) {
     shifted_ = jjt_;
     shifted_.diagonal().array() -= bound * bound;
-    llt_.compute(shifted_);
-    return llt_.info() == Eigen::Success;
+    return ldlt_.compute(shifted_);
   }
 
   // The eigen-decomposition of J J^T; remembers the weak direction when there is exactly one.
   bool decompose(double threshold) {
     ++decompositions_;
-    try_second_margin_ = true;
     eigen_.compute(jjt_);
     const Eigen::Matrix<double, 6, 1>& lambda = eigen_.eigenvalues();  // ascending
     has_weak_direction_ = lambda[0] < threshold && lambda[1] >= threshold;
@@ -148,15 +148,15 @@ private:
       // The step d on u's complement: (P (A - mu I) P + c u u^T) d = -r, P = I - u u^T, r = A u - mu u
       // (u^T r = 0, so P (A - mu I) P = A - mu I - u r^T - r u^T). u + d is (A - mu I)^-1 u scaled,
       // the RQI step, but the matrix is positive definite while mu stays below A's second eigenvalue
-      // (a Cholesky factor, no pivoting), and well conditioned where A - mu I is nearly singular.
+      // (an L D L^T, no pivoting), and well conditioned where A - mu I is nearly singular.
       shifted_ = jjt_;
       shifted_.diagonal().array() -= mu;
       shifted_.noalias() -= u * residual.transpose();
       shifted_.noalias() -= residual * u.transpose();
       shifted_.noalias() += scale * u * u.transpose();
-      llt_.compute(shifted_);
-      if (llt_.info() != Eigen::Success) return false;
-      u -= llt_.solve(residual);
+      if (!ldlt_.compute(shifted_)) return false;
+      ldlt_.solve_in_place(residual);
+      u -= residual;
       const double norm = u.norm();
       if (!std::isfinite(norm) || norm == 0.0) return false;
       u /= norm;
@@ -176,8 +176,10 @@ private:
 
   // Whether every eigenvalue of A = J J^T but the one along u is >= the threshold t. A + c u u^T - b I
   // positive definite gives lambda_1(A) >= b for any unit u (interlacing of a rank-one update), and by
-  // Weyl lambda_1 moves by at most ||A - A_c||_F: a test at b = 4 t carries to the next cycles while
-  // A stays within 3 t of the A_c it was made on. Below 4 t, b = t is tested every cycle, as before.
+  // Weyl lambda_1 moves by at most ||A - A_c||_F: a test at b = 4 t (or 2 t) carries to the next
+  // cycles while A stays within 3 t (t) of the A_c it was made on. When both fail, lambda_1 < 2 t
+  // (u being A's eigenvector to rounding) and a test at 4 t cannot pass before A has moved 2 t from
+  // there: until then b = t is tested every cycle.
   bool others_at_or_above(double threshold, const Vector6d& u, double scale) {
     if (second_margin_ > 0.0 && (jjt_ - second_jjt_).squaredNorm() < second_margin_ * second_margin_) {
       ++second_certified_;
@@ -188,15 +190,19 @@ private:
       shifted_ = jjt_;
       shifted_.diagonal().array() -= bound;
       shifted_.noalias() += (2.0 * scale) * u * u.transpose();
-      llt_.compute(shifted_);
-      return llt_.info() == Eigen::Success;
+      return ldlt_.compute(shifted_);
     };
-    if (try_second_margin_ && lifted_positive_definite(4.0 * threshold)) {
-      second_margin_ = 3.0 * threshold;
-      second_jjt_ = jjt_;
-      return true;
+    if (!second_ruled_out_ || (jjt_ - ruled_out_jjt_).squaredNorm() >= 4.0 * threshold * threshold) {
+      second_ruled_out_ = false;
+      for (const double factor : {4.0, 2.0}) {
+        if (!lifted_positive_definite(factor * threshold)) continue;
+        second_margin_ = (factor - 1.0) * threshold;
+        second_jjt_ = jjt_;
+        return true;
+      }
+      second_ruled_out_ = true;
+      ruled_out_jjt_ = jjt_;
     }
-    try_second_margin_ = false;  // until the next decomposition: lambda_1 is below 4 t
     return lifted_positive_definite(threshold);
   }
 
@@ -210,14 +216,15 @@ private:
   Vector6d weak_ = Vector6d::Zero();
   Matrix6d second_jjt_ = Matrix6d::Zero();  // A_c: lambda_1(A_c) >= t + second_margin_
   double second_margin_ = 0.0;              // 0: no certificate
-  bool try_second_margin_ = true;
+  bool second_ruled_out_ = false;            // lambda_1 < 2 t at ruled_out_jjt_
+  Matrix6d ruled_out_jjt_ = Matrix6d::Zero();
   long second_certified_ = 0;
   double smallest_singular_value_ = 0.0;
   Matrix6d jjt_ = Matrix6d::Zero();
   Matrix6d shifted_ = Matrix6d::Zero();
   Matrix6d weight_ = Matrix6d::Identity();
   Eigen::Matrix<double, 6, 1> factor_ = Eigen::Matrix<double, 6, 1>::Ones();
-  Eigen::LLT<Matrix6d> llt_{6};
+  FixedSizeLdlt<6> ldlt_;
   Eigen::SelfAdjointEigenSolver<Matrix6d> eigen_{6};
 };
 
