@@ -817,6 +817,23 @@ TEST(QpSolver, InvalidInputIsReported) {
   p = good;
   p.A(4, 4) = -kInf;
   expect_invalid(p, QpInvalidReason::kNonFiniteInequalityRows, 4, "Inf in A");
+  // A row that bounds nothing (both sides absent) is neither copied nor scaled, but still checked:
+  // a NaN or Inf in it, alone in an all-zero row or among finite entries, at its own index.
+  for (const double bad : {nan, kInf}) {
+    for (const bool zero_row : {true, false}) {
+      p = good;
+      p.l(3) = -kInf;
+      p.u(3) = kInf;
+      if (zero_row) p.A.row(3).setZero();
+      p.A(3, 2) = bad;
+      expect_invalid(p, QpInvalidReason::kNonFiniteInequalityRows, 3, "non-finite entry in a row that bounds nothing");
+    }
+  }
+  p = good;  // finite entries whose squares overflow, in a row that bounds nothing: valid
+  p.l(3) = -kInf;
+  p.u(3) = kInf;
+  p.A.row(3).setConstant(1e200);
+  EXPECT_EQ(s.solve(p), QpStatus::kOptimal);
   p = good;
   p.l(2) = p.u(2) + 1.0;
   expect_invalid(p, QpInvalidReason::kRowBoundsInverted, 2, "l > u");

@@ -312,7 +312,8 @@ void QpSolver::invert_factor() {
 // ------------------------------------------------------------------------------------ input
 
 // Scales the rows of `a` (m x n) to unit length, row_scale_ = 1 / |row| (0 for an all-zero row) from
-// index `first` on, and copies into rows_ the rows listed in `copy` (count of them; nullptr: all).
+// index `first` on, and copies into rows_ the rows listed in `copy` (count of them; nullptr: all;
+// the scale of a row left out is not meaningful and never read).
 // Returns the first row holding NaN or Inf, or -1: every row is checked, copied or not.
 // The squared norms accumulate down the contiguous columns of `a` and the square roots and
 // divisions go through Eigen's vectorised array functions in one batch; one row at a time,
@@ -353,7 +354,17 @@ Index QpSolver::load_rows(const Eigen::MatrixXd& a, Index first, const Index* co
   const double min_scale = 1.0 / std::sqrt(kMax);
   const double max_scale = 1.0 / std::sqrt(std::numeric_limits<double>::min());
   bool in_range = true;
-  for (Index i = 0; i < m; ++i) in_range &= scale[i] >= min_scale && scale[i] <= max_scale;
+  if (copy == nullptr) {
+    for (Index i = 0; i < m; ++i) in_range &= scale[i] >= min_scale && scale[i] <= max_scale;
+  } else {
+    // The rows left out bound nothing and their scale is never read: only a NaN or Inf in them
+    // matters, which makes the scale NaN or 0 (an all-zero row's is +inf, and passes).
+    for (Index t = 0; t < count; ++t) {
+      const double listed = scale[copy[t] - first];
+      in_range &= listed >= min_scale && listed <= max_scale;
+    }
+    for (Index i = 0; i < m; ++i) in_range &= scale[i] > 0.0;
+  }
   if (!in_range) {
     // Non-finite, zero (a constraint's row that bounds nothing this cycle: common), or so large or
     // small that the squares leave the double range (rare).
