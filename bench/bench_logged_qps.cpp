@@ -4,8 +4,9 @@
 // started from, with its options, as in the session; LoggedQpReplay/cold from the unconstrained
 // minimum. Reports per tick (its fastest of 5 passes) the median, p99 and worst in microseconds, the
 // worst tick's index in the file and its session cycle; the active-set changes (QpSolver::iterations)
-// in all and the ticks with at least one; and max |x - x_recorded|: 0 when warm (the same solver
-// on the same data from the same start reproduces the session bit for bit):
+// in all and the ticks with at least one; and max |x - x_recorded|: 0 when warm and the solver's
+// arithmetic is the recording's (bit for bit), rounding otherwise (~2e-11 since the unconstrained
+// start takes x from L instead of J = L^-T, after the file was recorded):
 //   build/release/bench/phri_bench --benchmark_filter=LoggedQpReplay
 #include "logged_qps.hpp"
 

@@ -769,6 +769,46 @@ TEST(QpSolver, HessianFactorReuseAndCallerFactor) {
   EXPECT_EQ(s3.set_hessian(MatrixXd::Identity(3, 3)), QpInvalidReason::kDimensionMismatch);
 }
 
+// J = L^-T is formed only when a constraint enters. Alternating, on one solver, problems whose
+// optimum is unconstrained (no J formed) with problems that need constraints (J formed then), with
+// new Hessians and with the factor the unconstrained solve before stored (reused: J formed from
+// it later), n = 7 (the unrolled factor) and n = 12: each answer is a fresh solver's to rounding
+// and meets KKT, i.e. never a J left from another Hessian.
+TEST(QpSolver, TheInverseFactorIsFormedFromTheCurrentHessianWhenFirstNeeded) {
+  Rng rng(4401);
+  for (const Index n : {Index{7}, Index{12}}) {
+    QpSolver s(n, 0, 6);
+    MatrixXd previous_h;
+    int constrained = 0;
+    for (int round = 0; round < 40; ++round) {
+      QpProblem p = random_problem(rng, {n, 0, 6}, 2.0, true, 10.0);
+      const bool free = round % 2 == 0;
+      const bool reuse = round % 4 == 1;  // the factor the free solve of the round before stored
+      if (free) {  // every side absent: the unconstrained minimum is the answer
+        p.l.setConstant(-kInf);
+        p.u.setConstant(kInf);
+        p.lb.setConstant(-kInf);
+        p.ub.setConstant(kInf);
+      }
+      if (reuse) p.H = previous_h;
+      QpSolver fresh = solver_for(p);
+      ASSERT_EQ(fresh.solve(p), QpStatus::kOptimal) << n << " round " << round;
+      QpProblem input = p;
+      if (reuse) input.H.resize(0, 0);
+      ASSERT_EQ(s.solve(input, {.warm_start = round % 3 == 0, .reuse_hessian_factor = reuse}), QpStatus::kOptimal)
+          << n << " round " << round;
+      EXPECT_LE((s.x() - fresh.x()).norm(), 1e-9 * (1.0 + fresh.x().norm())) << n << " round " << round;
+      expect_kkt(p, s, 1e-7, "round " + std::to_string(round));
+      if (free) {
+        EXPECT_EQ(s.active_count(), 0);
+      }
+      constrained += s.active_count() > 0 ? 1 : 0;
+      previous_h = p.H;
+    }
+    EXPECT_GE(constrained, 10) << n;  // the constrained rounds did need constraints
+  }
+}
+
 // ------------------------------------------------------------------------------------ bad input
 
 TEST(QpSolver, InvalidInputIsReported) {

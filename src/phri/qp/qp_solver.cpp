@@ -2,7 +2,9 @@
 // (q columns), J = L^-T Q and R upper triangular with Q' L^-1 N = [R; 0]; J1 = first q columns of
 // J, J2 = the rest. For a constraint n'x >= b entering the active set, d = J'n, the primal step
 // direction is z = J2 d2 and the dual one r = R^-1 d1 (Section 3 of the paper). L is chol_ and
-// the initial J = L^-T is inv_chol_, both computed once per factorisation.
+// the initial J = L^-T is inv_chol_, formed from L once per factorisation and only when a solve
+// needs it: a solve that starts and ends with no constraint active (most of the controller's
+// ticks) takes x = -H^-1 g from L's two triangular solves and never forms J.
 //
 // Each row is scaled to unit length once per solve, which makes the violation test a distance and
 // keeps R well balanced. A constraint k enters with sign +1 (normal a_k, active at its lower side)
@@ -121,7 +123,7 @@ QpActiveSide side_of(std::int8_t sign) {
   return sign > 0 ? QpActiveSide::kLower : (sign < 0 ? QpActiveSide::kUpper : QpActiveSide::kInactive);
 }
 
-// Cholesky factor L and J = L^-T of an n x n matrix, n <= kSmall: H is padded with the identity
+// Cholesky factor L of an n x n matrix, n <= kSmall: H is padded with the identity
 // to kSmall x kSmall (the padding factors to itself) so that the compile-time loop bounds let
 // the compiler unroll everything. It runs as L D L' (W = L D column by column), which leaves
 // one division per column on the critical path instead of a square root and a division; the
@@ -129,7 +131,7 @@ QpActiveSide side_of(std::int8_t sign) {
 // pivot_min, or -1.
 constexpr Index kSmall = 8;
 
-Index factor_small(const double* h, Index ld, Index n, double pivot_min, double* l_out, double* j_out) {
+Index factor_small(const double* h, Index ld, Index n, double pivot_min, double* l_out) {
   constexpr int N = kSmall;
   double w[N][N];  // w[column][row]
   double inv_d[N];
@@ -156,25 +158,8 @@ Index factor_small(const double* h, Index ld, Index n, double pivot_min, double*
   double scale[N];  // D^-1/2
 #pragma GCC unroll 8
   for (int k = 0; k < N; ++k) scale[k] = std::sqrt(inv_d[k]);
-  // Unit-diagonal part first, J~(:, k) = e_k - sum_{i<k} L~(k, i) J~(:, i) with L~ = W D^-1; then
-  // J = J~ D^-1/2 and L = W D^-1/2.
-  double b[N][N];
-#pragma GCC unroll 8
-  for (int k = 0; k < N; ++k) {
-#pragma GCC unroll 8
-    for (int r = 0; r < N; ++r) b[k][r] = r == k ? 1.0 : 0.0;
-#pragma GCC unroll 8
-    for (int i = 0; i < k; ++i) {
-      const double f = w[i][k] * inv_d[i];
-#pragma GCC unroll 8
-      for (int r = 0; r < N; ++r) b[k][r] -= f * b[i][r];
-    }
-  }
   for (Index c = 0; c < n; ++c) {
-    for (Index r = 0; r < n; ++r) {
-      l_out[r + c * n] = w[c][r] * scale[c];
-      j_out[r + c * n] = b[c][r] * scale[c];
-    }
+    for (Index r = 0; r < n; ++r) l_out[r + c * n] = w[c][r] * scale[c];
   }
   return -1;
 }
@@ -191,6 +176,8 @@ void QpSolver::resize(Index n, Index m_eq, Index m_in) {
   chol_.setZero(n_, n_);
   inv_chol_.setZero(n_, n_);
   has_factor_ = false;
+  has_inverse_ = false;
+  j_formed_ = false;
 
   rows_.setZero(n_, m_rows_);
   row_scale_.setZero(m_rows_);
@@ -243,13 +230,14 @@ QpInvalidReason QpSolver::set_hessian_factor(const Eigen::Ref<const Eigen::Matri
     }
   }
   chol_.triangularView<Eigen::Lower>() = factor_l;
-  invert_factor();
   has_factor_ = true;
+  has_inverse_ = false;
   return QpInvalidReason::kNone;
 }
 
 QpInvalidReason QpSolver::factorize(const Eigen::Ref<const Eigen::MatrixXd>& h, Index& bad_index) {
   has_factor_ = false;
+  has_inverse_ = false;
   const Index n = n_;
   bool finite = true;
   double max_diagonal = 0.0;
@@ -265,7 +253,7 @@ QpInvalidReason QpSolver::factorize(const Eigen::Ref<const Eigen::MatrixXd>& h, 
   // A pivot below n eps max|H_ii| means H is not (numerically) positive definite.
   const double pivot_min = static_cast<double>(n) * std::numeric_limits<double>::epsilon() * max_diagonal;
   if (n <= kSmall) {
-    bad_index = factor_small(h.data(), h.outerStride(), n, pivot_min, l, inv_chol_.data());
+    bad_index = factor_small(h.data(), h.outerStride(), n, pivot_min, l);
     if (bad_index >= 0) return QpInvalidReason::kHessianNotPositiveDefinite;
     has_factor_ = true;
     return QpInvalidReason::kNone;
@@ -287,7 +275,6 @@ QpInvalidReason QpSolver::factorize(const Eigen::Ref<const Eigen::MatrixXd>& h, 
     const double inv = 1.0 / std::sqrt(pivot);
     for (Index i = j; i < n; ++i) lj[i] *= inv;
   }
-  invert_factor();
   has_factor_ = true;
   return QpInvalidReason::kNone;
 }
@@ -593,9 +580,14 @@ QpStatus QpSolver::finish_invalid(QpInvalidReason reason, Index index) {
 }
 
 void QpSolver::start_working_set(bool warm) {
-  j_ = inv_chol_;
   q_ = 0;
   std::fill(sign_.begin(), sign_.end(), std::int8_t{0});
+  if (m_eq_ == 0 && !(warm && has_warm_side())) {
+    solve_unconstrained();
+    j_formed_ = false;
+    return;
+  }
+  form_j();
   for (Index k = 0; k < m_eq_; ++k) add_warm_constraint(k, +1);
 
   if (warm) {
@@ -635,6 +627,51 @@ void QpSolver::start_working_set(bool warm) {
       solve_working_set();
     }
   }
+}
+
+bool QpSolver::has_warm_side() const {
+  for (Index i = 0; i < m_in_; ++i) {
+    const Index k = m_eq_ + i;
+    const QpActiveSide side = row_sides_[static_cast<std::size_t>(i)];
+    if ((side == QpActiveSide::kLower && lower_(k) > -kInf) || (side == QpActiveSide::kUpper && upper_(k) < kInf)) {
+      return true;
+    }
+  }
+  for (Index j = 0; j < n_; ++j) {
+    const Index k = m_rows_ + j;
+    const QpActiveSide side = bound_sides_[static_cast<std::size_t>(j)];
+    if ((side == QpActiveSide::kLower && lower_(k) > -kInf) || (side == QpActiveSide::kUpper && upper_(k) < kInf)) {
+      return true;
+    }
+  }
+  return false;
+}
+
+// x = -H^-1 g = -L^-T (L^-1 g): the minimum with no constraint active, without J.
+void QpSolver::solve_unconstrained() {
+  const Index n = n_;
+  const double* l = chol_.data();
+  double* x = x_.data();
+  for (Index i = 0; i < n; ++i) x[i] = -g_[i];
+  for (Index k = 0; k < n; ++k) {  // L y = -g, column by column
+    const double* lk = l + k * n;
+    x[k] /= lk[k];
+    for (Index i = k + 1; i < n; ++i) x[i] -= lk[i] * x[k];
+  }
+  for (Index k = n - 1; k >= 0; --k) {  // L' x = y; row k of L' is column k of L
+    const double* lk = l + k * n;
+    x[k] = (x[k] - dot(lk + k + 1, x + k + 1, n - k - 1)) / lk[k];
+  }
+}
+
+// The working J: L^-T (formed once per factorisation), before any constraint enters.
+void QpSolver::form_j() {
+  if (!has_inverse_) {
+    invert_factor();
+    has_inverse_ = true;
+  }
+  j_ = inv_chol_;
+  j_formed_ = true;
 }
 
 void QpSolver::add_warm_constraint(Index k, int sign) {
@@ -734,6 +771,7 @@ QpStatus QpSolver::iterate(int max_iterations) {
     Index p = -1;
     int sign = 0;
     if (!most_violated(p, sign)) return QpStatus::kOptimal;
+    if (!j_formed_) form_j();  // the unconstrained start (start_working_set) left it out
     double u_p = 0.0;
 
     // Step 2: move (x, u) until p is satisfied, dropping the constraints whose multiplier

@@ -106,6 +106,9 @@ private:
   QpInvalidReason factorize(const Eigen::Ref<const Eigen::MatrixXd>& hessian, Index& bad_index);
   void invert_factor();
   void start_working_set(bool warm);
+  bool has_warm_side() const;
+  void solve_unconstrained();
+  void form_j();
   void add_warm_constraint(Index k, int sign);
   void solve_working_set();
   void polish_active_constraints();
@@ -125,10 +128,12 @@ private:
   Index m_in_ = 0;
   Index m_rows_ = 0;  // m_eq + m_in; constraint k: equality < m_eq <= row < m_rows <= bound
 
-  // Hessian factor: H = L L' with L = chol_ (lower); inv_chol_ = L^-T is the initial J.
+  // Hessian factor: H = L L' with L = chol_ (lower); inv_chol_ = L^-T is the initial J, formed
+  // from L when a solve first needs it (has_inverse_).
   Eigen::MatrixXd chol_;
   Eigen::MatrixXd inv_chol_;
   bool has_factor_ = false;
+  bool has_inverse_ = false;
 
   // Rows of A_eq and A, transposed (one contiguous column per row) and scaled to unit length; an
   // inequality row outside live_rows_ is not copied (its column holds an earlier solve's row).
@@ -143,6 +148,7 @@ private:
 
   // Goldfarb-Idnani state: J = L^-T Q and R with Q' L^-1 N = [R; 0] for the q active normals N.
   Eigen::MatrixXd j_;
+  bool j_formed_ = false;  // false: no constraint entered yet this solve, j_ not set
   Eigen::MatrixXd r_;
   Index q_ = 0;
   std::vector<Index> active_;       // constraint index per working-set position
