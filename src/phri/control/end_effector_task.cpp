@@ -224,7 +224,7 @@ void EndEffectorTask::update(const Model& model, const Data& data, const Eigen::
   reference_ = in_task_axes(tracked_acceleration_) + stiffness_.value().cwiseProduct(task_error_) +
                damping_.value().cwiseProduct(in_task_axes(tracked_velocity_ - velocity_)) + integral_term_ -
                in_task_axes(bias);
-  external_task_acceleration_.noalias() = jacobian_ * qdd_external;
+  external_task_acceleration_.noalias() = jacobian_.lazyProduct(qdd_external);
   reference_ += gamma_.value().cwiseProduct(in_task_axes(external_task_acceleration_));
   if (axes_ == TaskAxes::kFrame) {
     const Eigen::Matrix3d rt = pose_.linear().transpose();
@@ -250,6 +250,16 @@ void EndEffectorTask::weigh_rows() {
   const bool singular = singular_weight_.update(a);
   weighted_ = singular || selecting_;
   if (!weighted_) return;
+  if (!selecting_ && singular_weight_.rank_one()) {
+    // W A = A - shrink u (u^T A), column by column.
+    const Vector6d& u = singular_weight_.weak_direction();
+    const double shrink = singular_weight_.shrink();
+    for (Eigen::Index j = 0; j < a.cols(); ++j) {
+      const Eigen::Map<const Vector6d> column(a.col(j).data());
+      weighted_rows_.col(j) = column - (shrink * u.dot(column)) * u;
+    }
+    return;
+  }
   if (!selecting_) {
     weighted_rows_.noalias() = singular_weight_.weight() * a;
     return;

@@ -45,7 +45,7 @@ public:
     const Eigen::Vector3d v = frame_velocity(c.model, c.data, frame_id_, ReferenceFrame::kLocalWorldAligned).head<3>();
     const Eigen::Vector3d drift = frame_jdot_qdot(c.model, c.data, frame_id_, ReferenceFrame::kLocalWorldAligned).head<3>();
     error_ = target_ - p;
-    external_.noalias() = rows_ * c.qdd_external;
+    external_.noalias() = rows_.lazyProduct(c.qdd_external);
     reference_ = stiffness_.cwiseProduct(error_) - damping_.cwiseProduct(v) - drift + gamma_.cwiseProduct(external_);
     weighted_rows_ = rows_;
     weighted_rows_.array().colwise() *= selection_.array();

@@ -30,7 +30,7 @@ void MomentumObserver::set_gain(double gain) { gains_.setConstant(gain); }
 void MomentumObserver::set_gains(const Eigen::VectorXd& gains) { gains_ = gains; }
 
 void MomentumObserver::reset(const Data& data, const Eigen::VectorXd& qd) {
-  initial_momentum_.noalias() = data.mass_matrix * qd;
+  initial_momentum_.noalias() = data.mass_matrix.lazyProduct(qd);
   integral_.setZero();
   residual_.setZero();
   release_integral_.setZero();
@@ -48,7 +48,7 @@ const Eigen::VectorXd& MomentumObserver::update(const Data& data, const Eigen::V
   // Integrate the model's momentum rate over the last period (with last period's residual),
   // then compare with the measured momentum.
   integral_ += dt * (tau_sensor + data.coriolis_transpose_qd - data.gravity_torque + residual_);
-  momentum_.noalias() = data.mass_matrix * qd;
+  momentum_.noalias() = data.mass_matrix.lazyProduct(qd);  // lazy: no general gemv call at n ~ 7
   residual_ = gains_.cwiseProduct(momentum_ - initial_momentum_ - integral_);
   if (release_gain_ <= 0.0) return residual_;
   release_integral_ += dt * (tau_sensor + data.coriolis_transpose_qd - data.gravity_torque + release_residual_);

@@ -81,7 +81,8 @@ public:
     }
     const double threshold = sigma0_ * sigma0_;
     // Near a singularity last cycle: the tracked weak direction, checked exact, decides at once.
-    if (has_weak_direction_ && track_weak_direction(threshold)) return active_ = true;
+    rank_one_ = false;
+    if (has_weak_direction_ && track_weak_direction(threshold)) return active_ = rank_one_ = true;
     // Every sigma_i >= sigma_0 exactly when J J^T - sigma_0^2 I is positive definite (Sylvester):
     // a 6 x 6 L D L^T decides it; the eigen-decomposition only runs when some sigma_i is below.
     // After a pass, 2 sigma_0 and then 4 sigma_0 are tried for the certificate above.
@@ -101,6 +102,11 @@ public:
   }
 
   bool active() const { return active_; }
+  /// When active() and the weak direction was tracked: W = I - shrink u u^T with u = weak_direction()
+  /// (W is formed too; W A is cheaper from this form). Otherwise false.
+  bool rank_one() const { return rank_one_; }
+  const Vector6d& weak_direction() const { return weak_; }
+  double shrink() const { return shrink_; }
   const Matrix6d& weight() const { return weight_; }
   /// sigma_min of the last update() that returned true.
   double smallest_singular_value() const { return smallest_singular_value_; }
@@ -168,8 +174,9 @@ private:
     if (!converged || mu >= threshold || !others_at_or_above(threshold, u, scale)) return false;
     weak_ = u;
     const double lambda = std::max(0.0, mu);
+    shrink_ = 1.0 - std::min(1.0, lambda / threshold);
     weight_.setIdentity();
-    weight_.noalias() -= (1.0 - std::min(1.0, lambda / threshold)) * u * u.transpose();
+    weight_.noalias() -= shrink_ * u * u.transpose();
     smallest_singular_value_ = std::sqrt(lambda);
     return true;
   }
@@ -208,6 +215,8 @@ private:
 
   double sigma0_;
   bool active_ = false;
+  bool rank_one_ = false;  // W = I - shrink_ weak_ weak_^T (the last update tracked the weak direction)
+  double shrink_ = 0.0;
   bool has_weak_direction_ = false;  // the last update had exactly one eigenvalue below the threshold
   long decompositions_ = 0;
   long certified_skips_ = 0;

@@ -218,7 +218,7 @@ void WholeBodyQp::bound_uncancelled_push() {
 // motion where it speeds a joint up (uncancelled_push.hpp). The torque rows bound the command: kept.
 void WholeBodyQp::shift_rows_by_uncancelled_push(Eigen::Index row, int n) {
   auto shift = row_shift_.head(n);
-  shift.noalias() = problem_.A.middleRows(row, n) * *qdd_uncancelled_;
+  shift.noalias() = problem_.A.middleRows(row, n).lazyProduct(*qdd_uncancelled_);
   shift *= uncancelled_share_;
   problem_.l.segment(row, n) -= shift;
   problem_.u.segment(row, n) -= shift;
@@ -289,7 +289,7 @@ WholeBodyQpStatus WholeBodyQp::update(const Model& model, const Data& data, cons
     warm_ = true;
     qdd_desired_ = solver_.x();
     // tau_d = M qdd_d + h - tau_ext (the convention stated in the header).
-    tau_desired_.noalias() = data.mass_matrix * qdd_desired_;
+    tau_desired_.noalias() = data.mass_matrix.lazyProduct(qdd_desired_);  // lazy: no general gemv call at n ~ 7
     tau_desired_ += data.nonlinear_effects - tau_ext;
     last_good_tau_ = tau_desired_;
     status_ = scaled ? WholeBodyQpStatus::kBrakingScaled : WholeBodyQpStatus::kOk;
@@ -358,7 +358,7 @@ void WholeBodyQp::fallback_brake(const Data& data, const Eigen::VectorXd& qd, co
   // tau(s) = hold + s M a, s in [0, 1]: the largest s that keeps every joint within its limit
   // (or, for a joint beyond it already, no further beyond).
   hold_torque_ = data.nonlinear_effects - tau_ext;
-  tau_desired_.noalias() = data.mass_matrix * qdd_desired_;
+  tau_desired_.noalias() = data.mass_matrix.lazyProduct(qdd_desired_);
   double scale = 1.0;
   for (int i = 0; i < nv_; ++i) {
     const double limit = torque_limit()[i], hold = hold_torque_[i], brake = tau_desired_[i];
