@@ -2,6 +2,7 @@
 //   build/release/bench/phri_bench --benchmark_filter=Model --benchmark_repetitions=10 --benchmark_report_aggregates_only=true
 #include <phri/control/power_force_limit.hpp>
 #include <phri/model/algorithms.hpp>
+#include <phri/model/fixed_size_ldlt.hpp>
 #include <phri/model/collision_model.hpp>
 #include <phri/model/model.hpp>
 #include <phri/model/small_cholesky.hpp>
@@ -123,6 +124,42 @@ void EigenLltCholeskySolve(benchmark::State& state) {
   }
 }
 BENCHMARK(EigenLltCholeskySolve)->Arg(7)->Arg(30);
+
+// The singular-direction weight's 6 x 6 step: factor J J^T (the Gen3's end-effector Jacobian at the
+// fixture's posture; positive definite, so that neither stops early) and solve once,
+// phri::FixedSizeLdlt<6> against Eigen's LLT<Matrix<double, 6, 6>>:
+//   build/release/bench/phri_bench --benchmark_filter=6FactorSolve
+Eigen::Matrix<double, 6, 6> task_space_input() {
+  Gen3 g;
+  phri::frame_jacobian(g.model, g.data, g.ee, phri::ReferenceFrame::kLocalWorldAligned, g.jacobian);
+  return g.jacobian * g.jacobian.transpose();
+}
+void FixedSizeLdlt6FactorSolve(benchmark::State& state) {
+  const Eigen::Matrix<double, 6, 6> a = task_space_input();
+  const Eigen::Matrix<double, 6, 1> b = Eigen::Matrix<double, 6, 1>::LinSpaced(-1.0, 1.0);
+  phri::FixedSizeLdlt<6> ldlt;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(ldlt.compute(a));
+    Eigen::Matrix<double, 6, 1> x = b;
+    ldlt.solve_in_place(x);
+    benchmark::DoNotOptimize(x.data());
+    benchmark::ClobberMemory();
+  }
+}
+BENCHMARK(FixedSizeLdlt6FactorSolve);
+void EigenLlt6FactorSolve(benchmark::State& state) {
+  const Eigen::Matrix<double, 6, 6> a = task_space_input();
+  const Eigen::Matrix<double, 6, 1> b = Eigen::Matrix<double, 6, 1>::LinSpaced(-1.0, 1.0);
+  Eigen::LLT<Eigen::Matrix<double, 6, 6>> llt(6);
+  for (auto _ : state) {
+    llt.compute(a);
+    benchmark::DoNotOptimize(llt.info());
+    Eigen::Matrix<double, 6, 1> x = llt.solve(b);
+    benchmark::DoNotOptimize(x.data());
+    benchmark::ClobberMemory();
+  }
+}
+BENCHMARK(EigenLlt6FactorSolve);
 
 void ModelRnea(benchmark::State& state) {
   Gen3 g;

@@ -3,7 +3,8 @@
 // whose size is a compile-time constant (6 x 6 task-space matrices such as J J^T). The root-free
 // form leaves one division per column on the factorisation's dependent chain (Cholesky adds a
 // square root), and the loops, their lengths known, unroll completely: on 6 x 6, factor and solve
-// take ~1/7 of Eigen's LLT<Matrix<double, 6, 6>> (which runs its blocked kernels at run-time sizes).
+// take ~1/6 of Eigen's LLT<Matrix<double, 6, 6>>, which runs its blocked kernels at run-time sizes
+// (phri_bench --benchmark_filter=6FactorSolve).
 // compute() reads A's lower triangle and says whether A is positive definite: every pivot d_j > 0,
 // in exact arithmetic the squares of the Cholesky pivots (a NaN fails, where Eigen's x <= 0 test
 // lets it through). No allocation.
