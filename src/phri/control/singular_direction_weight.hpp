@@ -63,7 +63,7 @@ public:
   /// True when some singular value of J (6 x nv) is below sigma_0: weight() is then W.
   /// False: W is the identity (not formed).
   bool update(const Eigen::MatrixXd& jacobian) {
-    active_ = false;
+    active_ = rank_one_ = false;
     if (sigma0_ <= 0.0) return false;
     const bool same_width = jacobian.cols() == certified_jacobian_.cols();
     if (certified_margin_ > 0.0 && same_width &&
@@ -81,7 +81,6 @@ public:
     }
     const double threshold = sigma0_ * sigma0_;
     // Near a singularity last cycle: the tracked weak direction, checked exact, decides at once.
-    rank_one_ = false;
     if (has_weak_direction_ && track_weak_direction(threshold)) return active_ = rank_one_ = true;
     // Every sigma_i >= sigma_0 exactly when J J^T - sigma_0^2 I is positive definite (Sylvester):
     // a 6 x 6 L D L^T decides it; the eigen-decomposition only runs when some sigma_i is below.

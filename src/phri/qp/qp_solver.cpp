@@ -123,6 +123,13 @@ QpActiveSide side_of(std::int8_t sign) {
   return sign > 0 ? QpActiveSide::kLower : (sign < 0 ? QpActiveSide::kUpper : QpActiveSide::kInactive);
 }
 
+// The sign a warm-start side enters with (+1 lower, -1 upper), or 0 when it is inactive or absent.
+int warm_sign(QpActiveSide side, double lower, double upper) {
+  if (side == QpActiveSide::kLower && lower > -kInf) return +1;
+  if (side == QpActiveSide::kUpper && upper < kInf) return -1;
+  return 0;
+}
+
 // Cholesky factor L of an n x n matrix, n <= kSmall: H is padded with the identity
 // to kSmall x kSmall (the padding factors to itself) so that the compile-time loop bounds let
 // the compiler unroll everything. It runs as L D L' (W = L D column by column), which leaves
@@ -595,15 +602,13 @@ void QpSolver::start_working_set(bool warm) {
     // normals dependent on those already in are skipped.
     for (Index i = 0; i < m_in_; ++i) {
       const Index k = m_eq_ + i;
-      const QpActiveSide side = row_sides_[static_cast<std::size_t>(i)];
-      if (side == QpActiveSide::kLower && lower_(k) > -kInf) add_warm_constraint(k, +1);
-      if (side == QpActiveSide::kUpper && upper_(k) < kInf) add_warm_constraint(k, -1);
+      const int sign = warm_sign(row_sides_[static_cast<std::size_t>(i)], lower_(k), upper_(k));
+      if (sign != 0) add_warm_constraint(k, sign);
     }
     for (Index j = 0; j < n_; ++j) {
       const Index k = m_rows_ + j;
-      const QpActiveSide side = bound_sides_[static_cast<std::size_t>(j)];
-      if (side == QpActiveSide::kLower && lower_(k) > -kInf) add_warm_constraint(k, +1);
-      if (side == QpActiveSide::kUpper && upper_(k) < kInf) add_warm_constraint(k, -1);
+      const int sign = warm_sign(bound_sides_[static_cast<std::size_t>(j)], lower_(k), upper_(k));
+      if (sign != 0) add_warm_constraint(k, sign);
     }
   }
   solve_working_set();
@@ -632,17 +637,11 @@ void QpSolver::start_working_set(bool warm) {
 bool QpSolver::has_warm_side() const {
   for (Index i = 0; i < m_in_; ++i) {
     const Index k = m_eq_ + i;
-    const QpActiveSide side = row_sides_[static_cast<std::size_t>(i)];
-    if ((side == QpActiveSide::kLower && lower_(k) > -kInf) || (side == QpActiveSide::kUpper && upper_(k) < kInf)) {
-      return true;
-    }
+    if (warm_sign(row_sides_[static_cast<std::size_t>(i)], lower_(k), upper_(k)) != 0) return true;
   }
   for (Index j = 0; j < n_; ++j) {
     const Index k = m_rows_ + j;
-    const QpActiveSide side = bound_sides_[static_cast<std::size_t>(j)];
-    if ((side == QpActiveSide::kLower && lower_(k) > -kInf) || (side == QpActiveSide::kUpper && upper_(k) < kInf)) {
-      return true;
-    }
+    if (warm_sign(bound_sides_[static_cast<std::size_t>(j)], lower_(k), upper_(k)) != 0) return true;
   }
   return false;
 }
